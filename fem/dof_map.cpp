@@ -1,0 +1,75 @@
+#include "fem/dof_map.hpp"
+
+#include "fem/elements.hpp"
+
+#include <stdexcept>
+
+namespace jointid::fem {
+
+namespace {
+constexpr int absent = -2, fixed = -1;
+}
+
+DofMap::DofMap(const Model& model) {
+  const std::size_t n = model.nodes.size();
+  node_ids_.reserve(n);
+  for (const auto& node : model.nodes) node_ids_.push_back(node.id);
+  eq_.assign(n, {absent, absent, absent, absent, absent, absent});
+  auto use = [&](int node_id, Dof dof) { eq_[model.node_index(node_id)][static_cast<int>(dof)] = 0; };
+  for (const auto& e : model.elements)
+    for (Dof d : element_dofs(e.type)) {
+      use(e.node_a, d);
+      use(e.node_b, d);
+    }
+  for (const auto& s : model.springs) {
+    use(s.node, s.dof);
+    if (s.node_b != 0) use(s.node_b, s.dof);
+  }
+  for (const auto& s : model.supports)
+    for (Dof d : s.fixed) {
+      int& slot = eq_[model.node_index(s.node)][static_cast<int>(d)];
+      if (slot != absent) slot = fixed;
+    }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int d = 0; d < num_dof_kinds; ++d)
+      if (eq_[i][d] == 0) {
+        eq_[i][d] = static_cast<int>(by_equation_.size());
+        by_equation_.push_back({node_ids_[i], static_cast<Dof>(d)});
+      }
+}
+
+int DofMap::index_of(int node_id) const {
+  for (std::size_t i = 0; i < node_ids_.size(); ++i)
+    if (node_ids_[i] == node_id) return static_cast<int>(i);
+  return -1;
+}
+
+DofMap::State DofMap::state(const NodeDof& nd) const {
+  const int i = index_of(nd.node);
+  if (i < 0) return State::absent;
+  const int e = eq_[i][static_cast<int>(nd.dof)];
+  return e == absent ? State::absent : e == fixed ? State::fixed : State::free;
+}
+
+int DofMap::equation(const NodeDof& nd) const {
+  const int i = index_of(nd.node);
+  if (i < 0) throw std::invalid_argument("node " + std::to_string(nd.node) + " does not exist");
+  const int e = eq_[i][static_cast<int>(nd.dof)];
+  if (e == absent)
+    throw std::invalid_argument("node " + std::to_string(nd.node) + " has no DOF " +
+                                std::string(dof_name(nd.dof)) +
+                                " (no element or spring at the node uses it)");
+  if (e == fixed)
+    throw std::invalid_argument("DOF " + to_string(nd) + " is fixed by a support");
+  return e;
+}
+
+std::array<int, 6> DofMap::node_equations(int node_id) const {
+  const int i = index_of(node_id);
+  if (i < 0) throw std::invalid_argument("node " + std::to_string(node_id) + " does not exist");
+  std::array<int, 6> out;
+  for (int d = 0; d < 6; ++d) out[d] = eq_[i][d] >= 0 ? eq_[i][d] : -1;
+  return out;
+}
+
+} // namespace jointid::fem

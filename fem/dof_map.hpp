@@ -1,0 +1,36 @@
+#pragma once
+/// Map between (node id, DOF) and equation numbers. A node has only the DOFs that an element
+/// or spring at it uses; supported (fixed) DOFs get no equation. Equations are numbered node by
+/// node in the order of Model::nodes, DOFs in the order ux uy uz rx ry rz.
+#include "fem/model.hpp"
+
+#include <array>
+#include <vector>
+
+namespace jointid::fem {
+
+class DofMap {
+public:
+  enum class State { absent, fixed, free };
+
+  DofMap() = default;
+  explicit DofMap(const Model& model);
+
+  int num_equations() const { return static_cast<int>(by_equation_.size()); }
+  State state(const NodeDof& nd) const;
+  /// Equation of a free DOF; throws std::invalid_argument saying whether the node does not
+  /// exist, does not have that DOF, or has it fixed by a support.
+  int equation(const NodeDof& nd) const;
+  const NodeDof& node_dof(int equation) const { return by_equation_.at(equation); }
+  /// Node ids in model order, and every node's equation numbers (-1 where absent or fixed).
+  const std::vector<int>& node_ids() const { return node_ids_; }
+  std::array<int, 6> node_equations(int node_id) const;
+
+private:
+  int index_of(int node_id) const;
+  std::vector<int> node_ids_;
+  std::vector<std::array<int, 6>> eq_; // -2 absent, -1 fixed, >= 0 equation
+  std::vector<NodeDof> by_equation_;
+};
+
+} // namespace jointid::fem

@@ -1,0 +1,192 @@
+#include "fem/time_integration.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+namespace jointid::fem {
+
+Newmark::Newmark(const Assembled& system, const SparseMatrix& C, const LocalForces* forces, double h,
+                 const NewmarkOptions& options)
+    : system_(system), C_(C), forces_(forces), h_(h), o_(options) {
+  if (!(h > 0.0)) throw std::invalid_argument("time step must be > 0");
+  const double b = o_.beta, g = o_.gamma;
+  a0_ = 1.0 / (b * h * h);
+  a1_ = g / (b * h);
+  a2_ = 1.0 / (b * h);
+  a3_ = 1.0 / (2.0 * b) - 1.0;
+  a4_ = g / b - 1.0;
+  a5_ = h * (g / (2.0 * b) - 1.0);
+  const int n = system.dofs.num_equations();
+  SparseMatrix keff = system.K + a0_ * system.M;
+  if (C.nonZeros() > 0) keff += a1_ * C;
+  keff_.compute(keff);
+  if (keff_.info() != Eigen::Success)
+    throw std::runtime_error("Newmark: the effective stiffness K + a1 C + a0 M is singular");
+  const int nc = forces ? static_cast<int>(forces->coordinates().cols()) : 0;
+  if (forces) {
+    const Eigen::MatrixXd B(forces->coordinates());
+    S_ = keff_.solve(B);
+    W_ = B.transpose() * S_;
+    friction_ = forces->friction_limits();
+  }
+  u_ = v_ = a_ = Eigen::VectorXd::Zero(n);
+  y_ = lambda_ = g_total_ = Eigen::VectorXd::Zero(nc);
+}
+
+void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& f) {
+  u_ = u;
+  v_ = v;
+  Eigen::VectorXd rhs = f - system_.K * u;
+  if (C_.nonZeros() > 0) rhs -= C_ * v;
+  lambda_.setZero();
+  g_total_.setZero();
+  if (forces_) {
+    const SparseMatrix& B = forces_->coordinates();
+    y_ = B.transpose() * u;
+    Eigen::VectorXd g, gy, gv;
+    forces_->evaluate(y_, B.transpose() * v, g, gy, gv);
+    g_total_ = g;
+    rhs -= B * g;
+  }
+  Eigen::SimplicialLDLT<SparseMatrix> mass(system_.M);
+  a_ = mass.info() == Eigen::Success ? Eigen::VectorXd(mass.solve(rhs)) : Eigen::VectorXd::Zero(u.size());
+}
+
+// Solves  R1 = y − y_pred + W (g(y, a1 y + e) + λ) = 0  and, for each dry-friction coordinate,
+// R2_i = λ_i − proj_[−F_i, F_i](λ_i + r_i ẏ_i) = 0 (stick: ẏ_i = 0 with |λ_i| ≤ F_i; slip:
+// λ_i = F_i sign(ẏ_i)) by semi-smooth Newton on (y, λ).
+bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& e) {
+  const int nc = static_cast<int>(y_pred.size());
+  Eigen::VectorXd y = y_, lambda = lambda_, g, gy, gv;
+  Eigen::VectorXd r(nc);
+  for (int i = 0; i < nc; ++i) r(i) = 1.0 / (a1_ * W_(i, i));
+  Eigen::MatrixXd J(2 * nc, 2 * nc);
+  Eigen::VectorXd R(2 * nc);
+  const double scale = std::max({y_pred.cwiseAbs().maxCoeff(), y_.cwiseAbs().maxCoeff(), 1e-300});
+  for (int it = 0; it < o_.max_newton; ++it) {
+    const Eigen::VectorXd ydot = a1_ * y + e;
+    forces_->evaluate(y, ydot, g, gy, gv);
+    R.head(nc) = y - y_pred + W_ * (g + lambda);
+    J.setZero();
+    J.topLeftCorner(nc, nc) = Eigen::MatrixXd::Identity(nc, nc) + W_ * (gy + a1_ * gv).asDiagonal();
+    J.topRightCorner(nc, nc) = W_;
+    bool friction_ok = true;
+    for (int i = 0; i < nc; ++i) {
+      const double F = friction_(i);
+      if (F <= 0.0) {
+        R(nc + i) = lambda(i);
+        J(nc + i, nc + i) = 1.0;
+        continue;
+      }
+      const double trial = lambda(i) + r(i) * ydot(i);
+      if (std::abs(trial) <= F) { // stick
+        R(nc + i) = -r(i) * ydot(i);
+        J(nc + i, i) = -r(i) * a1_;
+        // ẏ = a1 y + e is a difference of large numbers: zero to within its rounding.
+        const double rounding = 64.0 * std::numeric_limits<double>::epsilon() * (std::abs(a1_ * y(i)) + std::abs(e(i)));
+        friction_ok = friction_ok && std::abs(ydot(i)) <= rounding;
+      } else { // slip
+        R(nc + i) = lambda(i) - F * (trial > 0 ? 1.0 : -1.0);
+        J(nc + i, nc + i) = 1.0;
+        friction_ok = friction_ok && std::abs(R(nc + i)) <= 1e-12 * F;
+      }
+    }
+    if (R.head(nc).cwiseAbs().maxCoeff() <= o_.newton_tolerance * scale && friction_ok) {
+      y_ = y;
+      lambda_ = lambda;
+      g_total_ = g + lambda;
+      return true;
+    }
+    const Eigen::VectorXd d = J.partialPivLu().solve(-R);
+    y += d.head(nc);
+    lambda += d.tail(nc);
+  }
+  return false;
+}
+
+StepStatus Newmark::step(const Eigen::VectorXd& f_next) {
+  Eigen::VectorXd rhs = f_next + system_.M * (a0_ * u_ + a2_ * v_ + a3_ * a_);
+  if (C_.nonZeros() > 0) rhs += C_ * (a1_ * u_ + a4_ * v_ + a5_ * a_);
+  Eigen::VectorXd u_next = keff_.solve(rhs);
+  StepStatus status = StepStatus::success;
+  if (forces_ && forces_->coordinates().cols() > 0) {
+    const SparseMatrix& B = forces_->coordinates();
+    const Eigen::VectorXd y_pred = B.transpose() * u_next;
+    // ẏ_{n+1} = a1 (y − y_n) − Bᵀ(a4 v_n + a5 a_n) = a1 y + e
+    const Eigen::VectorXd e = -a1_ * y_ - B.transpose() * (a4_ * v_ + a5_ * a_);
+    if (!solve_local(y_pred, e)) status = StepStatus::newton_failed;
+    u_next -= S_ * g_total_;
+  }
+  const Eigen::VectorXd a_next = a0_ * (u_next - u_) - a2_ * v_ - a3_ * a_;
+  v_ += h_ * ((1.0 - o_.gamma) * a_ + o_.gamma * a_next);
+  a_ = a_next;
+  u_ = u_next;
+  return status;
+}
+
+SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const LocalForces* forces,
+                         const SineLoad& load, std::span<const int> outputs, const SteadyStateOptions& o) {
+  const int n = system.dofs.num_equations();
+  if (load.equation < 0 || load.equation >= n) throw std::invalid_argument("sine load: bad equation");
+  if (!(load.frequency_hz > 0.0)) throw std::invalid_argument("sine load: frequency must be > 0 Hz");
+  if (o.steps_per_period < 8 || o.output_periods < 1 || o.max_periods < o.output_periods + 2)
+    throw std::invalid_argument("steady state: need >= 8 steps per period and max_periods > output_periods + 1");
+  const int N = o.steps_per_period, nout = static_cast<int>(outputs.size());
+  const double T = 1.0 / load.frequency_hz, h = T / N, omega = 2.0 * std::numbers::pi * load.frequency_hz;
+  Newmark integrator(system, C, forces, h, o.newmark);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  integrator.set_state(Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n), f);
+
+  // Ring of the last output_periods + 1 periods: samples at the start of each step.
+  const int keep = o.output_periods + 1;
+  Eigen::MatrixXd u_hist(keep * N, nout), v_hist(keep * N, nout);
+  SteadyState out;
+  int calm = 0;
+  for (int p = 0; p < o.max_periods; ++p) {
+    const int slot = p % keep;
+    for (int k = 0; k < N; ++k) {
+      for (int j = 0; j < nout; ++j) {
+        u_hist(slot * N + k, j) = integrator.u()(outputs[j]);
+        v_hist(slot * N + k, j) = integrator.v()(outputs[j]);
+      }
+      f(load.equation) = load.amplitude * std::sin(omega * (k + 1) * h);
+      if (integrator.step(f) != StepStatus::success) {
+        out.status = SteadyStateStatus::newton_failed;
+        out.periods_run = p + 1;
+        return out;
+      }
+    }
+    out.periods_run = p + 1;
+    if (p == 0) continue;
+    const int prev = (p - 1) % keep;
+    const auto now_u = u_hist.middleRows(slot * N, N), before_u = u_hist.middleRows(prev * N, N);
+    const double size = std::max(now_u.cwiseAbs().maxCoeff(), 1e-300);
+    out.period_change = (now_u - before_u).cwiseAbs().maxCoeff() / size;
+    calm = out.period_change < o.tolerance ? calm + 1 : 0;
+    if (calm >= 2 && p + 1 >= keep) break;
+  }
+  if (calm < 2) out.status = SteadyStateStatus::not_periodic;
+  // Assemble the last output_periods periods in time order.
+  const int last = (out.periods_run - 1) % keep;
+  const int total = o.output_periods * N;
+  out.t.resize(total);
+  out.force.resize(total);
+  out.u.resize(total, nout);
+  out.v.resize(total, nout);
+  for (int q = 0; q < o.output_periods; ++q) {
+    const int slot = ((last - (o.output_periods - 1) + q) % keep + keep) % keep;
+    out.u.middleRows(q * N, N) = u_hist.middleRows(slot * N, N);
+    out.v.middleRows(q * N, N) = v_hist.middleRows(slot * N, N);
+  }
+  for (int i = 0; i < total; ++i) {
+    out.t(i) = i * h;
+    out.force(i) = load.amplitude * std::sin(omega * i * h);
+  }
+  return out;
+}
+
+} // namespace jointid::fem

@@ -1,0 +1,111 @@
+#pragma once
+/// Implicit time integration (Newmark, average acceleration by default) of
+///     M ü + C u̇ + K u = f(t) − B g(Bᵀu, Bᵀu̇) − B λ,
+/// where B (n_eq × n_c) maps the structure to a few local coordinates y = Bᵀu (the joints'
+/// deformations), g is their smooth force law and λ their dry-friction force, set-valued:
+/// λ_i ∈ F_i·Sign(ẏ_i), i.e. |λ_i| ≤ F_i while the coordinate sticks (ẏ_i = 0). Each step is
+/// solved in the n_c local coordinates only (the linear part is condensed once), by a
+/// semi-smooth Newton method on y and λ — exact stick–slip, no regularisation.
+#include "fem/assembly.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <functional>
+#include <memory>
+#include <span>
+
+namespace jointid::fem {
+
+/// Forces of a few local coordinates (the joints), as the integrator needs them. The force g
+/// resists the deformation: the structure receives −B g. `fem` knows nothing of joint models.
+class LocalForces {
+public:
+  virtual ~LocalForces() = default;
+  /// B: n_eq × n_c, the coordinates y = Bᵀu.
+  virtual const SparseMatrix& coordinates() const = 0;
+  /// Smooth part: g_i(y_i, ẏ_i) and its derivatives (each coordinate's force depends on that
+  /// coordinate only).
+  virtual void evaluate(const Eigen::VectorXd& y, const Eigen::VectorXd& ydot, Eigen::VectorXd& g,
+                        Eigen::VectorXd& dg_dy, Eigen::VectorXd& dg_dydot) const = 0;
+  /// Dry-friction force limits F_i >= 0 (0 where a coordinate has no dry friction).
+  virtual Eigen::VectorXd friction_limits() const = 0;
+};
+
+struct NewmarkOptions {
+  double beta = 0.25; ///< 1/4, gamma 1/2: average acceleration, unconditionally stable, no
+  double gamma = 0.5; ///< numerical damping; period error ≈ (ωh)²/12
+  int max_newton = 60;
+  double newton_tolerance = 1e-13; ///< on the local equations, relative to |y|
+};
+
+enum class StepStatus { success, newton_failed };
+
+/// State-holding integrator: construct, then step(). Time step h fixed (s).
+class Newmark {
+public:
+  Newmark(const Assembled& system, const SparseMatrix& C, const LocalForces* forces, double h,
+          const NewmarkOptions& options = {});
+  /// Sets u, u̇ and computes ü from the equation of motion with force f (friction taken as 0).
+  void set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& f);
+  /// Advances one step to the load f_{n+1}.
+  StepStatus step(const Eigen::VectorXd& f_next);
+
+  const Eigen::VectorXd& u() const { return u_; }
+  const Eigen::VectorXd& v() const { return v_; }
+  const Eigen::VectorXd& a() const { return a_; }
+  /// Local coordinates and their total force (g + λ) after the last step.
+  const Eigen::VectorXd& y() const { return y_; }
+  const Eigen::VectorXd& local_force() const { return g_total_; }
+  double h() const { return h_; }
+
+private:
+  bool solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& e);
+  const Assembled& system_;
+  const SparseMatrix& C_;
+  const LocalForces* forces_;
+  double h_;
+  NewmarkOptions o_;
+  double a0_, a1_, a2_, a3_, a4_, a5_;
+  Eigen::SimplicialLDLT<SparseMatrix> keff_;
+  Eigen::MatrixXd S_; ///< K_eff⁻¹ B
+  Eigen::MatrixXd W_; ///< Bᵀ K_eff⁻¹ B
+  Eigen::VectorXd friction_;
+  Eigen::VectorXd u_, v_, a_, y_, lambda_, g_total_;
+};
+
+/// A sinusoidal force F0·sin(2π f t) at one equation.
+struct SineLoad {
+  int equation = 0;
+  double amplitude = 0.0;    ///< N or N·m (peak)
+  double frequency_hz = 0.0; ///< Hz
+};
+
+struct SteadyStateOptions {
+  int steps_per_period = 2048;
+  int output_periods = 4;
+  int max_periods = 4000;
+  /// Converged when two consecutive periods differ by less than this, relative to the
+  /// largest output amplitude, twice in a row.
+  double tolerance = 1e-10;
+  NewmarkOptions newmark;
+};
+
+enum class SteadyStateStatus { converged, not_periodic, newton_failed };
+
+struct SteadyState {
+  SteadyStateStatus status = SteadyStateStatus::converged;
+  int periods_run = 0;
+  double period_change = 0.0;  ///< last relative period-to-period change
+  Eigen::VectorXd t;           ///< uniformly sampled whole periods, s (starting at 0)
+  Eigen::VectorXd force;       ///< applied force at the samples
+  Eigen::MatrixXd u;           ///< n_samples × n_outputs displacements
+  Eigen::MatrixXd v;           ///< n_samples × n_outputs velocities
+};
+
+/// Runs from rest until a periodic steady state; returns the last `output_periods` periods
+/// sampled at the time steps (steps_per_period samples per period, the endpoint excluded).
+SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const LocalForces* forces,
+                         const SineLoad& load, std::span<const int> output_equations,
+                         const SteadyStateOptions& options = {});
+
+} // namespace jointid::fem

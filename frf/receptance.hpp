@@ -1,0 +1,63 @@
+#pragma once
+/// Receptance FRFs H(ω) = X/F (m/N, complex, x(t) = Re(X e^{iωt})) of the linear substructure,
+/// by modal synthesis (with a static residual-flexibility correction for the modes not kept)
+/// and by a direct sparse solve of (K − ω²M + iωC), the cross-check.
+#include "fem/damping.hpp"
+#include "fem/modal.hpp"
+
+#include <Eigen/Core>
+#include <complex>
+#include <span>
+#include <vector>
+
+namespace jointid::frf {
+
+using Complex = std::complex<double>;
+using CMatrix = Eigen::MatrixXcd;
+using CVector = Eigen::VectorXcd;
+
+/// DOF sets by equation number: set 2 = DOFs a joint touches, set 1 = the others of interest
+/// (drive points, measured points).
+struct Partition {
+  std::vector<int> set1;
+  std::vector<int> set2;
+};
+
+/// H11 (n1×n1), H12 (n1×n2), H21 (n2×n1), H22 (n2×n2) at one frequency.
+struct Blocks {
+  CMatrix H11, H12, H21, H22;
+};
+
+struct ModalSynthesisOptions {
+  /// Add K⁻¹ − Σ_kept φφᵀ/ω² (the static flexibility of the modes not kept). Needs a
+  /// non-singular K (no rigid-body modes); ignored otherwise.
+  bool residual_flexibility = true;
+};
+
+/// H(ω)_ij = Σ_r φ_ir φ_jr / (ω_r² − ω² + 2iζ_r ω_r ω) [+ R_ij], for DOFs among `dofs`.
+/// ζ_r comes from the model's damping (modal ratio, or Rayleigh's α/2ω_r + βω_r/2).
+class ModalSynthesis {
+public:
+  ModalSynthesis(const fem::Assembled& system, const fem::Modes& modes, const fem::Damping& damping,
+                 std::vector<int> dofs, const ModalSynthesisOptions& options = {});
+  /// Rows and columns are equation numbers, each one of `dofs`.
+  CMatrix receptance(double omega, std::span<const int> rows, std::span<const int> cols) const;
+  Blocks blocks(double omega, const Partition& partition) const;
+  bool has_residual() const { return has_residual_; }
+  const std::vector<int>& dofs() const { return dofs_; }
+
+private:
+  int position(int equation) const;
+  std::vector<int> dofs_;
+  Eigen::MatrixXd phi_; ///< |dofs| × n_modes
+  Eigen::VectorXd omega_, zeta_;
+  Eigen::MatrixXd residual_; ///< |dofs| × |dofs|
+  bool has_residual_ = false;
+};
+
+/// Direct receptance (K − ω²M + iωC)⁻¹ restricted to rows × cols, by a complex sparse LU
+/// (UMFPACK). Cost: one factorisation per frequency.
+CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix& C, double omega,
+                          std::span<const int> rows, std::span<const int> cols);
+
+} // namespace jointid::frf

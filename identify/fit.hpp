@@ -1,0 +1,88 @@
+#pragma once
+/// Joint identification in the frequency domain (METHOD.md). For every test and harmonic k,
+///     H22(kω) · (−Σ_i B_i Σ_j b_ij G_ij(kω)) = X2(kω) − H2f(kω) F(kω) =: R(kω),
+/// where set 2 holds the joints' DOFs, B_i maps joint i's force onto them (+1 at its node,
+/// −1 at node_b: the structure receives −g at the node), G_ij are the harmonics of the basis
+/// functions evaluated on the measured deformation, and b_ij are the unknown real
+/// coefficients. Real and imaginary parts of all equations are stacked into Q b = p, the
+/// columns of Q scaled to unit norm, and solved by SVD.
+#include "fem/dof_map.hpp"
+#include "frf/receptance.hpp"
+#include "identify/record.hpp"
+#include "joints/joint.hpp"
+
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace jointid::identify {
+
+/// Receptance of the substructure: H(ω) restricted to rows × cols (equation numbers), m/N.
+using ReceptanceFn = std::function<frf::CMatrix(double omega, std::span<const int> rows, std::span<const int> cols)>;
+
+struct FitOptions {
+  /// Harmonics whose equations are used: {1} is the paper's method; {1, 2, 3} adds the
+  /// higher harmonics of the periodic response (true by the same linearity). 0 adds the
+  /// static (mean) balance.
+  std::vector<int> harmonics{1};
+  /// Warn when the two halves of a record differ by more than this (relative fundamental).
+  double steady_tolerance = 1e-3;
+  /// Warn when a parameter's standard deviation exceeds this fraction of its value.
+  double poorly_determined = 0.05;
+};
+
+struct TermEstimate {
+  joints::Term term = joints::Term::k;
+  double value = 0.0;
+  double std = 0.0;     ///< standard deviation from the residual (NaN if no redundancy)
+  double ci_low = 0.0;  ///< 95 % confidence interval (Student's t)
+  double ci_high = 0.0;
+  bool fixed = false;   ///< held at the model's value, not identified
+};
+
+struct JointEstimate {
+  std::string name;
+  std::vector<TermEstimate> terms;
+};
+
+struct FitResult {
+  std::vector<JointEstimate> joints;
+  int equations = 0;
+  int unknowns = 0;
+  double condition_number = 0.0; ///< of the column-scaled Q
+  double residual_rms = 0.0;     ///< rms of Q b − p, m
+  double residual_relative = 0.0; ///< |Q b − p| / |p|
+  std::vector<std::string> warnings;
+  /// The joints with their identified values (fixed terms unchanged).
+  std::vector<joints::Joint> identified(const std::vector<joints::Joint>& model_joints) const;
+};
+
+/// One test reduced to harmonics 0 … K at its excitation frequency.
+struct TestSpectrum {
+  std::string source;
+  double frequency_hz = 0.0;
+  std::vector<int> force_equations; ///< equations of the force channels
+  Eigen::MatrixXcd F;               ///< (K+1) × n_forces
+  Eigen::MatrixXcd X2;              ///< (K+1) × n_set2 displacements at the joints' DOFs
+  std::vector<Eigen::MatrixXcd> G;  ///< per joint: (K+1) × n_terms basis-function harmonics
+};
+
+/// The joints' DOFs (set 2), in the order used by TestSpectrum::X2.
+std::vector<int> joint_dof_set(const std::vector<joints::Joint>& joints, const fem::DofMap& dofs);
+
+/// Extracts a test's harmonics: checks the channels (a force channel, x at every joint DOF;
+/// v derived from x when absent), trims to whole periods, and adds warnings (not periodic,
+/// clipped, short, derived velocity). Throws std::invalid_argument naming the record.
+TestSpectrum extract_spectrum(const Record& record, const fem::DofMap& dofs, const std::vector<joints::Joint>& joints,
+                              int max_harmonic, std::vector<std::string>& warnings, const FitOptions& options = {});
+
+/// Identifies the non-fixed terms of every joint from the tests. Throws std::invalid_argument
+/// when there are fewer equations than unknowns or the unknowns are not separable.
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs, const std::vector<joints::Joint>& joints,
+              const std::vector<TestSpectrum>& tests, const FitOptions& options = {},
+              std::vector<std::string> warnings = {});
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs, const std::vector<joints::Joint>& joints,
+              const std::vector<Record>& records, const FitOptions& options = {});
+
+} // namespace jointid::identify

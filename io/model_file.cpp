@@ -1,0 +1,627 @@
+#include "io/model_file.hpp"
+
+#include "fem/dof_map.hpp"
+#include "fem/elements.hpp"
+#include "io/files.hpp"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace jointid::io {
+
+namespace {
+
+int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+
+// A value as the user wrote it, for "got ..." in messages.
+std::string shown(const toml::node& n) {
+  switch (n.type()) {
+  case toml::node_type::string:
+    return "\"" + std::string(n.as_string()->get()) + "\"";
+  case toml::node_type::integer:
+    return std::to_string(n.as_integer()->get());
+  case toml::node_type::floating_point:
+    return fmt::format("{}", n.as_floating_point()->get());
+  case toml::node_type::boolean:
+    return n.as_boolean()->get() ? "true" : "false";
+  case toml::node_type::array:
+    return "an array";
+  case toml::node_type::table:
+    return "a table";
+  default:
+    return "a date/time";
+  }
+}
+
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+std::string id_list(const std::vector<int>& ids) {
+  std::string out;
+  const std::size_t shown_max = 10;
+  for (std::size_t i = 0; i < ids.size() && i < shown_max; ++i) out += (i ? ", " : "") + std::to_string(ids[i]);
+  if (ids.size() > shown_max) out += fmt::format(" and {} more", ids.size() - shown_max);
+  return out;
+}
+
+struct File {
+  std::string name;
+  [[noreturn]] void fail(int line, const std::string& what) const {
+    throw Error(line > 0 ? fmt::format("{}:{}: {}", name, line, what) : fmt::format("{}: {}", name, what));
+  }
+};
+
+// One TOML table and its place in the file ("[[joints]] 'tip'"): checks its keys against the
+// allowed ones and converts values, reporting file, line, key and the expected type.
+class Table {
+public:
+  Table(const File& file, const toml::table& table, std::string where, std::initializer_list<std::string_view> keys)
+      : file_(file), table_(table), where_(std::move(where)) {
+    for (auto&& [key, value] : table_) {
+      bool known = false;
+      for (std::string_view k : keys) known = known || key.str() == k;
+      if (known) continue;
+      std::vector<std::string> names(keys.begin(), keys.end());
+      const int line = key.source().begin.line > 0 ? static_cast<int>(key.source().begin.line) : line_of(value);
+      file_.fail(line, prefix() + "unknown key '" + std::string(key.str()) + "' (expected one of: " + joined(names) +
+                           ")");
+    }
+  }
+
+  void rename(std::string where) { where_ = std::move(where); }
+  const std::string& where() const { return where_; }
+  int line() const { return line_of(table_); }
+  bool has(std::string_view key) const { return table_.contains(key); }
+  const toml::node* get(std::string_view key) const { return table_.get(key); }
+
+  [[noreturn]] void fail(const std::string& what) const { file_.fail(line(), prefix() + what); }
+  [[noreturn]] void fail_at(const toml::node& n, const std::string& label, const std::string& what) const {
+    file_.fail(line_of(n) > 0 ? line_of(n) : line(), prefix() + label + ": " + what);
+  }
+
+  const toml::node& need(std::string_view key, std::string_view expected) const {
+    const toml::node* n = table_.get(key);
+    if (!n) fail(fmt::format("missing key '{}' (expected {})", key, expected));
+    return *n;
+  }
+
+  // Conversions of any node; `label` says where it is ("key 'E'", "key 'nodes', entry 3").
+  double to_number(const toml::node& n, const std::string& label) const {
+    std::optional<double> v;
+    if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
+    if (const auto* f = n.as_floating_point()) v = f->get();
+    if (!v) fail_at(n, label, "expected a number, got " + shown(n));
+    if (!std::isfinite(*v)) fail_at(n, label, "expected a finite number, got " + shown(n));
+    return *v;
+  }
+  int to_integer(const toml::node& n, const std::string& label) const {
+    const auto* i = n.as_integer();
+    if (!i) fail_at(n, label, "expected an integer, got " + shown(n));
+    if (i->get() < std::numeric_limits<int>::min() || i->get() > std::numeric_limits<int>::max())
+      fail_at(n, label, "expected an integer of at most 9 digits, got " + shown(n));
+    return static_cast<int>(i->get());
+  }
+  std::string to_string(const toml::node& n, const std::string& label) const {
+    const auto* s = n.as_string();
+    if (!s) fail_at(n, label, "expected a string, got " + shown(n));
+    return s->get();
+  }
+  const toml::array& to_array(const toml::node& n, const std::string& label, std::string_view of) const {
+    const auto* a = n.as_array();
+    if (!a) fail_at(n, label, fmt::format("expected an array of {}, got {}", of, shown(n)));
+    return *a;
+  }
+  fem::Dof to_dof(const toml::node& n, const std::string& label) const {
+    const std::string text = to_string(n, label);
+    try {
+      return fem::parse_dof(text);
+    } catch (const std::invalid_argument&) {
+      fail_at(n, label, "expected one of ux, uy, uz, rx, ry, rz, got " + shown(n));
+    }
+  }
+  Eigen::Vector3d to_vector3(const toml::node& n, const std::string& label) const {
+    const toml::array& a = to_array(n, label, "3 numbers");
+    if (a.size() != 3) fail_at(n, label, fmt::format("expected 3 numbers, got {}", a.size()));
+    return {to_number(a[0], label), to_number(a[1], label), to_number(a[2], label)};
+  }
+
+  static std::string key_label(std::string_view key) { return fmt::format("key '{}'", key); }
+
+  // Typed access by key.
+  double number(std::string_view key) const { return to_number(need(key, "a number"), key_label(key)); }
+  std::optional<double> optional_number(std::string_view key) const {
+    if (const auto* n = get(key)) return to_number(*n, key_label(key));
+    return std::nullopt;
+  }
+  double positive(std::string_view key, std::string_view unit) const {
+    const double v = number(key);
+    if (!(v > 0.0)) fail_at(*get(key), key_label(key), fmt::format("expected a value > 0 {}, got {}", unit, v));
+    return v;
+  }
+  double non_negative(const toml::node& n, std::string_view key, std::string_view unit) const {
+    const double v = to_number(n, key_label(key));
+    if (!(v >= 0.0)) fail_at(n, key_label(key), fmt::format("expected a value >= 0 {}, got {}", unit, v));
+    return v;
+  }
+  int integer(std::string_view key) const { return to_integer(need(key, "an integer"), key_label(key)); }
+  std::string string(std::string_view key) const { return to_string(need(key, "a string"), key_label(key)); }
+  fem::Dof dof(std::string_view key) const {
+    return to_dof(need(key, "one of ux, uy, uz, rx, ry, rz"), key_label(key));
+  }
+  std::optional<bool> optional_boolean(std::string_view key) const {
+    const auto* n = get(key);
+    if (!n) return std::nullopt;
+    const auto* b = n->as_boolean();
+    if (!b) fail_at(*n, key_label(key), "expected true or false, got " + shown(*n));
+    return b->get();
+  }
+
+private:
+  std::string prefix() const { return where_.empty() ? "" : where_ + ": "; }
+  const File& file_;
+  const toml::table& table_;
+  std::string where_;
+};
+
+// The tables of an array of tables ([[joints]]), or none when the key is absent.
+std::vector<const toml::table*> tables(const Table& root, std::string_view key) {
+  std::vector<const toml::table*> out;
+  const toml::node* n = root.get(key);
+  if (!n) return out;
+  const std::string label = Table::key_label(key);
+  const toml::array& a = root.to_array(*n, label, fmt::format("tables (write [[{}]])", key));
+  for (const auto& entry : a) {
+    const auto* t = entry.as_table();
+    if (!t) root.fail_at(entry, label, fmt::format("expected a table (write [[{}]]), got {}", key, shown(entry)));
+    out.push_back(t);
+  }
+  return out;
+}
+
+const toml::table* table(const Table& root, std::string_view key) {
+  const toml::node* n = root.get(key);
+  if (!n) return nullptr;
+  const auto* t = n->as_table();
+  if (!t) root.fail_at(*n, Table::key_label(key), fmt::format("expected a table (write [{}]), got {}", key, shown(*n)));
+  return t;
+}
+
+fem::ElementType parse_element_type(const Table& t) {
+  const toml::node& n = t.need("type", "one of beam, frame2d, frame3d");
+  const std::string type = t.to_string(n, "key 'type'");
+  if (type == "beam") return fem::ElementType::beam;
+  if (type == "frame2d") return fem::ElementType::frame2d;
+  if (type == "frame3d") return fem::ElementType::frame3d;
+  t.fail_at(n, "key 'type'", "expected one of beam, frame2d, frame3d, got " + shown(n));
+}
+
+// Reads the whole file into a Model and joints; `lines` keeps where each item was defined.
+class ModelReader {
+public:
+  ModelReader(const std::filesystem::path& path, const toml::table& root) : file_{path.string()}, root_(root) {}
+
+  ModelFile read() {
+    Table root(file_, root_, "",
+               {"model", "materials", "sections", "mesh", "element_sets", "supports", "masses", "springs", "damping",
+                "options", "joints"});
+    read_model_table(root);
+    read_materials(root);
+    read_sections(root);
+    read_mesh(root);
+    read_element_sets(root);
+    read_supports(root);
+    read_masses(root);
+    read_springs(root);
+    read_damping(root);
+    read_options(root);
+    read_joints(root);
+    check();
+    return std::move(out_);
+  }
+
+private:
+  fem::Model& model() { return out_.model; }
+
+  int node_id(const Table& t, const toml::node& n, const std::string& label, bool zero_is_ground = false) {
+    const int id = t.to_integer(n, label);
+    if (zero_is_ground && id == 0) return 0;
+    if (!node_lines_.count(id)) t.fail_at(n, label, fmt::format("node {} does not exist in [mesh] nodes", id));
+    return id;
+  }
+  int node_key(const Table& t, std::string_view key) {
+    return node_id(t, t.need(key, "a node id"), Table::key_label(key));
+  }
+
+  void read_model_table(const Table& root) {
+    const toml::table* m = table(root, "model");
+    if (!m) root.fail("missing table [model] (expected [model] with dimension = 2 or 3)");
+    Table t(file_, *m, "[model]", {"dimension"});
+    const toml::node& n = t.need("dimension", "2 or 3");
+    model().dimension = t.to_integer(n, "key 'dimension'");
+    if (model().dimension != 2 && model().dimension != 3)
+      t.fail_at(n, "key 'dimension'", "expected 2 (planar) or 3 (spatial), got " + shown(n));
+  }
+
+  void read_materials(const Table& root) {
+    const auto list = tables(root, "materials");
+    if (list.empty()) root.fail("missing [[materials]] (expected at least one, with name, E, rho, nu)");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[materials]] #{}", i + 1), {"name", "E", "rho", "nu"});
+      fem::Material m;
+      m.name = t.string("name");
+      t.rename("[[materials]] '" + m.name + "'");
+      if (material_index_.count(m.name)) t.fail("name '" + m.name + "' is used by another material");
+      m.E = t.positive("E", "Pa");
+      m.rho = t.non_negative(t.need("rho", "a number"), "rho", "kg/m^3");
+      if (const auto nu = t.optional_number("nu")) {
+        m.nu = *nu;
+        if (!(m.nu > -1.0 && m.nu < 0.5)) t.fail_at(*t.get("nu"), "key 'nu'", fmt::format("expected -1 < nu < 0.5, got {}", m.nu));
+      }
+      material_index_[m.name] = static_cast<int>(model().materials.size());
+      model().materials.push_back(m);
+    }
+  }
+
+  void read_sections(const Table& root) {
+    const auto list = tables(root, "sections");
+    if (list.empty()) root.fail("missing [[sections]] (expected at least one, with name, A, Iz)");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[sections]] #{}", i + 1), {"name", "A", "Iz", "Iy", "J"});
+      fem::Section s;
+      s.name = t.string("name");
+      t.rename("[[sections]] '" + s.name + "'");
+      if (section_index_.count(s.name)) t.fail("name '" + s.name + "' is used by another section");
+      s.A = t.positive("A", "m^2");
+      s.Iz = t.positive("Iz", "m^4");
+      if (t.has("Iy")) s.Iy = t.positive("Iy", "m^4");
+      if (t.has("J")) s.J = t.positive("J", "m^4");
+      section_index_[s.name] = static_cast<int>(model().sections.size());
+      model().sections.push_back(s);
+    }
+  }
+
+  void read_mesh(const Table& root) {
+    const toml::table* m = table(root, "mesh");
+    if (!m) root.fail("missing table [mesh] (expected nodes = [[id, x, y], ...] and elements = [[id, a, b], ...])");
+    Table t(file_, *m, "[mesh]", {"nodes", "elements", "file"});
+    if (const auto* f = t.get("file"))
+      t.fail_at(*f, "key 'file'", "Gmsh meshes are not supported yet; give nodes = [...] and elements = [...]");
+    const bool planar = model().dimension == 2;
+    const std::string coords = planar ? "[id, x, y] or [id, x, y, z]" : "[id, x, y, z]";
+    const toml::node& nodes_node = t.need("nodes", "an array of " + coords);
+    const toml::array& nodes = t.to_array(nodes_node, "key 'nodes'", coords);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const std::string label = fmt::format("key 'nodes', entry {}", i + 1);
+      const auto* a = nodes[i].as_array();
+      if (!a || a->size() < (planar ? 3u : 4u) || a->size() > 4)
+        t.fail_at(nodes[i], label, "expected " + coords + ", got " + (a ? fmt::format("{} values", a->size()) : shown(nodes[i])));
+      fem::Node node;
+      node.id = t.to_integer((*a)[0], label);
+      if (node.id <= 0) t.fail_at(nodes[i], label, fmt::format("node ids must be > 0 (0 means ground), got {}", node.id));
+      if (const auto it = node_lines_.find(node.id); it != node_lines_.end())
+        t.fail_at(nodes[i], label, fmt::format("node id {} is already used at line {}", node.id, it->second));
+      for (std::size_t c = 1; c < a->size(); ++c) node.x(c - 1) = t.to_number((*a)[c], label);
+      if (planar && node.x.z() != 0.0)
+        t.fail_at(nodes[i], label, fmt::format("node {}: a planar model (dimension = 2) needs z = 0, got {}", node.id, node.x.z()));
+      node_lines_[node.id] = line_of(nodes[i]) > 0 ? line_of(nodes[i]) : line_of(nodes_node);
+      model().nodes.push_back(node);
+    }
+
+    const toml::node& elements_node = t.need("elements", "an array of [id, node a, node b]");
+    elements_line_ = line_of(elements_node);
+    const toml::array& elements = t.to_array(elements_node, "key 'elements'", "[id, node a, node b]");
+    for (std::size_t i = 0; i < elements.size(); ++i) {
+      const std::string label = fmt::format("key 'elements', entry {}", i + 1);
+      const auto* a = elements[i].as_array();
+      if (!a || a->size() != 3)
+        t.fail_at(elements[i], label, "expected [id, node a, node b], got " + (a ? fmt::format("{} values", a->size()) : shown(elements[i])));
+      fem::Element e;
+      e.id = t.to_integer((*a)[0], label);
+      if (const auto it = element_lines_.find(e.id); it != element_lines_.end())
+        t.fail_at(elements[i], label, fmt::format("element id {} is already used at line {}", e.id, it->second));
+      e.node_a = node_id(t, (*a)[1], label);
+      e.node_b = node_id(t, (*a)[2], label);
+      if (e.node_a == e.node_b) t.fail_at(elements[i], label, fmt::format("element {} connects node {} to itself", e.id, e.node_a));
+      element_lines_[e.id] = line_of(elements[i]) > 0 ? line_of(elements[i]) : elements_line_;
+      element_position_[e.id] = static_cast<int>(model().elements.size());
+      model().elements.push_back(e);
+    }
+  }
+
+  void read_element_sets(const Table& root) {
+    const auto list = tables(root, "element_sets");
+    std::vector<int> set_line(model().elements.size(), 0); // line of the set covering each element
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[element_sets]] #{}", i + 1), {"elements", "type", "material", "section", "up"});
+      const fem::ElementType type = parse_element_type(t);
+      const int material = lookup(t, "material", material_index_);
+      const int section = lookup(t, "section", section_index_);
+      Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+      if (const auto* n = t.get("up")) {
+        if (type != fem::ElementType::frame3d) t.fail_at(*n, "key 'up'", "only frame3d elements have an up vector");
+        up = t.to_vector3(*n, "key 'up'");
+        if (!(up.norm() > 0.0)) t.fail_at(*n, "key 'up'", "expected a non-zero vector");
+      }
+      // The elements it covers: "all" or a list of ids.
+      const toml::node& which = t.need("elements", "\"all\" or a list of element ids");
+      std::vector<int> members;
+      if (which.is_string()) {
+        if (which.as_string()->get() != "all")
+          t.fail_at(which, "key 'elements'",
+                    "expected \"all\" or a list of element ids, got " + shown(which) +
+                        " (Gmsh physical groups need a Gmsh mesh, not supported yet)");
+        for (const auto& e : model().elements) members.push_back(e.id);
+      } else {
+        const toml::array& ids = t.to_array(which, "key 'elements'", "element ids (or \"all\")");
+        for (const auto& n : ids) {
+          const int id = t.to_integer(n, "key 'elements'");
+          if (!element_position_.count(id)) t.fail_at(n, "key 'elements'", fmt::format("element {} does not exist in [mesh] elements", id));
+          members.push_back(id);
+        }
+      }
+      std::vector<int> twice;
+      std::set<int> other_lines;
+      for (int id : members) {
+        const int p = element_position_.at(id);
+        if (set_line[p] != 0) {
+          twice.push_back(id);
+          other_lines.insert(set_line[p]);
+          continue;
+        }
+        set_line[p] = t.line();
+        fem::Element& e = model().elements[p];
+        e.type = type;
+        e.material = material;
+        e.section = section;
+        e.up = up;
+      }
+      if (!twice.empty()) {
+        std::vector<std::string> lines;
+        for (int l : other_lines) lines.push_back(std::to_string(l));
+        t.fail_at(which, "key 'elements'",
+                  fmt::format("element{} {} already in the element set at line {} (each element belongs to exactly one set)",
+                              twice.size() > 1 ? "s" : "", id_list(twice) + (twice.size() > 1 ? " are" : " is"),
+                              joined(lines)));
+      }
+    }
+    std::vector<int> uncovered;
+    for (std::size_t p = 0; p < model().elements.size(); ++p)
+      if (set_line[p] == 0) uncovered.push_back(model().elements[p].id);
+    if (!uncovered.empty())
+      file_.fail(elements_line_, fmt::format("[mesh]: element{} {} in no [[element_sets]] (each element belongs to exactly one set)",
+                                             uncovered.size() > 1 ? "s" : "", id_list(uncovered) + (uncovered.size() > 1 ? " are" : " is")));
+  }
+
+  int lookup(const Table& t, std::string_view key, const std::map<std::string, int>& index) {
+    const toml::node& n = t.need(key, "a name");
+    const std::string name = t.to_string(n, Table::key_label(key));
+    const auto it = index.find(name);
+    if (it == index.end()) {
+      std::vector<std::string> names;
+      for (const auto& [k, v] : index) names.push_back("\"" + k + "\"");
+      t.fail_at(n, Table::key_label(key), fmt::format("expected one of the [[{}s]] names ({}), got \"{}\"", key, joined(names), name));
+    }
+    return it->second;
+  }
+
+  void read_supports(const Table& root) {
+    const auto list = tables(root, "supports");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[supports]] #{}", i + 1), {"node", "fix"});
+      fem::Support s;
+      s.node = node_key(t, "node");
+      t.rename(fmt::format("[[supports]] node {}", s.node));
+      const toml::node& fix = t.need("fix", "a list of DOFs such as [\"ux\", \"uy\", \"rz\"]");
+      const toml::array& dofs = t.to_array(fix, "key 'fix'", "DOF names (ux, uy, uz, rx, ry, rz)");
+      if (dofs.empty()) t.fail_at(fix, "key 'fix'", "expected at least one DOF");
+      for (const auto& d : dofs) s.fixed.push_back(t.to_dof(d, "key 'fix'"));
+      model().supports.push_back(s);
+    }
+  }
+
+  void read_masses(const Table& root) {
+    const auto list = tables(root, "masses");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[masses]] #{}", i + 1), {"node", "mass", "inertia"});
+      fem::PointMass m;
+      m.node = node_key(t, "node");
+      t.rename(fmt::format("[[masses]] node {}", m.node));
+      m.mass = t.non_negative(t.need("mass", "a number (kg)"), "mass", "kg");
+      if (const auto* n = t.get("inertia")) {
+        m.inertia = t.to_vector3(*n, "key 'inertia'");
+        if (!(m.inertia.minCoeff() >= 0.0)) t.fail_at(*n, "key 'inertia'", "expected [Ix, Iy, Iz] >= 0 kg m^2");
+      }
+      model().masses.push_back(m);
+    }
+  }
+
+  void read_springs(const Table& root) {
+    const auto list = tables(root, "springs");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[springs]] #{}", i + 1), {"node", "node_b", "dof", "stiffness"});
+      fem::Spring s;
+      s.node = node_key(t, "node");
+      t.rename(fmt::format("[[springs]] node {}", s.node));
+      if (const auto* n = t.get("node_b")) s.node_b = node_id(t, *n, "key 'node_b'", true);
+      if (s.node_b == s.node) t.fail_at(*t.get("node_b"), "key 'node_b'", "a spring cannot connect a node to itself");
+      s.dof = t.dof("dof");
+      s.stiffness = t.non_negative(t.need("stiffness", "a number (N/m or N m/rad)"), "stiffness", "N/m");
+      model().springs.push_back(s);
+    }
+  }
+
+  void read_damping(const Table& root) {
+    const toml::table* d = table(root, "damping");
+    if (!d) return;
+    Table t(file_, *d, "[damping]", {"modal", "rayleigh"});
+    const auto* modal = t.get("modal");
+    const auto* rayleigh = t.get("rayleigh");
+    if (modal && rayleigh) t.fail("give either modal = ratio or rayleigh = [alpha, beta], not both");
+    if (!modal && !rayleigh) t.fail("expected modal = ratio or rayleigh = [alpha, beta]");
+    fem::Damping& damping = model().damping;
+    if (modal) {
+      damping.kind = fem::Damping::Kind::modal;
+      damping.modal_ratio = t.to_number(*modal, "key 'modal'");
+      if (!(damping.modal_ratio >= 0.0 && damping.modal_ratio < 1.0))
+        t.fail_at(*modal, "key 'modal'", fmt::format("expected a damping ratio in [0, 1), got {}", damping.modal_ratio));
+    } else {
+      const toml::array& a = t.to_array(*rayleigh, "key 'rayleigh'", "two numbers [alpha, beta]");
+      if (a.size() != 2) t.fail_at(*rayleigh, "key 'rayleigh'", fmt::format("expected [alpha, beta], got {} values", a.size()));
+      damping.kind = fem::Damping::Kind::rayleigh;
+      damping.alpha = t.to_number(a[0], "key 'rayleigh'");
+      damping.beta = t.to_number(a[1], "key 'rayleigh'");
+      if (!(damping.alpha >= 0.0 && damping.beta >= 0.0))
+        t.fail_at(*rayleigh, "key 'rayleigh'", "expected alpha >= 0 (1/s) and beta >= 0 (s)");
+    }
+  }
+
+  void read_options(const Table& root) {
+    const toml::table* o = table(root, "options");
+    if (!o) return;
+    Table t(file_, *o, "[options]", {"lumped_mass"});
+    if (const auto lumped = t.optional_boolean("lumped_mass")) model().mass_options.lumped = *lumped;
+  }
+
+  void read_joints(const Table& root) {
+    const auto list = tables(root, "joints");
+    std::map<std::string, int> name_lines;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[joints]] #{}", i + 1), {"name", "node", "node_b", "dof", "terms", "values", "fixed"});
+      joints::Joint j;
+      j.name = t.string("name");
+      if (j.name.empty()) t.fail_at(*t.get("name"), "key 'name'", "expected a non-empty name");
+      t.rename("[[joints]] '" + j.name + "'");
+      if (const auto it = name_lines.find(j.name); it != name_lines.end())
+        t.fail_at(*t.get("name"), "key 'name'", fmt::format("the name is already used by the joint at line {}", it->second));
+      name_lines[j.name] = t.line();
+      j.node = node_key(t, "node");
+      if (const auto* n = t.get("node_b")) j.node_b = node_id(t, *n, "key 'node_b'", true);
+      if (j.node_b == j.node) t.fail_at(*t.get("node_b"), "key 'node_b'", "a joint cannot connect a node to itself");
+      j.dof = t.dof("dof");
+
+      const toml::node& terms_node = t.need("terms", "a list of terms such as [\"k\", \"c\", \"k3\"]");
+      const toml::array& terms = t.to_array(terms_node, "key 'terms'", "term names (k, c, k2, k3, c2, c3, fc)");
+      if (terms.empty()) t.fail_at(terms_node, "key 'terms'", "expected at least one term");
+      for (const auto& n : terms) {
+        const std::string name = t.to_string(n, "key 'terms'");
+        try {
+          j.terms.push_back(joints::parse_term(name));
+        } catch (const std::invalid_argument&) {
+          t.fail_at(n, "key 'terms'", "expected one of k, c, k2, k3, c2, c3, fc, got " + shown(n));
+        }
+        if (j.term_index(j.terms.back()) != static_cast<int>(j.terms.size()) - 1)
+          t.fail_at(n, "key 'terms'", "term '" + name + "' is listed twice");
+      }
+      const std::string listed = listed_terms(j);
+      j.values.assign(j.terms.size(), 0.0); // a term without a value starts at 0
+      j.fixed.assign(j.terms.size(), false);
+      std::vector<bool> has_value(j.terms.size(), false);
+      if (const auto* n = t.get("values")) {
+        const auto* values = n->as_table();
+        if (!values) t.fail_at(*n, "key 'values'", "expected a table such as { k = 4800.0, c = 20.0 }, got " + shown(*n));
+        for (auto&& [key, value] : *values) {
+          const std::string label = "key 'values." + std::string(key.str()) + "'";
+          const int index = term_position(j, key.str());
+          if (index < 0) t.fail_at(value, label, "'" + std::string(key.str()) + "' is not among the joint's terms (" + listed + ")");
+          j.values[index] = t.to_number(value, label);
+          has_value[index] = true;
+        }
+      }
+      if (const auto* n = t.get("fixed")) {
+        const toml::array& fixed = t.to_array(*n, "key 'fixed'", "term names");
+        for (const auto& f : fixed) {
+          const std::string name = t.to_string(f, "key 'fixed'");
+          const int index = term_position(j, name);
+          if (index < 0) t.fail_at(f, "key 'fixed'", "'" + name + "' is not among the joint's terms (" + listed + ")");
+          if (!has_value[index]) t.fail_at(f, "key 'fixed'", "term '" + name + "' is held fixed but has no value in 'values'");
+          j.fixed[index] = true;
+        }
+      }
+      joint_lines_.push_back(t.line());
+      out_.joints.push_back(std::move(j));
+    }
+  }
+
+  static std::string listed_terms(const joints::Joint& j) {
+    std::vector<std::string> names;
+    for (joints::Term term : j.terms) names.emplace_back(joints::term_name(term));
+    return joined(names);
+  }
+  static int term_position(const joints::Joint& j, std::string_view name) {
+    for (std::size_t i = 0; i < j.terms.size(); ++i)
+      if (joints::term_name(j.terms[i]) == name) return static_cast<int>(i);
+    return -1;
+  }
+
+  // The library's own checks, reported with the file (and the line where it is known).
+  void check() {
+    try {
+      model().validate();
+    } catch (const std::invalid_argument& e) {
+      file_.fail(0, e.what());
+    }
+    for (const auto& e : model().elements) {
+      try {
+        fem::element_matrices(model(), e);
+      } catch (const std::exception& err) {
+        file_.fail(element_lines_.at(e.id), err.what());
+      }
+    }
+    fem::DofMap dofs;
+    try {
+      dofs = fem::DofMap(model());
+    } catch (const std::exception& e) {
+      file_.fail(0, e.what());
+    }
+    for (std::size_t i = 0; i < out_.joints.size(); ++i) {
+      try {
+        joints::validate_joints({out_.joints[i]}, dofs);
+      } catch (const std::invalid_argument& e) {
+        file_.fail(joint_lines_[i], e.what());
+      }
+    }
+    try {
+      joints::validate_joints(out_.joints, dofs);
+    } catch (const std::invalid_argument& e) {
+      file_.fail(0, e.what());
+    }
+  }
+
+  File file_;
+  const toml::table& root_;
+  ModelFile out_;
+  std::map<int, int> node_lines_, element_lines_, element_position_;
+  int elements_line_ = 0;
+  std::map<std::string, int> material_index_, section_index_;
+  std::vector<int> joint_lines_;
+};
+
+} // namespace
+
+ModelFile read_model(const std::filesystem::path& path) {
+  const std::string text = read_file(path);
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(text), path.string());
+  } catch (const toml::parse_error& e) {
+    throw Error(fmt::format("{}:{}:{}: {}", path.string(), e.source().begin.line, e.source().begin.column, e.description()));
+  }
+  ModelFile out = ModelReader(path, root).read();
+  out.path = path;
+  return out;
+}
+
+} // namespace jointid::io

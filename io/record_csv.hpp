@@ -1,0 +1,51 @@
+#pragma once
+/// Measurement records and stepped-sine tables as CSV files (DESIGN.md's contracts).
+/// Record: `#` comment lines (optionally `# excitation_hz = 3.0`), then `t,<channel>...`, then
+/// uniformly sampled rows; channels are `<quantity>@<node>:<dof>` (SI units).
+/// Stepped-sine table: `#` comments, then `freq_hz,<channel>.re,<channel>.im,...`, one test
+/// per row, complex peak amplitudes with x(t) = Re(X e^{iωt}).
+#include "fem/dof_map.hpp"
+#include "identify/record.hpp"
+#include "joints/joint.hpp"
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace jointid::io {
+
+/// Reads one record. Record::source is the path as given. Throws io::Error naming the file
+/// and line: missing header, first column not `t`, unknown or repeated channel, a row with the
+/// wrong number of fields, a field that is not a finite number, fewer than 4 rows, time not
+/// strictly increasing or not uniform (a step deviating from the mean step by more than 1e-6,
+/// relative).
+identify::Record read_record(const std::filesystem::path& path);
+std::vector<identify::Record> read_records(const std::vector<std::filesystem::path>& paths);
+
+/// The CSV text of a record: each comment as `# ...` lines, `# excitation_hz = ...` when
+/// set, the header and the rows, every number in its shortest form that reads back
+/// bit-exactly. Throws io::Error if the channels' lengths differ from t's or a value is not
+/// finite (the reader would refuse the file).
+std::string record_csv(const identify::Record& record, const std::vector<std::string>& comments = {});
+/// Writes record_csv(record, comments) atomically (see write_file_atomically).
+void write_record(const std::filesystem::path& path, const identify::Record& record,
+                  const std::vector<std::string>& comments = {});
+
+/// Checks that a record holds what identification with these joints needs: a force channel
+/// at a free DOF of the model and a displacement channel at every joint DOF. Throws io::Error
+/// naming the record's file and the missing or misplaced channel.
+void check_record_channels(const identify::Record& record, const fem::DofMap& dofs,
+                           const std::vector<joints::Joint>& joints);
+
+/// Many sine tests reduced to their fundamentals.
+struct SteppedSineTable {
+  std::vector<double> freq_hz;       ///< one per test, Hz
+  std::vector<std::string> channels; ///< "x@7:uy", ...
+  Eigen::MatrixXcd values;           ///< tests × channels, complex peak amplitudes (SI)
+};
+
+/// Reads a stepped-sine table; throws io::Error naming file, line and column as read_record.
+SteppedSineTable read_stepped_sine(const std::filesystem::path& path);
+
+} // namespace jointid::io

@@ -1,0 +1,26 @@
+#pragma once
+/// JSON results (DESIGN.md's contract): identification results and mode lists.
+#include "fem/modal.hpp"
+#include "identify/fit.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace jointid::io {
+
+/// The identification result as DESIGN.md's JSON:
+/// {"joints": [{"name", "terms": [{"term", "effect", "value", "std", "ci95": [lo, hi],
+/// "fixed"}]}], "equations", "unknowns", "condition_number", "residual_rms",
+/// "residual_relative", "warnings": [...]}. `extra` warnings are appended to the result's.
+/// NaN and infinite numbers are written as null.
+std::string identify_result_json(const identify::FitResult& result, const std::vector<std::string>& extra = {});
+
+/// {"modes": [{"mode": 1, "frequency_hz": ...}, ...]} for the first `count` modes (all when
+/// count < 0 or larger than the number of modes).
+std::string modes_json(const fem::Modes& modes, int count = -1);
+
+/// Writes JSON text atomically (see write_file_atomically).
+void write_json(const std::filesystem::path& path, const std::string& json);
+
+} // namespace jointid::io

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs the Debian packages jointid needs. Safe to run twice: only missing packages are installed.
+set -euo pipefail
+packages=(build-essential cmake pkg-config libeigen3-dev libspectra-dev libsuitesparse-dev
+  libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev libgmock-dev
+  libbenchmark-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  echo "setup: installing ${missing[*]}"
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "setup: all packages present"
+fi
