@@ -24,13 +24,18 @@ std::string percent(double fraction) {
   return s.str();
 }
 
-// Fraction of samples sitting at the channel's extreme values (a flat top: clipping).
-double clipped_fraction(const Eigen::VectorXd& x) {
+// Fraction of samples sitting at the channel's extreme values (a flat top: clipping). A
+// displacement that is flat because the point is at rest (its measured velocity is zero, as
+// in a friction joint's stick phase) is not clipped: pass that velocity to exempt it.
+double clipped_fraction(const Eigen::VectorXd& x, const Eigen::VectorXd* velocity = nullptr) {
   const double hi = x.maxCoeff(), lo = x.minCoeff(), tol = 1e-9 * std::max(std::abs(hi), std::abs(lo));
   if (hi - lo <= tol) return 0.0;
+  const double vmax = velocity ? velocity->cwiseAbs().maxCoeff() : 0.0;
   int at_edge = 0;
-  for (double s : x)
-    if (hi - s <= tol || s - lo <= tol) ++at_edge;
+  for (int i = 0; i < x.size(); ++i) {
+    const bool resting = velocity && std::abs((*velocity)(i)) <= 1e-6 * vmax;
+    if ((hi - x(i) <= tol || x(i) - lo <= tol) && !resting) ++at_edge;
+  }
   return static_cast<double>(at_edge) / x.size();
 }
 
@@ -83,10 +88,13 @@ TestSpectrum extract_spectrum(const Record& r, const fem::DofMap& dofs, const st
   if (periods < 2.0 - 1e-9) warnings.push_back(r.source + ": only " + std::to_string(static_cast<int>(periods)) +
                                                " period; steady state cannot be checked (record at least 2)");
 
-  for (const auto& c : r.channels)
-    if (clipped_fraction(c.samples) > 0.01)
-      warnings.push_back(r.source + ": channel " + c.name() + " looks clipped (" +
-                         percent(clipped_fraction(c.samples)) + " of samples at its extremes)");
+  for (const auto& c : r.channels) {
+    const Channel* v = c.quantity == Quantity::displacement ? r.find(Quantity::velocity, c.at) : nullptr;
+    const double clipped = clipped_fraction(c.samples, v ? &v->samples : nullptr);
+    if (clipped > 0.01)
+      warnings.push_back(r.source + ": channel " + c.name() + " looks clipped (" + percent(clipped) +
+                         " of samples at its extremes)");
+  }
 
   // Displacement and velocity at every joint DOF.
   const std::vector<int> set2 = joint_dof_set(joints, dofs);
@@ -129,6 +137,15 @@ TestSpectrum extract_spectrum(const Record& r, const fem::DofMap& dofs, const st
       const auto pb = std::find(set2.begin(), set2.end(), dofs.equation({j.node_b, j.dof})) - set2.begin();
       y -= x2.col(pb);
       ydot -= v2.col(pb);
+    }
+    if (j.term_index(joints::Term::fc) >= 0) {
+      // While a dry-friction joint sticks (ẏ = 0) its force lies anywhere in [−fc, fc], but the
+      // basis sign(ẏ) says 0: the stuck part of the record is not described by the model.
+      const double vmax = ydot.cwiseAbs().maxCoeff();
+      const double stuck = (ydot.array().abs() <= 1e-9 * vmax).cast<double>().mean();
+      if (stuck > 0.002)
+        warnings.push_back(r.source + ": joint '" + j.name + "' sticks for " + percent(stuck) +
+                           " of the record; the Coulomb basis sign(ydot) does not describe the force while stuck");
     }
     Eigen::MatrixXd g(n, j.terms.size());
     for (std::size_t term = 0; term < j.terms.size(); ++term)

@@ -1,0 +1,88 @@
+// Times the stages of the paper study (METHOD.md): modal analysis of the 6-element cantilever,
+// FRF blocks by modal synthesis, one steady-state simulation with the model-I joint, and one
+// identification from ten records (case I). Results: docs/benchmarks.md.
+#include "fem/damping.hpp"
+#include "fem/time_integration.hpp"
+#include "frf/receptance.hpp"
+#include "identify/fit.hpp"
+#include "support/cantilever.hpp"
+
+#include <benchmark/benchmark.h>
+
+using namespace jointid;
+
+namespace {
+
+struct Setup {
+  fem::Model model = test::paper_cantilever();
+  fem::Assembled system = fem::assemble(model);
+  fem::Modes modes = fem::modal_analysis(system, {.num_modes = 0});
+  fem::SparseMatrix C = fem::damping_matrix(system, model.damping, &modes);
+  int tip = system.dofs.equation({7, fem::Dof::uy});
+  joints::Joint joint{"tip", 7, 0, fem::Dof::uy,
+                      {joints::Term::k, joints::Term::c, joints::Term::c2, joints::Term::k3},
+                      {4800.0, 20.0, 500.0, 1.6e8}, {false, false, false, false}};
+};
+
+const Setup& setup() {
+  static const Setup s;
+  return s;
+}
+
+identify::Record record(const Setup& s, double f) {
+  const joints::JointForces forces({s.joint}, s.system.dofs);
+  const std::array<int, 1> out{s.tip};
+  const fem::SteadyState ss = fem::steady_state(s.system, s.C, &forces, {s.tip, 80.0, f}, out);
+  identify::Record r;
+  r.source = "bench";
+  r.t = ss.t;
+  r.excitation_hz = f;
+  r.channels = {{identify::Quantity::force, {7, fem::Dof::uy}, ss.force},
+                {identify::Quantity::displacement, {7, fem::Dof::uy}, ss.u.col(0)},
+                {identify::Quantity::velocity, {7, fem::Dof::uy}, ss.v.col(0)}};
+  return r;
+}
+
+void BM_Assembly(benchmark::State& state) {
+  const fem::Model m = test::paper_cantilever();
+  for (auto _ : state) benchmark::DoNotOptimize(fem::assemble(m));
+}
+
+void BM_ModalAnalysisAllModes(benchmark::State& state) {
+  const Setup& s = setup();
+  for (auto _ : state) benchmark::DoNotOptimize(fem::modal_analysis(s.system, {.num_modes = 0}));
+}
+
+void BM_FrfBlocksTenFrequencies(benchmark::State& state) {
+  const Setup& s = setup();
+  const frf::Partition p{{s.system.dofs.equation({4, fem::Dof::uy})}, {s.tip}};
+  for (auto _ : state) {
+    const frf::ModalSynthesis H(s.system, s.modes, s.model.damping, {p.set1[0], p.set2[0]});
+    for (int i = 0; i < 10; ++i) benchmark::DoNotOptimize(H.blocks(2.0 * M_PI * (1.0 + 0.4 * i), p));
+  }
+}
+
+void BM_SteadyStateOneTest(benchmark::State& state) {
+  const Setup& s = setup();
+  for (auto _ : state) benchmark::DoNotOptimize(record(s, 3.0));
+}
+
+void BM_IdentifyCaseI(benchmark::State& state) {
+  const Setup& s = setup();
+  std::vector<identify::Record> records;
+  for (int i = 0; i < 10; ++i) records.push_back(record(s, 1.0 + 0.4 * i));
+  const frf::ModalSynthesis H(s.system, s.modes, s.model.damping, {s.tip});
+  const identify::ReceptanceFn Hf = [&](double w, std::span<const int> r, std::span<const int> c) {
+    return H.receptance(w, r, c);
+  };
+  for (auto _ : state) benchmark::DoNotOptimize(identify::fit(Hf, s.system.dofs, {s.joint}, records));
+}
+
+} // namespace
+
+BENCHMARK(BM_Assembly)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ModalAnalysisAllModes)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FrfBlocksTenFrequencies)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SteadyStateOneTest)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_IdentifyCaseI)->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
