@@ -5,7 +5,7 @@
 // uses only those records and the modal FRFs of the substructure. Prints the paper's tables
 // with the exact values, the paper's values and ours, and the relative errors.
 //
-//   paper_cantilever [MODEL.toml] [--steps N] [--json FILE]
+//   paper_cantilever [MODEL.toml] [--steps N] [--json FILE] [--check]
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
 #include "frf/receptance.hpp"
@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <future>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -87,6 +88,10 @@ public:
         for (const std::vector<int>& harmonics : {std::vector<int>{1}, std::vector<int>{1, 2, 3}}) {
           const identify::FitResult r = identify(model, records, harmonics);
           print_table(model, test_case.name, c, harmonics, r);
+          if (harmonics.size() == 1)
+            for (std::size_t t = 0; t < model.terms.size(); ++t)
+              worst_[model.name] = std::max(worst_[model.name],
+                                            std::abs(r.joints[0].terms[t].value / model.exact[t] - 1.0));
           out["models"][model.name][test_case.name][harmonics.size() == 1 ? "harmonic_1" : "harmonics_1_3"] =
               nlohmann::json::parse(io::identify_result_json(r));
         }
@@ -94,6 +99,18 @@ public:
     }
     diagnose_stick_slip(out);
     return out;
+  }
+
+  /// The bars (fundamental only): model I within 0.05 %, model II within 1 %.
+  bool check() const {
+    bool ok = true;
+    for (const auto& [name, limit] : {std::pair<std::string, double>{"I", 5e-4}, {"II", 1e-2}}) {
+      const double worst = worst_.at(name);
+      std::printf("check: model %s worst relative error %.4f %% (limit %.2f %%) %s\n", name.c_str(), 100 * worst,
+                  100 * limit, worst <= limit ? "ok" : "FAILED");
+      ok = ok && worst <= limit;
+    }
+    return ok;
   }
 
 private:
@@ -203,6 +220,7 @@ private:
   fem::SparseMatrix C_;
   int tip_ = 0;
   std::optional<frf::ModalSynthesis> synthesis_;
+  std::map<std::string, double> worst_;
 };
 
 } // namespace
@@ -211,19 +229,22 @@ int main(int argc, char** argv) {
   try {
     std::string model = JOINTID_PAPER_MODEL, json_path;
     int steps = 2048;
+    bool check = false;
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
       if (a == "--steps" && i + 1 < argc) steps = std::stoi(argv[++i]);
+      else if (a == "--check") check = true;
       else if (a == "--json" && i + 1 < argc) json_path = argv[++i];
       else if (a == "--help" || a == "-h") {
-        std::puts("paper_cantilever [MODEL.toml] [--steps N (time steps per period, default 2048)] [--json FILE]");
+        std::puts("paper_cantilever [MODEL.toml] [--steps N (time steps per period, default 2048)] [--json FILE]\n"
+                  "  [--check: exit 2 unless model I is within 0.05 % and model II within 1 %]");
         return 0;
       } else model = a;
     }
     PaperStudy study(model, steps);
     const nlohmann::json result = study.run();
     if (!json_path.empty()) io::write_json(json_path, result.dump(2));
-    return 0;
+    return check && !study.check() ? 2 : 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "paper_cantilever: %s\n", e.what());
     return 1;
