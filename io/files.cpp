@@ -13,15 +13,18 @@ namespace jointid::io {
 
 namespace {
 
-std::string reason(int error_number) { return std::strerror(error_number); }
+std::string reason(int error_number) {
+  return std::strerror(error_number);
+}
 
 // A name in the target's directory that no other writer (thread or process) uses.
 std::filesystem::path temporary_name(const std::filesystem::path& path, int attempt) {
   static std::atomic<unsigned> counter{0};
   static const unsigned salt = std::random_device{}();
-  const std::string name = "." + path.filename().string() + ".tmp." + std::to_string(::getpid()) + "." +
-                           std::to_string(salt) + "." + std::to_string(counter++) + "." +
-                           std::to_string(attempt);
+  std::string name = ".";
+  name += path.filename().string();
+  name += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(salt) + "." +
+          std::to_string(counter++) + "." + std::to_string(attempt);
   return path.parent_path() / name;
 }
 
@@ -40,7 +43,8 @@ std::string read_file(const std::filesystem::path& path) {
 }
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& content) {
-  if (path.filename().empty()) throw Error("'" + path.string() + "': expected a file name, got a directory");
+  if (path.filename().empty())
+    throw Error("'" + path.string() + "': expected a file name, got a directory");
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw Error(path.string() + ": is a directory, cannot write a file there");

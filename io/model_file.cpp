@@ -3,10 +3,12 @@
 #include "fem/dof_map.hpp"
 #include "fem/elements.hpp"
 #include "io/files.hpp"
+#include "io/gmsh.hpp"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
@@ -21,7 +23,9 @@ namespace jointid::io {
 
 namespace {
 
-int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+int line_of(const toml::node& n) {
+  return static_cast<int>(n.source().begin.line);
+}
 
 // A value as the user wrote it, for "got ..." in messages.
 std::string shown(const toml::node& n) {
@@ -45,14 +49,16 @@ std::string shown(const toml::node& n) {
 
 std::string joined(const std::vector<std::string>& items) {
   std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  for (const auto& s : items)
+    out += (out.empty() ? "" : ", ") + s;
   return out;
 }
 
 std::string id_list(const std::vector<int>& ids) {
   std::string out;
   const std::size_t shown_max = 10;
-  for (std::size_t i = 0; i < ids.size() && i < shown_max; ++i) out += (i ? ", " : "") + std::to_string(ids[i]);
+  for (std::size_t i = 0; i < ids.size() && i < shown_max; ++i)
+    out += (i ? ", " : "") + std::to_string(ids[i]);
   if (ids.size() > shown_max) out += fmt::format(" and {} more", ids.size() - shown_max);
   return out;
 }
@@ -60,7 +66,8 @@ std::string id_list(const std::vector<int>& ids) {
 struct File {
   std::string name;
   [[noreturn]] void fail(int line, const std::string& what) const {
-    throw Error(line > 0 ? fmt::format("{}:{}: {}", name, line, what) : fmt::format("{}: {}", name, what));
+    throw Error(line > 0 ? fmt::format("{}:{}: {}", name, line, what)
+                         : fmt::format("{}: {}", name, what));
   }
 };
 
@@ -68,27 +75,36 @@ struct File {
 // allowed ones and converts values, reporting file, line, key and the expected type.
 class Table {
 public:
-  Table(const File& file, const toml::table& table, std::string where, std::initializer_list<std::string_view> keys)
+  Table(const File& file, const toml::table& table, std::string where,
+        std::initializer_list<std::string_view> keys)
       : file_(file), table_(table), where_(std::move(where)) {
+    // Report the first unknown key in the file (the table iterates in key order).
+    const toml::key* unknown = nullptr;
+    int unknown_line = 0;
     for (auto&& [key, value] : table_) {
       bool known = false;
-      for (std::string_view k : keys) known = known || key.str() == k;
+      for (std::string_view k : keys)
+        known = known || key.str() == k;
       if (known) continue;
-      std::vector<std::string> names(keys.begin(), keys.end());
-      const int line = key.source().begin.line > 0 ? static_cast<int>(key.source().begin.line) : line_of(value);
-      file_.fail(line, prefix() + "unknown key '" + std::string(key.str()) + "' (expected one of: " + joined(names) +
-                           ")");
+      const int line =
+          key.source().begin.line > 0 ? static_cast<int>(key.source().begin.line) : line_of(value);
+      if (!unknown || line < unknown_line) unknown = &key, unknown_line = line;
+    }
+    if (unknown) {
+      const std::vector<std::string> names(keys.begin(), keys.end());
+      file_.fail(unknown_line, prefix() + "unknown key '" + std::string(unknown->str()) +
+                                   "' (expected one of: " + joined(names) + ")");
     }
   }
 
-  void rename(std::string where) { where_ = std::move(where); }
   const std::string& where() const { return where_; }
   int line() const { return line_of(table_); }
   bool has(std::string_view key) const { return table_.contains(key); }
   const toml::node* get(std::string_view key) const { return table_.get(key); }
 
   [[noreturn]] void fail(const std::string& what) const { file_.fail(line(), prefix() + what); }
-  [[noreturn]] void fail_at(const toml::node& n, const std::string& label, const std::string& what) const {
+  [[noreturn]] void fail_at(const toml::node& n, const std::string& label,
+                            const std::string& what) const {
     file_.fail(line_of(n) > 0 ? line_of(n) : line(), prefix() + label + ": " + what);
   }
 
@@ -119,7 +135,8 @@ public:
     if (!s) fail_at(n, label, "expected a string, got " + shown(n));
     return s->get();
   }
-  const toml::array& to_array(const toml::node& n, const std::string& label, std::string_view of) const {
+  const toml::array& to_array(const toml::node& n, const std::string& label,
+                              std::string_view of) const {
     const auto* a = n.as_array();
     if (!a) fail_at(n, label, fmt::format("expected an array of {}, got {}", of, shown(n)));
     return *a;
@@ -141,23 +158,31 @@ public:
   static std::string key_label(std::string_view key) { return fmt::format("key '{}'", key); }
 
   // Typed access by key.
-  double number(std::string_view key) const { return to_number(need(key, "a number"), key_label(key)); }
+  double number(std::string_view key) const {
+    return to_number(need(key, "a number"), key_label(key));
+  }
   std::optional<double> optional_number(std::string_view key) const {
     if (const auto* n = get(key)) return to_number(*n, key_label(key));
     return std::nullopt;
   }
   double positive(std::string_view key, std::string_view unit) const {
     const double v = number(key);
-    if (!(v > 0.0)) fail_at(*get(key), key_label(key), fmt::format("expected a value > 0 {}, got {}", unit, v));
+    if (!(v > 0.0))
+      fail_at(*get(key), key_label(key), fmt::format("expected a value > 0 {}, got {}", unit, v));
     return v;
   }
   double non_negative(const toml::node& n, std::string_view key, std::string_view unit) const {
     const double v = to_number(n, key_label(key));
-    if (!(v >= 0.0)) fail_at(n, key_label(key), fmt::format("expected a value >= 0 {}, got {}", unit, v));
+    if (!(v >= 0.0))
+      fail_at(n, key_label(key), fmt::format("expected a value >= 0 {}, got {}", unit, v));
     return v;
   }
-  int integer(std::string_view key) const { return to_integer(need(key, "an integer"), key_label(key)); }
-  std::string string(std::string_view key) const { return to_string(need(key, "a string"), key_label(key)); }
+  int integer(std::string_view key) const {
+    return to_integer(need(key, "an integer"), key_label(key));
+  }
+  std::string string(std::string_view key) const {
+    return to_string(need(key, "a string"), key_label(key));
+  }
   fem::Dof dof(std::string_view key) const {
     return to_dof(need(key, "one of ux, uy, uz, rx, ry, rz"), key_label(key));
   }
@@ -185,7 +210,9 @@ std::vector<const toml::table*> tables(const Table& root, std::string_view key) 
   const toml::array& a = root.to_array(*n, label, fmt::format("tables (write [[{}]])", key));
   for (const auto& entry : a) {
     const auto* t = entry.as_table();
-    if (!t) root.fail_at(entry, label, fmt::format("expected a table (write [[{}]]), got {}", key, shown(entry)));
+    if (!t)
+      root.fail_at(entry, label,
+                   fmt::format("expected a table (write [[{}]]), got {}", key, shown(entry)));
     out.push_back(t);
   }
   return out;
@@ -195,8 +222,20 @@ const toml::table* table(const Table& root, std::string_view key) {
   const toml::node* n = root.get(key);
   if (!n) return nullptr;
   const auto* t = n->as_table();
-  if (!t) root.fail_at(*n, Table::key_label(key), fmt::format("expected a table (write [{}]), got {}", key, shown(*n)));
+  if (!t)
+    root.fail_at(*n, Table::key_label(key),
+                 fmt::format("expected a table (write [{}]), got {}", key, shown(*n)));
   return t;
+}
+
+// "[[joints]] 'tip'" or "[[supports]] node 1" when the table has that key, else "[[joints]] #2".
+std::string item_label(const toml::table& t, std::string_view array, std::size_t index,
+                       std::string_view key) {
+  if (const auto* n = t.get(key)) {
+    if (const auto* s = n->as_string()) return fmt::format("[[{}]] '{}'", array, s->get());
+    if (const auto* i = n->as_integer()) return fmt::format("[[{}]] {} {}", array, key, i->get());
+  }
+  return fmt::format("[[{}]] #{}", array, index + 1);
 }
 
 fem::ElementType parse_element_type(const Table& t) {
@@ -208,15 +247,17 @@ fem::ElementType parse_element_type(const Table& t) {
   t.fail_at(n, "key 'type'", "expected one of beam, frame2d, frame3d, got " + shown(n));
 }
 
-// Reads the whole file into a Model and joints; `lines` keeps where each item was defined.
+// Reads the whole file into a Model and joints, remembering the lines of nodes, elements and
+// joints for the checks that come after reading.
 class ModelReader {
 public:
-  ModelReader(const std::filesystem::path& path, const toml::table& root) : file_{path.string()}, root_(root) {}
+  ModelReader(const std::filesystem::path& path, const toml::table& root)
+      : file_{path.string()}, root_(root), directory_(path.parent_path()) {}
 
   ModelFile read() {
     Table root(file_, root_, "",
-               {"model", "materials", "sections", "mesh", "element_sets", "supports", "masses", "springs", "damping",
-                "options", "joints"});
+               {"model", "materials", "sections", "mesh", "element_sets", "supports", "masses",
+                "springs", "damping", "options", "joints"});
     read_model_table(root);
     read_materials(root);
     read_sections(root);
@@ -235,14 +276,37 @@ public:
 private:
   fem::Model& model() { return out_.model; }
 
-  int node_id(const Table& t, const toml::node& n, const std::string& label, bool zero_is_ground = false) {
+  int node_id(const Table& t, const toml::node& n, const std::string& label,
+              bool zero_is_ground = false) {
+    if (n.is_string()) { // a Gmsh physical group with exactly one node
+      const std::vector<int> ids = group_nodes(t, n, label);
+      if (ids.size() != 1)
+        t.fail_at(n, label,
+                  fmt::format("group {} holds {} nodes ({}); expected exactly one", shown(n),
+                              ids.size(), id_list(ids)));
+      return ids.front();
+    }
     const int id = t.to_integer(n, label);
     if (zero_is_ground && id == 0) return 0;
-    if (!node_lines_.count(id)) t.fail_at(n, label, fmt::format("node {} does not exist in [mesh] nodes", id));
+    if (!node_lines_.count(id))
+      t.fail_at(n, label, fmt::format("node {} does not exist in [mesh] nodes", id));
     return id;
   }
   int node_key(const Table& t, std::string_view key) {
-    return node_id(t, t.need(key, "a node id"), Table::key_label(key));
+    return node_id(t, t.need(key, "a node id or a Gmsh group name"), Table::key_label(key));
+  }
+  // The nodes of a named Gmsh physical group (points, or every node of a group of lines).
+  std::vector<int> group_nodes(const Table& t, const toml::node& n, const std::string& label) {
+    const std::string name = t.to_string(n, label);
+    if (!mesh_)
+      t.fail_at(n, label,
+                "expected a node id; group names such as " + shown(n) +
+                    " need a Gmsh mesh ([mesh] file = \"x.msh\")");
+    try {
+      return mesh_->nodes_in(name);
+    } catch (const Error& e) {
+      t.fail_at(n, label, e.what());
+    }
   }
 
   void read_model_table(const Table& root) {
@@ -257,18 +321,21 @@ private:
 
   void read_materials(const Table& root) {
     const auto list = tables(root, "materials");
-    if (list.empty()) root.fail("missing [[materials]] (expected at least one, with name, E, rho, nu)");
+    if (list.empty())
+      root.fail("missing [[materials]] (expected at least one, with name, E, rho, nu)");
     for (std::size_t i = 0; i < list.size(); ++i) {
-      Table t(file_, *list[i], fmt::format("[[materials]] #{}", i + 1), {"name", "E", "rho", "nu"});
+      Table t(file_, *list[i], item_label(*list[i], "materials", i, "name"),
+              {"name", "E", "rho", "nu"});
       fem::Material m;
       m.name = t.string("name");
-      t.rename("[[materials]] '" + m.name + "'");
-      if (material_index_.count(m.name)) t.fail("name '" + m.name + "' is used by another material");
+      if (material_index_.count(m.name))
+        t.fail("name '" + m.name + "' is used by another material");
       m.E = t.positive("E", "Pa");
       m.rho = t.non_negative(t.need("rho", "a number"), "rho", "kg/m^3");
       if (const auto nu = t.optional_number("nu")) {
         m.nu = *nu;
-        if (!(m.nu > -1.0 && m.nu < 0.5)) t.fail_at(*t.get("nu"), "key 'nu'", fmt::format("expected -1 < nu < 0.5, got {}", m.nu));
+        if (!(m.nu > -1.0 && m.nu < 0.5))
+          t.fail_at(*t.get("nu"), "key 'nu'", fmt::format("expected -1 < nu < 0.5, got {}", m.nu));
       }
       material_index_[m.name] = static_cast<int>(model().materials.size());
       model().materials.push_back(m);
@@ -279,10 +346,10 @@ private:
     const auto list = tables(root, "sections");
     if (list.empty()) root.fail("missing [[sections]] (expected at least one, with name, A, Iz)");
     for (std::size_t i = 0; i < list.size(); ++i) {
-      Table t(file_, *list[i], fmt::format("[[sections]] #{}", i + 1), {"name", "A", "Iz", "Iy", "J"});
+      Table t(file_, *list[i], item_label(*list[i], "sections", i, "name"),
+              {"name", "A", "Iz", "Iy", "J"});
       fem::Section s;
       s.name = t.string("name");
-      t.rename("[[sections]] '" + s.name + "'");
       if (section_index_.count(s.name)) t.fail("name '" + s.name + "' is used by another section");
       s.A = t.positive("A", "m^2");
       s.Iz = t.positive("Iz", "m^4");
@@ -295,10 +362,14 @@ private:
 
   void read_mesh(const Table& root) {
     const toml::table* m = table(root, "mesh");
-    if (!m) root.fail("missing table [mesh] (expected nodes = [[id, x, y], ...] and elements = [[id, a, b], ...])");
+    if (!m)
+      root.fail("missing table [mesh] (expected nodes = [[id, x, y], ...] and elements = [[id, a, "
+                "b], ...])");
     Table t(file_, *m, "[mesh]", {"nodes", "elements", "file"});
-    if (const auto* f = t.get("file"))
-      t.fail_at(*f, "key 'file'", "Gmsh meshes are not supported yet; give nodes = [...] and elements = [...]");
+    if (const auto* f = t.get("file")) {
+      read_gmsh_mesh(t, *f);
+      return;
+    }
     const bool planar = model().dimension == 2;
     const std::string coords = planar ? "[id, x, y] or [id, x, y, z]" : "[id, x, y, z]";
     const toml::node& nodes_node = t.need("nodes", "an array of " + coords);
@@ -307,68 +378,138 @@ private:
       const std::string label = fmt::format("key 'nodes', entry {}", i + 1);
       const auto* a = nodes[i].as_array();
       if (!a || a->size() < (planar ? 3u : 4u) || a->size() > 4)
-        t.fail_at(nodes[i], label, "expected " + coords + ", got " + (a ? fmt::format("{} values", a->size()) : shown(nodes[i])));
+        t.fail_at(nodes[i], label,
+                  "expected " + coords + ", got " +
+                      (a ? fmt::format("{} values", a->size()) : shown(nodes[i])));
       fem::Node node;
       node.id = t.to_integer((*a)[0], label);
-      if (node.id <= 0) t.fail_at(nodes[i], label, fmt::format("node ids must be > 0 (0 means ground), got {}", node.id));
+      if (node.id <= 0)
+        t.fail_at(nodes[i], label,
+                  fmt::format("node ids must be > 0 (0 means ground), got {}", node.id));
       if (const auto it = node_lines_.find(node.id); it != node_lines_.end())
-        t.fail_at(nodes[i], label, fmt::format("node id {} is already used at line {}", node.id, it->second));
-      for (std::size_t c = 1; c < a->size(); ++c) node.x(c - 1) = t.to_number((*a)[c], label);
+        t.fail_at(nodes[i], label,
+                  fmt::format("node id {} is already used at line {}", node.id, it->second));
+      for (std::size_t c = 1; c < a->size(); ++c)
+        node.x(c - 1) = t.to_number((*a)[c], label);
       if (planar && node.x.z() != 0.0)
-        t.fail_at(nodes[i], label, fmt::format("node {}: a planar model (dimension = 2) needs z = 0, got {}", node.id, node.x.z()));
+        t.fail_at(nodes[i], label,
+                  fmt::format("node {}: a planar model (dimension = 2) needs z = 0, got {}",
+                              node.id, node.x.z()));
       node_lines_[node.id] = line_of(nodes[i]) > 0 ? line_of(nodes[i]) : line_of(nodes_node);
       model().nodes.push_back(node);
     }
 
     const toml::node& elements_node = t.need("elements", "an array of [id, node a, node b]");
     elements_line_ = line_of(elements_node);
-    const toml::array& elements = t.to_array(elements_node, "key 'elements'", "[id, node a, node b]");
+    const toml::array& elements =
+        t.to_array(elements_node, "key 'elements'", "[id, node a, node b]");
     for (std::size_t i = 0; i < elements.size(); ++i) {
       const std::string label = fmt::format("key 'elements', entry {}", i + 1);
       const auto* a = elements[i].as_array();
       if (!a || a->size() != 3)
-        t.fail_at(elements[i], label, "expected [id, node a, node b], got " + (a ? fmt::format("{} values", a->size()) : shown(elements[i])));
+        t.fail_at(elements[i], label,
+                  "expected [id, node a, node b], got " +
+                      (a ? fmt::format("{} values", a->size()) : shown(elements[i])));
       fem::Element e;
       e.id = t.to_integer((*a)[0], label);
       if (const auto it = element_lines_.find(e.id); it != element_lines_.end())
-        t.fail_at(elements[i], label, fmt::format("element id {} is already used at line {}", e.id, it->second));
+        t.fail_at(elements[i], label,
+                  fmt::format("element id {} is already used at line {}", e.id, it->second));
       e.node_a = node_id(t, (*a)[1], label);
       e.node_b = node_id(t, (*a)[2], label);
-      if (e.node_a == e.node_b) t.fail_at(elements[i], label, fmt::format("element {} connects node {} to itself", e.id, e.node_a));
+      if (e.node_a == e.node_b)
+        t.fail_at(elements[i], label,
+                  fmt::format("element {} connects node {} to itself", e.id, e.node_a));
       element_lines_[e.id] = line_of(elements[i]) > 0 ? line_of(elements[i]) : elements_line_;
       element_position_[e.id] = static_cast<int>(model().elements.size());
       model().elements.push_back(e);
     }
   }
 
+  // [mesh] file = "frame.msh": nodes and 2-node lines from Gmsh (path relative to this file).
+  void read_gmsh_mesh(const Table& t, const toml::node& f) {
+    if (t.has("nodes") || t.has("elements"))
+      t.fail_at(f, "key 'file'", "give either file = \"x.msh\" or nodes and elements, not both");
+    const std::filesystem::path msh = directory_ / t.to_string(f, "key 'file'");
+    mesh_ = read_gmsh(msh); // its errors name the .msh file and line
+    elements_line_ = line_of(f);
+    for (const auto& node : mesh_->nodes) {
+      if (node.id <= 0)
+        throw Error(fmt::format("{}: node ids must be > 0 (0 means ground), got {}", msh.string(),
+                                node.id));
+      if (model().dimension == 2 && node.x.z() != 0.0)
+        throw Error(fmt::format("{}: node {} has z = {}, but {} declares a planar model "
+                                "(dimension = 2)",
+                                msh.string(), node.id, node.x.z(), file_.name));
+      node_lines_[node.id] = 0;
+      model().nodes.push_back(node);
+    }
+    for (const auto& line : mesh_->lines) {
+      fem::Element e;
+      e.id = line.id;
+      e.node_a = line.node_a;
+      e.node_b = line.node_b;
+      element_lines_[e.id] = 0;
+      element_origin_[e.id] = fmt::format("{}:{}", msh.string(), line.source_line);
+      element_position_[e.id] = static_cast<int>(model().elements.size());
+      model().elements.push_back(e);
+    }
+  }
+
+  // Names of the Gmsh physical groups of lines an element belongs to, for messages.
+  std::string groups_of(const std::vector<int>& ids) const {
+    if (!mesh_) return {};
+    std::set<std::string> names;
+    for (const auto& line : mesh_->lines)
+      if (std::find(ids.begin(), ids.end(), line.id) != ids.end())
+        for (int g : line.groups)
+          if (const auto it = mesh_->names.find({1, g}); it != mesh_->names.end())
+            names.insert("'" + it->second + "'");
+    if (names.empty()) return " (in no physical group)";
+    return " (physical group " + joined({names.begin(), names.end()}) + ")";
+  }
+
   void read_element_sets(const Table& root) {
     const auto list = tables(root, "element_sets");
     std::vector<int> set_line(model().elements.size(), 0); // line of the set covering each element
     for (std::size_t i = 0; i < list.size(); ++i) {
-      Table t(file_, *list[i], fmt::format("[[element_sets]] #{}", i + 1), {"elements", "type", "material", "section", "up"});
+      Table t(file_, *list[i], fmt::format("[[element_sets]] #{}", i + 1),
+              {"elements", "type", "material", "section", "up"});
       const fem::ElementType type = parse_element_type(t);
       const int material = lookup(t, "material", material_index_);
       const int section = lookup(t, "section", section_index_);
       Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
       if (const auto* n = t.get("up")) {
-        if (type != fem::ElementType::frame3d) t.fail_at(*n, "key 'up'", "only frame3d elements have an up vector");
+        if (type != fem::ElementType::frame3d)
+          t.fail_at(*n, "key 'up'", "only frame3d elements have an up vector");
         up = t.to_vector3(*n, "key 'up'");
         if (!(up.norm() > 0.0)) t.fail_at(*n, "key 'up'", "expected a non-zero vector");
       }
       // The elements it covers: "all" or a list of ids.
       const toml::node& which = t.need("elements", "\"all\" or a list of element ids");
       std::vector<int> members;
-      if (which.is_string()) {
-        if (which.as_string()->get() != "all")
+      if (which.is_string() && which.as_string()->get() == "all") {
+        for (const auto& e : model().elements)
+          members.push_back(e.id);
+      } else if (which.is_string()) {
+        if (!mesh_)
           t.fail_at(which, "key 'elements'",
                     "expected \"all\" or a list of element ids, got " + shown(which) +
-                        " (Gmsh physical groups need a Gmsh mesh, not supported yet)");
-        for (const auto& e : model().elements) members.push_back(e.id);
+                        " (group names need a Gmsh mesh: [mesh] file = \"x.msh\")");
+        try {
+          members = mesh_->elements_in(which.as_string()->get());
+        } catch (const Error& e) {
+          t.fail_at(which, "key 'elements'", e.what());
+        }
+        if (members.empty())
+          t.fail_at(which, "key 'elements'", "the physical group " + shown(which) + " has no lines");
       } else {
         const toml::array& ids = t.to_array(which, "key 'elements'", "element ids (or \"all\")");
         for (const auto& n : ids) {
           const int id = t.to_integer(n, "key 'elements'");
-          if (!element_position_.count(id)) t.fail_at(n, "key 'elements'", fmt::format("element {} does not exist in [mesh] elements", id));
+          if (!element_position_.count(id))
+            t.fail_at(n, "key 'elements'",
+                      fmt::format("element {} does not exist in [mesh] elements", id));
           members.push_back(id);
         }
       }
@@ -390,19 +531,24 @@ private:
       }
       if (!twice.empty()) {
         std::vector<std::string> lines;
-        for (int l : other_lines) lines.push_back(std::to_string(l));
+        for (int l : other_lines)
+          lines.push_back(std::to_string(l));
         t.fail_at(which, "key 'elements'",
-                  fmt::format("element{} {} already in the element set at line {} (each element belongs to exactly one set)",
-                              twice.size() > 1 ? "s" : "", id_list(twice) + (twice.size() > 1 ? " are" : " is"),
-                              joined(lines)));
+                  fmt::format("element{} {} already in the element set at line {} (each element "
+                              "belongs to exactly one set)",
+                              twice.size() > 1 ? "s" : "",
+                              id_list(twice) + (twice.size() > 1 ? " are" : " is"), joined(lines)));
       }
     }
     std::vector<int> uncovered;
     for (std::size_t p = 0; p < model().elements.size(); ++p)
       if (set_line[p] == 0) uncovered.push_back(model().elements[p].id);
     if (!uncovered.empty())
-      file_.fail(elements_line_, fmt::format("[mesh]: element{} {} in no [[element_sets]] (each element belongs to exactly one set)",
-                                             uncovered.size() > 1 ? "s" : "", id_list(uncovered) + (uncovered.size() > 1 ? " are" : " is")));
+      file_.fail(elements_line_,
+                 fmt::format("[mesh]: element{} {}{} in no [[element_sets]] (each element belongs "
+                             "to exactly one set, which gives its type, material and section)",
+                             uncovered.size() > 1 ? "s" : "", id_list(uncovered),
+                             groups_of(uncovered) + (uncovered.size() > 1 ? " are" : " is")));
   }
 
   int lookup(const Table& t, std::string_view key, const std::map<std::string, int>& index) {
@@ -411,8 +557,11 @@ private:
     const auto it = index.find(name);
     if (it == index.end()) {
       std::vector<std::string> names;
-      for (const auto& [k, v] : index) names.push_back("\"" + k + "\"");
-      t.fail_at(n, Table::key_label(key), fmt::format("expected one of the [[{}s]] names ({}), got \"{}\"", key, joined(names), name));
+      for (const auto& [k, v] : index)
+        names.push_back("\"" + k + "\"");
+      t.fail_at(n, Table::key_label(key),
+                fmt::format("expected one of the [[{}s]] names ({}), got \"{}\"", key,
+                            joined(names), name));
     }
     return it->second;
   }
@@ -420,29 +569,45 @@ private:
   void read_supports(const Table& root) {
     const auto list = tables(root, "supports");
     for (std::size_t i = 0; i < list.size(); ++i) {
-      Table t(file_, *list[i], fmt::format("[[supports]] #{}", i + 1), {"node", "fix"});
-      fem::Support s;
-      s.node = node_key(t, "node");
-      t.rename(fmt::format("[[supports]] node {}", s.node));
+      Table t(file_, *list[i], item_label(*list[i], "supports", i, "node"),
+              {"node", "nodes", "fix"});
+      // node = id (or a one-node group); nodes = [ids] or a Gmsh group name.
+      std::vector<int> nodes;
+      const auto* one = t.get("node");
+      const auto* many = t.get("nodes");
+      if (one && many) t.fail("give either node or nodes, not both");
+      if (!one && !many) t.fail("missing key 'node' (a node id) or 'nodes' (ids or a Gmsh group)");
+      if (one) nodes.push_back(node_key(t, "node"));
+      if (many && many->is_string()) nodes = group_nodes(t, *many, "key 'nodes'");
+      else if (many)
+        for (const auto& n : t.to_array(*many, "key 'nodes'", "node ids or a Gmsh group name"))
+          nodes.push_back(node_id(t, n, "key 'nodes'"));
+      if (nodes.empty()) t.fail("the support holds no nodes");
       const toml::node& fix = t.need("fix", "a list of DOFs such as [\"ux\", \"uy\", \"rz\"]");
       const toml::array& dofs = t.to_array(fix, "key 'fix'", "DOF names (ux, uy, uz, rx, ry, rz)");
       if (dofs.empty()) t.fail_at(fix, "key 'fix'", "expected at least one DOF");
-      for (const auto& d : dofs) s.fixed.push_back(t.to_dof(d, "key 'fix'"));
-      model().supports.push_back(s);
+      fem::Support s;
+      for (const auto& d : dofs)
+        s.fixed.push_back(t.to_dof(d, "key 'fix'"));
+      for (int node : nodes) {
+        s.node = node;
+        model().supports.push_back(s);
+      }
     }
   }
 
   void read_masses(const Table& root) {
     const auto list = tables(root, "masses");
     for (std::size_t i = 0; i < list.size(); ++i) {
-      Table t(file_, *list[i], fmt::format("[[masses]] #{}", i + 1), {"node", "mass", "inertia"});
+      Table t(file_, *list[i], item_label(*list[i], "masses", i, "node"),
+              {"node", "mass", "inertia"});
       fem::PointMass m;
       m.node = node_key(t, "node");
-      t.rename(fmt::format("[[masses]] node {}", m.node));
       m.mass = t.non_negative(t.need("mass", "a number (kg)"), "mass", "kg");
       if (const auto* n = t.get("inertia")) {
         m.inertia = t.to_vector3(*n, "key 'inertia'");
-        if (!(m.inertia.minCoeff() >= 0.0)) t.fail_at(*n, "key 'inertia'", "expected [Ix, Iy, Iz] >= 0 kg m^2");
+        if (!(m.inertia.minCoeff() >= 0.0))
+          t.fail_at(*n, "key 'inertia'", "expected [Ix, Iy, Iz] >= 0 kg m^2");
       }
       model().masses.push_back(m);
     }
@@ -451,14 +616,16 @@ private:
   void read_springs(const Table& root) {
     const auto list = tables(root, "springs");
     for (std::size_t i = 0; i < list.size(); ++i) {
-      Table t(file_, *list[i], fmt::format("[[springs]] #{}", i + 1), {"node", "node_b", "dof", "stiffness"});
+      Table t(file_, *list[i], item_label(*list[i], "springs", i, "node"),
+              {"node", "node_b", "dof", "stiffness"});
       fem::Spring s;
       s.node = node_key(t, "node");
-      t.rename(fmt::format("[[springs]] node {}", s.node));
       if (const auto* n = t.get("node_b")) s.node_b = node_id(t, *n, "key 'node_b'", true);
-      if (s.node_b == s.node) t.fail_at(*t.get("node_b"), "key 'node_b'", "a spring cannot connect a node to itself");
+      if (s.node_b == s.node)
+        t.fail_at(*t.get("node_b"), "key 'node_b'", "a spring cannot connect a node to itself");
       s.dof = t.dof("dof");
-      s.stiffness = t.non_negative(t.need("stiffness", "a number (N/m or N m/rad)"), "stiffness", "N/m");
+      s.stiffness =
+          t.non_negative(t.need("stiffness", "a number (N/m or N m/rad)"), "stiffness", "N/m");
       model().springs.push_back(s);
     }
   }
@@ -469,17 +636,21 @@ private:
     Table t(file_, *d, "[damping]", {"modal", "rayleigh"});
     const auto* modal = t.get("modal");
     const auto* rayleigh = t.get("rayleigh");
-    if (modal && rayleigh) t.fail("give either modal = ratio or rayleigh = [alpha, beta], not both");
+    if (modal && rayleigh)
+      t.fail("give either modal = ratio or rayleigh = [alpha, beta], not both");
     if (!modal && !rayleigh) t.fail("expected modal = ratio or rayleigh = [alpha, beta]");
     fem::Damping& damping = model().damping;
     if (modal) {
       damping.kind = fem::Damping::Kind::modal;
       damping.modal_ratio = t.to_number(*modal, "key 'modal'");
       if (!(damping.modal_ratio >= 0.0 && damping.modal_ratio < 1.0))
-        t.fail_at(*modal, "key 'modal'", fmt::format("expected a damping ratio in [0, 1), got {}", damping.modal_ratio));
+        t.fail_at(*modal, "key 'modal'",
+                  fmt::format("expected a damping ratio in [0, 1), got {}", damping.modal_ratio));
     } else {
       const toml::array& a = t.to_array(*rayleigh, "key 'rayleigh'", "two numbers [alpha, beta]");
-      if (a.size() != 2) t.fail_at(*rayleigh, "key 'rayleigh'", fmt::format("expected [alpha, beta], got {} values", a.size()));
+      if (a.size() != 2)
+        t.fail_at(*rayleigh, "key 'rayleigh'",
+                  fmt::format("expected [alpha, beta], got {} values", a.size()));
       damping.kind = fem::Damping::Kind::rayleigh;
       damping.alpha = t.to_number(a[0], "key 'rayleigh'");
       damping.beta = t.to_number(a[1], "key 'rayleigh'");
@@ -492,28 +663,33 @@ private:
     const toml::table* o = table(root, "options");
     if (!o) return;
     Table t(file_, *o, "[options]", {"lumped_mass"});
-    if (const auto lumped = t.optional_boolean("lumped_mass")) model().mass_options.lumped = *lumped;
+    if (const auto lumped = t.optional_boolean("lumped_mass"))
+      model().mass_options.lumped = *lumped;
   }
 
   void read_joints(const Table& root) {
     const auto list = tables(root, "joints");
     std::map<std::string, int> name_lines;
     for (std::size_t i = 0; i < list.size(); ++i) {
-      Table t(file_, *list[i], fmt::format("[[joints]] #{}", i + 1), {"name", "node", "node_b", "dof", "terms", "values", "fixed"});
+      Table t(file_, *list[i], item_label(*list[i], "joints", i, "name"),
+              {"name", "node", "node_b", "dof", "terms", "values", "fixed"});
       joints::Joint j;
       j.name = t.string("name");
       if (j.name.empty()) t.fail_at(*t.get("name"), "key 'name'", "expected a non-empty name");
-      t.rename("[[joints]] '" + j.name + "'");
       if (const auto it = name_lines.find(j.name); it != name_lines.end())
-        t.fail_at(*t.get("name"), "key 'name'", fmt::format("the name is already used by the joint at line {}", it->second));
+        t.fail_at(*t.get("name"), "key 'name'",
+                  fmt::format("the name is already used by the joint at line {}", it->second));
       name_lines[j.name] = t.line();
       j.node = node_key(t, "node");
       if (const auto* n = t.get("node_b")) j.node_b = node_id(t, *n, "key 'node_b'", true);
-      if (j.node_b == j.node) t.fail_at(*t.get("node_b"), "key 'node_b'", "a joint cannot connect a node to itself");
+      if (j.node_b == j.node)
+        t.fail_at(*t.get("node_b"), "key 'node_b'", "a joint cannot connect a node to itself");
       j.dof = t.dof("dof");
 
-      const toml::node& terms_node = t.need("terms", "a list of terms such as [\"k\", \"c\", \"k3\"]");
-      const toml::array& terms = t.to_array(terms_node, "key 'terms'", "term names (k, c, k2, k3, c2, c3, fc)");
+      const toml::node& terms_node =
+          t.need("terms", "a list of terms such as [\"k\", \"c\", \"k3\"]");
+      const toml::array& terms =
+          t.to_array(terms_node, "key 'terms'", "term names (k, c, k2, k3, c2, c3, fc)");
       if (terms.empty()) t.fail_at(terms_node, "key 'terms'", "expected at least one term");
       for (const auto& n : terms) {
         const std::string name = t.to_string(n, "key 'terms'");
@@ -531,11 +707,16 @@ private:
       std::vector<bool> has_value(j.terms.size(), false);
       if (const auto* n = t.get("values")) {
         const auto* values = n->as_table();
-        if (!values) t.fail_at(*n, "key 'values'", "expected a table such as { k = 4800.0, c = 20.0 }, got " + shown(*n));
+        if (!values)
+          t.fail_at(*n, "key 'values'",
+                    "expected a table such as { k = 4800.0, c = 20.0 }, got " + shown(*n));
         for (auto&& [key, value] : *values) {
           const std::string label = "key 'values." + std::string(key.str()) + "'";
           const int index = term_position(j, key.str());
-          if (index < 0) t.fail_at(value, label, "'" + std::string(key.str()) + "' is not among the joint's terms (" + listed + ")");
+          if (index < 0)
+            t.fail_at(value, label,
+                      "'" + std::string(key.str()) + "' is not among the joint's terms (" + listed +
+                          ")");
           j.values[index] = t.to_number(value, label);
           has_value[index] = true;
         }
@@ -545,8 +726,12 @@ private:
         for (const auto& f : fixed) {
           const std::string name = t.to_string(f, "key 'fixed'");
           const int index = term_position(j, name);
-          if (index < 0) t.fail_at(f, "key 'fixed'", "'" + name + "' is not among the joint's terms (" + listed + ")");
-          if (!has_value[index]) t.fail_at(f, "key 'fixed'", "term '" + name + "' is held fixed but has no value in 'values'");
+          if (index < 0)
+            t.fail_at(f, "key 'fixed'",
+                      "'" + name + "' is not among the joint's terms (" + listed + ")");
+          if (!has_value[index])
+            t.fail_at(f, "key 'fixed'",
+                      "term '" + name + "' is held fixed but has no value in 'values'");
           j.fixed[index] = true;
         }
       }
@@ -557,7 +742,8 @@ private:
 
   static std::string listed_terms(const joints::Joint& j) {
     std::vector<std::string> names;
-    for (joints::Term term : j.terms) names.emplace_back(joints::term_name(term));
+    for (joints::Term term : j.terms)
+      names.emplace_back(joints::term_name(term));
     return joined(names);
   }
   static int term_position(const joints::Joint& j, std::string_view name) {
@@ -577,6 +763,8 @@ private:
       try {
         fem::element_matrices(model(), e);
       } catch (const std::exception& err) {
+        if (const auto it = element_origin_.find(e.id); it != element_origin_.end())
+          throw Error(it->second + ": " + err.what());
         file_.fail(element_lines_.at(e.id), err.what());
       }
     }
@@ -603,7 +791,10 @@ private:
   File file_;
   const toml::table& root_;
   ModelFile out_;
+  std::filesystem::path directory_;
+  std::optional<GmshMesh> mesh_;
   std::map<int, int> node_lines_, element_lines_, element_position_;
+  std::map<int, std::string> element_origin_; // "mesh.msh:LINE" of elements read from Gmsh
   int elements_line_ = 0;
   std::map<std::string, int> material_index_, section_index_;
   std::vector<int> joint_lines_;
@@ -617,7 +808,8 @@ ModelFile read_model(const std::filesystem::path& path) {
   try {
     root = toml::parse(std::string_view(text), path.string());
   } catch (const toml::parse_error& e) {
-    throw Error(fmt::format("{}:{}:{}: {}", path.string(), e.source().begin.line, e.source().begin.column, e.description()));
+    throw Error(fmt::format("{}:{}:{}: {}", path.string(), e.source().begin.line,
+                            e.source().begin.column, e.description()));
   }
   ModelFile out = ModelReader(path, root).read();
   out.path = path;

@@ -33,7 +33,8 @@ std::vector<std::string_view> split_fields(std::string_view line) {
   std::size_t start = 0;
   while (true) {
     const auto comma = line.find(',', start);
-    fields.push_back(trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
+    fields.push_back(trim(line.substr(
+        start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
@@ -57,7 +58,8 @@ struct CsvText {
   std::vector<Line> rows;
 
   [[noreturn]] void fail(int line, const std::string& what) const {
-    throw Error(line > 0 ? fmt::format("{}:{}: {}", name, line, what) : fmt::format("{}: {}", name, what));
+    throw Error(line > 0 ? fmt::format("{}:{}: {}", name, line, what)
+                         : fmt::format("{}: {}", name, what));
   }
 };
 
@@ -76,7 +78,8 @@ CsvText scan(const std::filesystem::path& path, std::string_view header_example)
     if (line.empty()) continue;
     if (line.front() == '#') {
       if (csv.header.number != 0)
-        csv.fail(number, "comment after the header (comment lines must come before the header row)");
+        csv.fail(number,
+                 "comment after the header (comment lines must come before the header row)");
       csv.comments.push_back({number, trim(line.substr(1))});
     } else if (csv.header.number == 0) {
       csv.header = {number, line};
@@ -85,40 +88,50 @@ CsvText scan(const std::filesystem::path& path, std::string_view header_example)
     }
   }
   if (csv.header.number == 0)
-    csv.fail(0, fmt::format("missing header: the file has no header row (expected e.g. {}) and no data", header_example));
+    csv.fail(
+        0, fmt::format("missing header: the file has no header row (expected e.g. {}) and no data",
+                       header_example));
   if (parse_double(split_fields(csv.header.text).front()))
-    csv.fail(csv.header.number, fmt::format("missing header: expected a header row such as {} before the numbers, got "
-                                            "a row of numbers",
-                                            header_example));
+    csv.fail(csv.header.number,
+             fmt::format("missing header: expected a header row such as {} before the numbers, got "
+                         "a row of numbers",
+                         header_example));
   return csv;
 }
 
 // The rows as numbers, one vector per column; checks field counts and finiteness.
-std::vector<std::vector<double>> parse_rows(const CsvText& csv, const std::vector<std::string>& columns,
+std::vector<std::vector<double>> parse_rows(const CsvText& csv,
+                                            const std::vector<std::string>& columns,
                                             std::string_view what_columns) {
   const std::size_t width = columns.size();
   std::vector<std::vector<double>> data(width);
-  for (auto& column : data) column.reserve(csv.rows.size());
+  for (auto& column : data)
+    column.reserve(csv.rows.size());
   for (const Line& row : csv.rows) {
     const auto fields = split_fields(row.text);
     if (fields.size() != width)
-      csv.fail(row.number, fmt::format("row has {} field{}, expected {} ({})", fields.size(), fields.size() == 1 ? "" : "s",
-                                       width, what_columns));
+      csv.fail(row.number, fmt::format("row has {} field{}, expected {} ({})", fields.size(),
+                                       fields.size() == 1 ? "" : "s", width, what_columns));
     for (std::size_t c = 0; c < width; ++c) {
       const auto value = parse_double(fields[c]);
       const std::string where = fmt::format("column {} ({})", c + 1, columns[c]);
       if (!value)
         csv.fail(row.number, fmt::format("{}: expected a number, got {}", where,
-                                         fields[c].empty() ? std::string("an empty field") : "\"" + std::string(fields[c]) + "\""));
+                                         fields[c].empty() ? std::string("an empty field")
+                                                           : fmt::format("\"{}\"", fields[c])));
       if (!std::isfinite(*value))
-        csv.fail(row.number, fmt::format("{}: expected a finite number, got \"{}\" (NaN or infinite)", where, fields[c]));
+        csv.fail(row.number,
+                 fmt::format("{}: expected a finite number, got \"{}\" (NaN or infinite)", where,
+                             fields[c]));
       data[c].push_back(*value);
     }
   }
   return data;
 }
 
-std::string shortest(double value) { return fmt::format("{}", value); }
+std::string shortest(double value) {
+  return fmt::format("{}", value);
+}
 
 } // namespace
 
@@ -134,18 +147,22 @@ identify::Record read_record(const std::filesystem::path& path) {
     const std::string_view value_text = trim(after.substr(1));
     const auto value = parse_double(value_text);
     if (!value || !std::isfinite(*value) || !(*value > 0.0))
-      csv.fail(c.number, fmt::format("excitation_hz: expected a frequency > 0 Hz, got \"{}\"", value_text));
+      csv.fail(c.number,
+               fmt::format("excitation_hz: expected a frequency > 0 Hz, got \"{}\"", value_text));
     if (record.excitation_hz && *record.excitation_hz != *value)
-      csv.fail(c.number, fmt::format("excitation_hz given twice ({} and {} Hz)", *record.excitation_hz, *value));
+      csv.fail(c.number, fmt::format("excitation_hz given twice ({} and {} Hz)",
+                                     *record.excitation_hz, *value));
     record.excitation_hz = *value;
   }
 
   // Header: t, then channels.
   const auto names = split_fields(csv.header.text);
   if (names.front() != "t")
-    csv.fail(csv.header.number,
-             fmt::format("header: the first column must be 't' (time in s), got \"{}\"", names.front()));
-  if (names.size() < 2) csv.fail(csv.header.number, "header: no channels after 't' (expected e.g. t,f@7:uy,x@7:uy)");
+    csv.fail(
+        csv.header.number,
+        fmt::format("header: the first column must be 't' (time in s), got \"{}\"", names.front()));
+  if (names.size() < 2)
+    csv.fail(csv.header.number, "header: no channels after 't' (expected e.g. t,f@7:uy,x@7:uy)");
   std::vector<std::string> columns{"t"};
   std::map<std::string, std::size_t> seen;
   for (std::size_t c = 1; c < names.size(); ++c) {
@@ -159,43 +176,50 @@ identify::Record read_record(const std::filesystem::path& path) {
     const auto [it, inserted] = seen.emplace(channel.name(), c + 1);
     if (!inserted)
       csv.fail(csv.header.number,
-               fmt::format("header: column {}: channel {} appears twice (columns {} and {})", c + 1, name, it->second, c + 1));
+               fmt::format("header: column {}: channel {} appears twice (columns {} and {})", c + 1,
+                           name, it->second, c + 1));
     record.channels.push_back(std::move(channel));
     columns.push_back(name);
   }
 
-  const auto data =
-      parse_rows(csv, columns, fmt::format("t and {} channel{}", columns.size() - 1, columns.size() == 2 ? "" : "s"));
+  const auto data = parse_rows(
+      csv, columns,
+      fmt::format("t and {} channel{}", columns.size() - 1, columns.size() == 2 ? "" : "s"));
   const std::size_t n = csv.rows.size();
-  if (n < 4) csv.fail(csv.header.number, fmt::format("only {} data row{}, expected at least 4", n, n == 1 ? "" : "s"));
+  if (n < 4)
+    csv.fail(csv.header.number,
+             fmt::format("only {} data row{}, expected at least 4", n, n == 1 ? "" : "s"));
 
   // Time: strictly increasing and uniform.
   const std::vector<double>& t = data[0];
   for (std::size_t i = 1; i < n; ++i)
     if (!(t[i] > t[i - 1]))
-      csv.fail(csv.rows[i].number, fmt::format("t = {} does not increase from the previous row's t = {} (time must "
-                                               "increase strictly)",
-                                               t[i], t[i - 1]));
+      csv.fail(csv.rows[i].number,
+               fmt::format("t = {} does not increase from the previous row's t = {} (time must "
+                           "increase strictly)",
+                           t[i], t[i - 1]));
   const double mean_step = (t[n - 1] - t[0]) / static_cast<double>(n - 1);
   for (std::size_t i = 1; i < n; ++i) {
     const double deviation = std::abs((t[i] - t[i - 1]) - mean_step) / mean_step;
     if (deviation > 1e-6)
-      csv.fail(csv.rows[i].number,
-               fmt::format("time step {} s differs from the mean step {} s by {:.3g} (relative; sampling must be "
-                           "uniform to 1e-6)",
-                           t[i] - t[i - 1], mean_step, deviation));
+      csv.fail(csv.rows[i].number, fmt::format("time step {} s differs from the mean step {} s by "
+                                               "{:.3g} (relative; sampling must be "
+                                               "uniform to 1e-6)",
+                                               t[i] - t[i - 1], mean_step, deviation));
   }
 
   record.t = Eigen::Map<const Eigen::VectorXd>(t.data(), static_cast<Eigen::Index>(n));
   for (std::size_t c = 0; c < record.channels.size(); ++c)
-    record.channels[c].samples = Eigen::Map<const Eigen::VectorXd>(data[c + 1].data(), static_cast<Eigen::Index>(n));
+    record.channels[c].samples =
+        Eigen::Map<const Eigen::VectorXd>(data[c + 1].data(), static_cast<Eigen::Index>(n));
   return record;
 }
 
 std::vector<identify::Record> read_records(const std::vector<std::filesystem::path>& paths) {
   std::vector<identify::Record> records;
   records.reserve(paths.size());
-  for (const auto& p : paths) records.push_back(read_record(p));
+  for (const auto& p : paths)
+    records.push_back(read_record(p));
   return records;
 }
 
@@ -204,8 +228,10 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
   const Eigen::Index n = record.t.size();
   for (const auto& c : record.channels) {
     if (c.samples.size() != n)
-      throw Error(fmt::format("{}: channel {} has {} samples but t has {}", name, c.name(), c.samples.size(), n));
-    if (!c.samples.allFinite()) throw Error(fmt::format("{}: channel {} has NaN or infinite values", name, c.name()));
+      throw Error(fmt::format("{}: channel {} has {} samples but t has {}", name, c.name(),
+                              c.samples.size(), n));
+    if (!c.samples.allFinite())
+      throw Error(fmt::format("{}: channel {} has NaN or infinite values", name, c.name()));
   }
   if (!record.t.allFinite()) throw Error(name + ": t has NaN or infinite values");
   if (record.excitation_hz && !std::isfinite(*record.excitation_hz))
@@ -220,19 +246,24 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
       const auto newline = rest.find('\n');
       const std::string_view line = trim(rest.substr(0, newline));
       if (line.starts_with("excitation_hz"))
-        throw Error(name + ": a comment may not start with 'excitation_hz' (it is written from the record)");
+        throw Error(
+            name +
+            ": a comment may not start with 'excitation_hz' (it is written from the record)");
       out += line.empty() ? std::string("#\n") : fmt::format("# {}\n", line);
       if (newline == std::string_view::npos) break;
       rest = rest.substr(newline + 1);
     }
   }
-  if (record.excitation_hz) fmt::format_to(inserter, "# excitation_hz = {}\n", shortest(*record.excitation_hz));
+  if (record.excitation_hz)
+    fmt::format_to(inserter, "# excitation_hz = {}\n", shortest(*record.excitation_hz));
   out += "t";
-  for (const auto& c : record.channels) out += "," + c.name();
+  for (const auto& c : record.channels)
+    fmt::format_to(inserter, ",{}", c.name());
   out += "\n";
   for (Eigen::Index i = 0; i < n; ++i) {
     fmt::format_to(inserter, "{}", record.t(i));
-    for (const auto& c : record.channels) fmt::format_to(inserter, ",{}", c.samples(i));
+    for (const auto& c : record.channels)
+      fmt::format_to(inserter, ",{}", c.samples(i));
     out += "\n";
   }
   return out;
@@ -248,16 +279,19 @@ void check_record_channels(const identify::Record& record, const fem::DofMap& do
   auto fail = [&](const std::string& what) { throw Error(record.source + ": " + what); };
   auto header = [&] {
     std::string names = "t";
-    for (const auto& c : record.channels) names += "," + c.name();
+    for (const auto& c : record.channels)
+      names += fmt::format(",{}", c.name());
     return names;
   };
   const auto forces = record.all(identify::Quantity::force);
-  if (forces.empty()) fail("no force channel (expected a column such as f@7:uy; the header is " + header() + ")");
+  if (forces.empty())
+    fail("no force channel (expected a column such as f@7:uy; the header is " + header() + ")");
   for (const identify::Channel* f : forces) {
     try {
       dofs.equation(f->at);
     } catch (const std::invalid_argument& e) {
-      fail("channel " + f->name() + ": " + e.what() + " (a force must act on a free DOF of the model)");
+      fail("channel " + f->name() + ": " + e.what() +
+           " (a force must act on a free DOF of the model)");
     }
   }
   for (const auto& j : joints) {
@@ -266,7 +300,8 @@ void check_record_channels(const identify::Record& record, const fem::DofMap& do
       const fem::NodeDof at{node, j.dof};
       if (!record.find(identify::Quantity::displacement, at))
         fail("no channel x@" + fem::to_string(at) + " for joint '" + j.name +
-             "' (identification needs the displacement at every joint DOF; the header is " + header() + ")");
+             "' (identification needs the displacement at every joint DOF; the header is " +
+             header() + ")");
     }
   }
 }
@@ -275,24 +310,28 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
   const CsvText csv = scan(path, "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im");
   const auto names = split_fields(csv.header.text);
   if (names.front() != "freq_hz")
-    csv.fail(csv.header.number,
-             fmt::format("header: the first column must be 'freq_hz' (excitation frequency in Hz), got \"{}\"",
-                         names.front()));
+    csv.fail(
+        csv.header.number,
+        fmt::format(
+            "header: the first column must be 'freq_hz' (excitation frequency in Hz), got \"{}\"",
+            names.front()));
   if (names.size() < 3 || (names.size() - 1) % 2 != 0)
-    csv.fail(csv.header.number,
-             fmt::format("header: expected freq_hz then two columns per channel (<channel>.re, <channel>.im), got {} "
-                         "column{} after freq_hz",
-                         names.size() - 1, names.size() == 2 ? "" : "s"));
+    csv.fail(csv.header.number, fmt::format("header: expected freq_hz then two columns per channel "
+                                            "(<channel>.re, <channel>.im), got {} "
+                                            "column{} after freq_hz",
+                                            names.size() - 1, names.size() == 2 ? "" : "s"));
   SteppedSineTable table;
   std::map<std::string, std::size_t> seen;
   for (std::size_t c = 1; c < names.size(); c += 2) {
     const std::string_view re = names[c], im = names[c + 1];
     if (!re.ends_with(".re"))
-      csv.fail(csv.header.number, fmt::format("header: column {}: expected <channel>.re, got \"{}\"", c + 1, re));
+      csv.fail(csv.header.number,
+               fmt::format("header: column {}: expected <channel>.re, got \"{}\"", c + 1, re));
     const std::string channel(re.substr(0, re.size() - 3));
     if (im != channel + ".im")
-      csv.fail(csv.header.number, fmt::format("header: column {}: expected \"{}.im\" after \"{}\", got \"{}\"", c + 2,
-                                              channel, re, im));
+      csv.fail(csv.header.number,
+               fmt::format("header: column {}: expected \"{}.im\" after \"{}\", got \"{}\"", c + 2,
+                           channel, re, im));
     try {
       identify::parse_channel_name(channel);
     } catch (const std::invalid_argument& e) {
@@ -301,23 +340,30 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
     const auto [it, inserted] = seen.emplace(channel, c + 1);
     if (!inserted)
       csv.fail(csv.header.number,
-               fmt::format("header: column {}: channel {} appears twice (columns {} and {})", c + 1, channel, it->second, c + 1));
+               fmt::format("header: column {}: channel {} appears twice (columns {} and {})", c + 1,
+                           channel, it->second, c + 1));
     table.channels.push_back(channel);
   }
   std::vector<std::string> columns;
-  for (auto name : names) columns.emplace_back(name);
-  const auto data = parse_rows(csv, columns, fmt::format("freq_hz and .re, .im for {} channel{}", table.channels.size(),
-                                                         table.channels.size() == 1 ? "" : "s"));
+  for (auto name : names)
+    columns.emplace_back(name);
+  const auto data =
+      parse_rows(csv, columns,
+                 fmt::format("freq_hz and .re, .im for {} channel{}", table.channels.size(),
+                             table.channels.size() == 1 ? "" : "s"));
   const std::size_t n = csv.rows.size();
   if (n == 0) csv.fail(csv.header.number, "no data rows (expected one row per test)");
   for (std::size_t i = 0; i < n; ++i)
     if (!(data[0][i] > 0.0))
-      csv.fail(csv.rows[i].number, fmt::format("column 1 (freq_hz): expected a frequency > 0 Hz, got {}", data[0][i]));
+      csv.fail(csv.rows[i].number,
+               fmt::format("column 1 (freq_hz): expected a frequency > 0 Hz, got {}", data[0][i]));
   table.freq_hz = data[0];
-  table.values.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(table.channels.size()));
+  table.values.resize(static_cast<Eigen::Index>(n),
+                      static_cast<Eigen::Index>(table.channels.size()));
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t c = 0; c < table.channels.size(); ++c)
-      table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = {data[1 + 2 * c][i], data[2 + 2 * c][i]};
+      table.values(static_cast<Eigen::Index>(i),
+                   static_cast<Eigen::Index>(c)) = {data[1 + 2 * c][i], data[2 + 2 * c][i]};
   return table;
 }
 

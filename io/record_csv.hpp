@@ -25,9 +25,11 @@ std::vector<identify::Record> read_records(const std::vector<std::filesystem::pa
 
 /// The CSV text of a record: each comment as `# ...` lines, `# excitation_hz = ...` when
 /// set, the header and the rows, every number in its shortest form that reads back
-/// bit-exactly. Throws io::Error if the channels' lengths differ from t's or a value is not
-/// finite (the reader would refuse the file).
-std::string record_csv(const identify::Record& record, const std::vector<std::string>& comments = {});
+/// bit-exactly. Throws io::Error if the channels' lengths differ from t's, a value is not
+/// finite (the reader would refuse the file) or a comment line starts with `excitation_hz`
+/// (that comment is written from Record::excitation_hz only).
+std::string record_csv(const identify::Record& record,
+                       const std::vector<std::string>& comments = {});
 /// Writes record_csv(record, comments) atomically (see write_file_atomically).
 void write_record(const std::filesystem::path& path, const identify::Record& record,
                   const std::vector<std::string>& comments = {});

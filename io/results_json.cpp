@@ -12,13 +12,18 @@ namespace {
 
 using Json = nlohmann::ordered_json; // keeps the contract's key order
 
-Json number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
+Json number(double value) {
+  return std::isfinite(value) ? Json(value) : Json(nullptr);
+}
 
-std::string text(const Json& json) { return json.dump(2) + "\n"; }
+std::string text(const Json& json) {
+  return json.dump(2) + "\n";
+}
 
 } // namespace
 
-std::string identify_result_json(const identify::FitResult& result, const std::vector<std::string>& extra) {
+std::string identify_result_json(const identify::FitResult& result,
+                                 const std::vector<std::string>& extra) {
   Json joints = Json::array();
   for (const auto& joint : result.joints) {
     Json terms = Json::array();
@@ -38,8 +43,10 @@ std::string identify_result_json(const identify::FitResult& result, const std::v
     joints.push_back(std::move(j));
   }
   Json warnings = Json::array();
-  for (const auto& w : result.warnings) warnings.push_back(w);
-  for (const auto& w : extra) warnings.push_back(w);
+  for (const auto& w : result.warnings)
+    warnings.push_back(w);
+  for (const auto& w : extra)
+    warnings.push_back(w);
 
   Json out;
   out["joints"] = std::move(joints);
@@ -66,6 +73,8 @@ std::string modes_json(const fem::Modes& modes, int count) {
   return text(out);
 }
 
-void write_json(const std::filesystem::path& path, const std::string& json) { write_file_atomically(path, json); }
+void write_json(const std::filesystem::path& path, const std::string& json) {
+  write_file_atomically(path, json);
+}
 
 } // namespace jointid::io

@@ -14,7 +14,8 @@ namespace jointid::io {
 /// "fixed"}]}], "equations", "unknowns", "condition_number", "residual_rms",
 /// "residual_relative", "warnings": [...]}. `extra` warnings are appended to the result's.
 /// NaN and infinite numbers are written as null.
-std::string identify_result_json(const identify::FitResult& result, const std::vector<std::string>& extra = {});
+std::string identify_result_json(const identify::FitResult& result,
+                                 const std::vector<std::string>& extra = {});
 
 /// {"modes": [{"mode": 1, "frequency_hz": ...}, ...]} for the first `count` modes (all when
 /// count < 0 or larger than the number of modes).

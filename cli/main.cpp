@@ -1,0 +1,93 @@
+// jointid: the command line. Only parses arguments and calls the commands; every error ends
+// here as one line on stderr and exit status 1.
+#include "cli/commands.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <iostream>
+#include <string>
+
+namespace {
+
+// Messages are printed on one line.
+std::string one_line(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!text.empty() && text.back() == ' ')
+    text.pop_back();
+  return text;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  namespace cli = jointid::cli;
+  CLI::App app{"jointid: identify non-linear joints of structures from measured responses",
+               "jointid"};
+  app.require_subcommand(1);
+
+  cli::SimulateOptions sim;
+  auto* simulate = app.add_subcommand(
+      "simulate", "Simulate sine tests of the model with its joints at their values; "
+                  "one record (CSV) per frequency x amplitude");
+  simulate->add_option("MODEL", sim.model, "Model file (TOML)")->required();
+  simulate->add_option("--force", sim.force, "NODE:DOF of the sine force, e.g. 7:uy")->required();
+  simulate->add_option("--freq", sim.frequencies, "Excitation frequencies, Hz (comma-separated)")
+      ->required()
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  simulate
+      ->add_option("--amplitude", sim.amplitudes,
+                   "Force amplitudes (peak), N or N m (comma-separated)")
+      ->required()
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  simulate
+      ->add_option("--method", sim.method,
+                   "time: Newmark integration to steady state; hb: harmonic balance")
+      ->capture_default_str();
+  simulate->add_option("--periods", sim.periods, "Periods in each record")->capture_default_str();
+  simulate
+      ->add_option("--steps-per-period", sim.steps_per_period, "Time steps (samples) per period")
+      ->capture_default_str();
+  simulate->add_option("--harmonics", sim.harmonics, "Harmonics of the harmonic balance (hb)")
+      ->capture_default_str();
+  simulate->add_option("-o,--output", sim.output_dir, "Output directory (created if missing)")
+      ->required();
+
+  cli::IdentifyOptions ident;
+  auto* identify = app.add_subcommand(
+      "identify", "Identify the joints' terms from measured records; writes JSON");
+  identify->add_option("MODEL", ident.model, "Model file (TOML)")->required();
+  identify->add_option("RECORDS", ident.records, "Measurement records (CSV)")->required();
+  identify->add_option("-o,--output", ident.output, "Result file (JSON)")->required();
+  identify
+      ->add_option("--harmonics", ident.harmonics, "Harmonics whose equations are used, e.g. 1,2,3")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->capture_default_str();
+
+  cli::ModesOptions mod;
+  auto* modes = app.add_subcommand(
+      "modes", "Natural frequencies of the linear substructure; writes DIR/modes.json");
+  modes->add_option("MODEL", mod.model, "Model file (TOML)")->required();
+  modes->add_option("-o,--output", mod.output_dir, "Output directory (created if missing)")
+      ->required();
+  modes->add_option("--count", mod.count, "Number of modes")->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+    if (simulate->parsed()) cli::simulate(sim);
+    if (identify->parsed()) cli::identify(ident);
+    if (modes->parsed()) cli::modes(mod);
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e); // --help
+    std::cerr << "jointid: " << one_line(e.what()) << " (run with --help for usage)\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "jointid: " << one_line(e.what()) << "\n";
+    return 1;
+  }
+}

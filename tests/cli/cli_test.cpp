@@ -1,0 +1,312 @@
+// Runs the built `jointid` program on the cantilever of DESIGN.md, as a user would.
+#include "io/cantilever_toml.hpp"
+#include "io/record_csv.hpp"
+#include "io/test_files.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <numbers>
+#include <sys/wait.h>
+
+namespace jointid {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Outcome {
+  int status = -1;
+  std::string out, err;
+};
+
+std::string quoted(const std::string& s) {
+  std::string q = "'";
+  for (char c : s)
+    q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs jointid with `args`, capturing stdout and stderr through files in `dir`.
+Outcome jointid(const std::vector<std::string>& args, const fs::path& dir) {
+  std::string command = quoted(JOINTID_EXE);
+  for (const auto& a : args)
+    command.append(" ").append(quoted(a));
+  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  command.append(" > ").append(quoted(out.string())).append(" 2> ").append(quoted(err.string()));
+  const int raw = std::system(command.c_str());
+  Outcome run;
+  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  run.out = test::read_text(out);
+  run.err = test::read_text(err);
+  fs::remove(out);
+  fs::remove(err);
+  return run;
+}
+
+// A failed run: non-zero status and exactly one line "jointid: ..." on stderr.
+void expect_one_line_error(const Outcome& run, const std::string& part = "") {
+  EXPECT_NE(run.status, 0);
+  EXPECT_EQ(run.err.rfind("jointid: ", 0), 0u) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  if (!part.empty()) {
+    EXPECT_NE(run.err.find(part), std::string::npos) << "'" << part << "' not in: " << run.err;
+  }
+}
+
+const std::vector<double> frequencies{3.4, 4.2, 5.0};
+constexpr double amplitude = 10.0;
+constexpr int steps_per_period = 512, periods = 4;
+
+class CliTest : public ::testing::Test {
+protected:
+  // One simulation shared by the tests of a process.
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>();
+    test::write_text(model(), test::cantilever_toml());
+    simulate_ =
+        jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3.4,4.2,5",
+                 "--amplitude", "10", "--steps-per-period", std::to_string(steps_per_period),
+                 "--periods", std::to_string(periods), "-o", records_dir().string()},
+                dir_->path());
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+
+  static fs::path model() { return *dir_ / "cantilever.toml"; }
+  static fs::path records_dir() { return *dir_ / "records"; }
+  static std::vector<std::string> record_files() {
+    return {(records_dir() / "sine_f3.4Hz_F10N.csv").string(),
+            (records_dir() / "sine_f4.2Hz_F10N.csv").string(),
+            (records_dir() / "sine_f5Hz_F10N.csv").string()};
+  }
+  static const fs::path& dir() { return dir_->path(); }
+
+  static std::unique_ptr<test::TempDir> dir_;
+  static Outcome simulate_;
+};
+std::unique_ptr<test::TempDir> CliTest::dir_;
+Outcome CliTest::simulate_;
+
+TEST_F(CliTest, EveryCommandHasHelp) {
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"--help"},
+                                               {"simulate", "--help"},
+                                               {"identify", "--help"},
+                                               {"modes", "--help"}}) {
+    const Outcome run = jointid(args, dir());
+    EXPECT_EQ(run.status, 0) << args[0];
+    EXPECT_NE(run.out.find("Usage"), std::string::npos) << run.out;
+  }
+  const Outcome top = jointid({"--help"}, dir());
+  EXPECT_NE(top.out.find("simulate"), std::string::npos);
+  EXPECT_NE(top.out.find("identify"), std::string::npos);
+  EXPECT_NE(top.out.find("modes"), std::string::npos);
+}
+
+TEST_F(CliTest, SimulateWritesReadableRecords) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const auto files = record_files();
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const double f = frequencies[i];
+    const identify::Record r = io::read_record(files[i]);
+    ASSERT_TRUE(r.excitation_hz.has_value());
+    EXPECT_EQ(*r.excitation_hz, f);
+    ASSERT_EQ(r.channels.size(), 3u);
+    EXPECT_EQ(r.channels[0].name(), "f@7:uy");
+    EXPECT_EQ(r.channels[1].name(), "x@7:uy");
+    EXPECT_EQ(r.channels[2].name(), "v@7:uy");
+    const int n = steps_per_period * periods;
+    ASSERT_EQ(r.t.size(), n);
+    EXPECT_NEAR(r.dt(), 1.0 / (f * steps_per_period), 1e-15);
+    const Eigen::VectorXd& force = r.channels[0].samples;
+    const Eigen::VectorXd& x = r.channels[1].samples;
+    const Eigen::VectorXd& v = r.channels[2].samples;
+    for (int k = 0; k < n; ++k)
+      EXPECT_NEAR(force(k), amplitude * std::sin(2.0 * std::numbers::pi * f * r.t(k)), 1e-12);
+    // A periodic steady state: each period repeats the previous one.
+    const double x_max = x.cwiseAbs().maxCoeff(), v_max = v.cwiseAbs().maxCoeff();
+    EXPECT_GT(x_max, 1e-4);
+    const int N = steps_per_period;
+    EXPECT_LT((x.tail(n - N) - x.head(n - N)).cwiseAbs().maxCoeff(), 1e-6 * x_max);
+    // v is the rate of x (central differences, O(h²)), so the columns are not mixed up.
+    const double h = r.dt();
+    double worst = 0.0;
+    for (int k = 1; k + 1 < n; ++k)
+      worst = std::max(worst, std::abs((x(k + 1) - x(k - 1)) / (2.0 * h) - v(k)));
+    EXPECT_LT(worst, 1e-3 * v_max);
+  }
+  const std::string text = test::read_text(record_files()[0]);
+  EXPECT_NE(text.find("# model: "), std::string::npos);
+  EXPECT_NE(text.find("method: time"), std::string::npos);
+}
+
+TEST_F(CliTest, HarmonicBalanceAgreesWithTimeIntegration) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path out = dir() / "hb";
+  const Outcome run = jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "4.2",
+                               "--amplitude", "10", "--method", "hb", "--steps-per-period", "512",
+                               "--periods", "4", "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const identify::Record hb = io::read_record(out / "sine_f4.2Hz_F10N.csv");
+  const identify::Record time = io::read_record(record_files()[1]);
+  ASSERT_EQ(hb.t.size(), time.t.size());
+  const Eigen::VectorXd& x_time = time.channels[1].samples;
+  const double x_max = x_time.cwiseAbs().maxCoeff();
+  EXPECT_LT((hb.channels[1].samples - x_time).cwiseAbs().maxCoeff(), 1e-3 * x_max);
+}
+
+TEST_F(CliTest, IdentifyRecoversTheJoint) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path result = dir() / "result.json";
+  std::vector<std::string> args{"identify", model().string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"-o", result.string()});
+  const Outcome run = jointid(args, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("tip"), std::string::npos) << run.out;
+  const json j = json::parse(test::read_text(result));
+  EXPECT_EQ(j["equations"], 6); // 3 records × fundamental × (re, im)
+  EXPECT_EQ(j["unknowns"], 3);
+  ASSERT_EQ(j["joints"].size(), 1u);
+  EXPECT_EQ(j["joints"][0]["name"], "tip");
+  const json& terms = j["joints"][0]["terms"];
+  ASSERT_EQ(terms.size(), 3u);
+  const std::vector<std::pair<std::string, double>> truth{
+      {"k", 4800.0}, {"c", 20.0}, {"k3", 1.6e8}};
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    EXPECT_EQ(terms[i]["term"], truth[i].first);
+    EXPECT_NEAR(terms[i]["value"].get<double>(), truth[i].second, 0.005 * truth[i].second)
+        << truth[i].first;
+  }
+}
+
+TEST_F(CliTest, ModesMatchTheCantileverTheory) {
+  const fs::path out = dir() / "modes";
+  const Outcome run =
+      jointid({"modes", model().string(), "-o", out.string(), "--count", "3"}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json j = json::parse(test::read_text(out / "modes.json"));
+  ASSERT_EQ(j["modes"].size(), 3u);
+  // Euler–Bernoulli cantilever: f_r = (β_r L)² / (2π L²) √(EI / ρA).
+  const double scale = std::sqrt(test::E * test::Iz / (test::rho * test::area)) /
+                       (2.0 * std::numbers::pi * test::length * test::length);
+  const double beta_l[] = {1.8751040687, 4.6940911330};
+  const double tolerance[] = {1e-4, 1e-3}; // 6 cubic elements: error grows with the mode number
+  for (int r = 0; r < 2; ++r) {
+    EXPECT_EQ(j["modes"][r]["mode"], r + 1);
+    const double exact = beta_l[r] * beta_l[r] * scale;
+    EXPECT_NEAR(j["modes"][r]["frequency_hz"].get<double>(), exact, tolerance[r] * exact)
+        << "mode " << r + 1;
+  }
+}
+
+TEST_F(CliTest, BadModelFailsAndKeepsTheOldResult) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path bad = dir() / "bad_model.toml";
+  const std::string text =
+      test::replaced(test::cantilever_toml(), "rho = 7850.0", "rho = 7850.0\nrhoo = 1.0");
+  test::write_text(bad, text);
+  const fs::path result = dir() / "old_result.json";
+  test::write_text(result, "{\"previous\": true}\n");
+  std::vector<std::string> args{"identify", bad.string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"-o", result.string()});
+  expect_one_line_error(jointid(args, dir()),
+                        "bad_model.toml:" + std::to_string(test::line_of(text, "rhoo")) +
+                            ": [[materials]] 'steel': "
+                            "unknown key 'rhoo'");
+  EXPECT_EQ(test::read_text(result), "{\"previous\": true}\n");
+}
+
+TEST_F(CliTest, RecordWithoutTheJointChannelFails) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  identify::Record r = io::read_record(record_files()[0]);
+  r.channels.erase(r.channels.begin() + 1); // drop x@7:uy
+  const fs::path partial = dir() / "no_x.csv";
+  io::write_record(partial, r);
+  const fs::path result = dir() / "old_result2.json";
+  test::write_text(result, "old\n");
+  std::vector<std::string> args{"identify",       model().string(),  record_files()[1],
+                                partial.string(), record_files()[2], "-o",
+                                result.string()};
+  const Outcome run = jointid(args, dir());
+  expect_one_line_error(run, "no_x.csv");
+  EXPECT_NE(run.err.find("x@7:uy"), std::string::npos) << run.err;
+  EXPECT_EQ(test::read_text(result), "old\n");
+}
+
+TEST_F(CliTest, SimulateChecksEverythingBeforeWriting) {
+  const fs::path out = dir() / "sim_out";
+  fs::create_directories(out);
+  test::write_text(out / "keep.txt", "keep\n");
+  auto files_in_out = [&] {
+    int count = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(out))
+      ++count;
+    return count;
+  };
+  // A force on a fixed DOF, on a DOF the node lacks, bad numbers, an unknown method.
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "1:uy", "--freq", "3,4",
+                                 "--amplitude", "10", "-o", out.string()},
+                                dir()),
+                        "fixed by a support");
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:ux", "--freq", "3",
+                                 "--amplitude", "10", "-o", out.string()},
+                                dir()),
+                        "7:ux");
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3,-4",
+                                 "--amplitude", "10", "-o", out.string()},
+                                dir()),
+                        "--freq");
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3",
+                                 "--amplitude", "inf", "-o", out.string()},
+                                dir()),
+                        "--amplitude");
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3",
+                                 "--amplitude", "10", "--method", "magic", "-o", out.string()},
+                                dir()),
+                        "--method");
+  EXPECT_EQ(files_in_out(), 1);
+  EXPECT_EQ(test::read_text(out / "keep.txt"), "keep\n");
+  // A missing output directory is not created when the input is bad.
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "1:uy", "--freq", "3",
+                                 "--amplitude", "10", "-o", (dir() / "never").string()},
+                                dir()));
+  EXPECT_FALSE(fs::exists(dir() / "never"));
+}
+
+TEST_F(CliTest, ModesWithABadModelKeepsTheOldFile) {
+  const fs::path out = dir() / "modes_old";
+  fs::create_directories(out);
+  test::write_text(out / "modes.json", "old\n");
+  const fs::path bad = dir() / "bad_dof.toml";
+  const std::string text = test::replaced(test::cantilever_toml(), "dof = \"uy\"", "dof = \"uw\"");
+  test::write_text(bad, text);
+  expect_one_line_error(jointid({"modes", bad.string(), "-o", out.string()}, dir()),
+                        "bad_dof.toml:" + std::to_string(test::line_of(text, "\"uw\"")) +
+                            ": [[joints]] 'tip': key 'dof'");
+  EXPECT_EQ(test::read_text(out / "modes.json"), "old\n");
+}
+
+TEST_F(CliTest, UsageErrorsAreOneLine) {
+  expect_one_line_error(jointid({}, dir()));
+  expect_one_line_error(jointid({"discover", model().string()}, dir()));
+  expect_one_line_error(jointid({"modes", model().string()}, dir()), "-o");
+  expect_one_line_error(
+      jointid({"identify", model().string(), "-o", (dir() / "r.json").string()}, dir()));
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "three",
+                                 "--amplitude", "10", "-o", (dir() / "x").string()},
+                                dir()));
+  expect_one_line_error(
+      jointid({"modes", (dir() / "missing.toml").string(), "-o", (dir() / "m").string()}, dir()),
+      "missing.toml");
+}
+
+} // namespace
+} // namespace jointid

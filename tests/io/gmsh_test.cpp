@@ -1,0 +1,152 @@
+#include "io/gmsh.hpp"
+
+#include "io/files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace jointid;
+
+namespace {
+
+std::filesystem::path write_temp(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / "jointid_gmsh_test";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// An L-shaped frame: column 1–2–3 (group "column"), beam 3–4 (group "beam"), base point 1
+// ("base"), tip point 4 ("tip"). The same mesh in both formats.
+const char* msh22 = R"($MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+4
+0 10 "base"
+0 11 "tip"
+1 20 "column"
+1 21 "beam"
+$EndPhysicalNames
+$Nodes
+4
+1 0 0 0
+2 0 1.5 0
+3 0 3 0
+4 2 3 0
+$EndNodes
+$Elements
+5
+1 15 2 10 1 1
+2 15 2 11 2 4
+3 1 2 20 1 1 2
+4 1 2 20 1 2 3
+5 1 2 21 2 3 4
+$EndElements
+)";
+
+const char* msh41 = R"($MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+4
+0 10 "base"
+0 11 "tip"
+1 20 "column"
+1 21 "beam"
+$EndPhysicalNames
+$Entities
+2 2 0 0
+1 0 0 0 1 10
+2 2 3 0 1 11
+1 0 0 0 0 3 0 1 20 2 1 -3
+2 0 3 0 2 3 0 1 21 2 3 -2
+$EndEntities
+$Nodes
+4 4 1 4
+0 1 0 1
+1
+0 0 0
+0 2 0 1
+4
+2 3 0
+1 1 0 2
+2
+3
+0 1.5 0
+0 3 0
+1 2 0 0
+$EndNodes
+$Elements
+4 5 1 5
+0 1 15 1
+1 1
+0 2 15 1
+2 4
+1 1 1 2
+3 1 2
+4 2 3
+1 2 1 1
+5 3 4
+$EndElements
+)";
+
+void expect_l_frame(const io::GmshMesh& m) {
+  ASSERT_EQ(m.nodes.size(), 4u);
+  ASSERT_EQ(m.lines.size(), 3u);
+  EXPECT_EQ(m.elements_in("column"), (std::vector<int>{3, 4}));
+  EXPECT_EQ(m.elements_in("beam"), (std::vector<int>{5}));
+  EXPECT_EQ(m.nodes_in("base"), (std::vector<int>{1}));
+  EXPECT_EQ(m.nodes_in("tip"), (std::vector<int>{4}));
+  EXPECT_EQ(m.nodes_in("column"), (std::vector<int>{1, 2, 3})); // a line group as a node set
+  for (const auto& n : m.nodes) {
+    if (n.id == 2) {
+      EXPECT_DOUBLE_EQ(n.x.y(), 1.5);
+    }
+  }
+}
+
+void expect_error(const std::string& text, const std::string& fragment, const std::string& line) {
+  const auto path = write_temp("bad.msh", text);
+  try {
+    io::read_gmsh(path);
+    FAIL() << "accepted a mesh that should fail with: " << fragment;
+  } catch (const io::Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path.string() + ":" + line), std::string::npos) << what;
+    EXPECT_NE(what.find(fragment), std::string::npos) << what;
+  }
+}
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+} // namespace
+
+TEST(Gmsh, ReadsFormat22) { expect_l_frame(io::read_gmsh(write_temp("l22.msh", msh22))); }
+
+TEST(Gmsh, ReadsFormat41WithEntityPhysicalGroups) { expect_l_frame(io::read_gmsh(write_temp("l41.msh", msh41))); }
+
+TEST(Gmsh, UnknownGroupIsAnError) {
+  const io::GmshMesh m = io::read_gmsh(write_temp("l22.msh", msh22));
+  EXPECT_THROW(m.elements_in("roof"), io::Error);
+  EXPECT_THROW(m.nodes_in("roof"), io::Error);
+}
+
+TEST(Gmsh, ErrorsNameFileLineAndProblem) {
+  // Element 5 stands on line 24 of the file, node 4 on line 16.
+  expect_error(replace(msh22, "5 1 2 21 2 3 4", "5 2 2 21 2 2 3 4"), "triangle", "24");
+  expect_error(replace(msh22, "5 1 2 21 2 3 4", "5 8 2 21 2 3 4 2"), "second-order", "24");
+  expect_error(replace(msh22, "5 1 2 21 2 3 4", "5 1 2 21 2 3 9"), "node 9", "24");
+  expect_error(replace(msh22, "5 1 2 21 2 3 4", "4 1 2 21 2 3 4"), "duplicate element 4", "24");
+  expect_error(replace(msh22, "4 2 3 0", "3 2 3 0"), "duplicate node 3", "16");
+  expect_error(replace(msh22, "4 2 3 0", "4 0 3 0"), "zero length", "24");
+  expect_error(replace(msh22, "2.2 0 8", "3.0 0 8"), "unsupported .msh format 3.0", "2");
+  expect_error(replace(msh22, "2.2 0 8", "2.2 1 8"), "binary", "2");
+}

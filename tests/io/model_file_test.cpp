@@ -1,0 +1,401 @@
+#include "io/model_file.hpp"
+
+#include "io/cantilever_toml.hpp"
+#include "io/files.hpp"
+#include "io/test_files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace jointid::io {
+namespace {
+
+using fem::Dof;
+
+using test::cantilever_toml;
+using test::length;
+
+class ModelFileTest : public ::testing::Test {
+protected:
+  std::filesystem::path write(const std::string& text) {
+    const auto path = dir / "cantilever.toml";
+    test::write_text(path, text);
+    return path;
+  }
+  // Expects read_model to fail with a message naming the file, `line` and every one of `parts`.
+  void expect_error(const std::string& text, int line, std::initializer_list<std::string> parts) {
+    ASSERT_GT(line, 0) << "bad test: line not found";
+    const auto path = write(text);
+    try {
+      read_model(path);
+      FAIL() << "expected io::Error";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("cantilever.toml:" + std::to_string(line) + ":"), std::string::npos)
+          << message;
+      for (const auto& p : parts)
+        EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' not in: " << message;
+    }
+  }
+  test::TempDir dir;
+};
+
+TEST_F(ModelFileTest, ReadsTheCantilever) {
+  const auto path = write(cantilever_toml());
+  const ModelFile file = read_model(path);
+  const fem::Model& m = file.model;
+  EXPECT_EQ(file.path, path);
+  EXPECT_EQ(m.dimension, 2);
+  ASSERT_EQ(m.nodes.size(), 7u);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_EQ(m.nodes[i].id, i + 1);
+    EXPECT_DOUBLE_EQ(m.nodes[i].x.x(), length * i / 6.0);
+    EXPECT_EQ(m.nodes[i].x.y(), 0.0);
+    EXPECT_EQ(m.nodes[i].x.z(), 0.0);
+  }
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_EQ(m.materials[0].name, "steel");
+  EXPECT_EQ(m.materials[0].E, 210e9);
+  EXPECT_EQ(m.materials[0].rho, 7850.0);
+  EXPECT_EQ(m.materials[0].nu, 0.3);
+  ASSERT_EQ(m.sections.size(), 1u);
+  EXPECT_DOUBLE_EQ(m.sections[0].A, 0.0036);
+  EXPECT_DOUBLE_EQ(m.sections[0].Iz, 0.25 * std::pow(0.0144, 3) / 12.0);
+  ASSERT_EQ(m.elements.size(), 6u);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(m.elements[i].id, i + 1);
+    EXPECT_EQ(m.elements[i].node_a, i + 1);
+    EXPECT_EQ(m.elements[i].node_b, i + 2);
+    EXPECT_EQ(m.elements[i].type, fem::ElementType::beam);
+    EXPECT_EQ(m.elements[i].material, 0);
+    EXPECT_EQ(m.elements[i].section, 0);
+  }
+  ASSERT_EQ(m.supports.size(), 1u);
+  EXPECT_EQ(m.supports[0].node, 1);
+  EXPECT_EQ(m.supports[0].fixed, (std::vector<Dof>{Dof::ux, Dof::uy, Dof::rz}));
+  EXPECT_TRUE(m.masses.empty());
+  EXPECT_TRUE(m.springs.empty());
+  EXPECT_EQ(m.damping.kind, fem::Damping::Kind::modal);
+  EXPECT_EQ(m.damping.modal_ratio, 0.01);
+  EXPECT_FALSE(m.mass_options.lumped);
+
+  ASSERT_EQ(file.joints.size(), 1u);
+  const joints::Joint& j = file.joints[0];
+  EXPECT_EQ(j.name, "tip");
+  EXPECT_EQ(j.node, 7);
+  EXPECT_TRUE(j.to_ground());
+  EXPECT_EQ(j.dof, Dof::uy);
+  EXPECT_EQ(j.terms,
+            (std::vector<joints::Term>{joints::Term::k, joints::Term::c, joints::Term::k3}));
+  EXPECT_EQ(j.values, (std::vector<double>{4800.0, 20.0, 1.6e8}));
+  EXPECT_EQ(j.fixed, (std::vector<bool>{false, false, false}));
+}
+
+TEST_F(ModelFileTest, ReadsOptionalItemsAndExtensions) {
+  std::string text = cantilever_toml();
+  text = test::replaced(text, "modal = 0.01", "rayleigh = [0.5, 1e-4]");
+  text = test::replaced(text, "values = { k = 4800.0, c = 20.0, k3 = 1.6e8 }",
+                        "values = { k = 4800.0, k3 = 1.6e8 }\nfixed = [\"k\"]");
+  text +=
+      "\n[[joints]]\nname = \"link\"\nnode = 5\nnode_b = 6\ndof = \"rz\"\nterms = [\"k\", \"fc\"]\n"
+      "values = { fc = 2 }\n"
+      "\n[[masses]]\nnode = 7\nmass = 1.5\ninertia = [0.0, 0.0, 0.002]\n"
+      "\n[[springs]]\nnode = 4\ndof = \"uy\"\nstiffness = 1000\n"
+      "\n[[springs]]\nnode = 2\nnode_b = 3\ndof = \"rz\"\nstiffness = 50.0\n"
+      "\n[options]\nlumped_mass = true\n";
+  const ModelFile file = read_model(write(text));
+  const fem::Model& m = file.model;
+  EXPECT_EQ(m.damping.kind, fem::Damping::Kind::rayleigh);
+  EXPECT_EQ(m.damping.alpha, 0.5);
+  EXPECT_EQ(m.damping.beta, 1e-4);
+  EXPECT_TRUE(m.mass_options.lumped);
+  ASSERT_EQ(m.masses.size(), 1u);
+  EXPECT_EQ(m.masses[0].node, 7);
+  EXPECT_EQ(m.masses[0].mass, 1.5);
+  EXPECT_EQ(m.masses[0].inertia, Eigen::Vector3d(0.0, 0.0, 0.002));
+  ASSERT_EQ(m.springs.size(), 2u);
+  EXPECT_EQ(m.springs[0].node, 4);
+  EXPECT_EQ(m.springs[0].node_b, 0);
+  EXPECT_EQ(m.springs[0].dof, Dof::uy);
+  EXPECT_EQ(m.springs[0].stiffness, 1000.0);
+  EXPECT_EQ(m.springs[1].node_b, 3);
+  EXPECT_EQ(m.springs[1].dof, Dof::rz);
+
+  ASSERT_EQ(file.joints.size(), 2u);
+  const joints::Joint& tip = file.joints[0];
+  EXPECT_EQ(tip.values, (std::vector<double>{4800.0, 0.0, 1.6e8})); // c has no value: starts at 0
+  EXPECT_EQ(tip.fixed, (std::vector<bool>{true, false, false}));
+  const joints::Joint& link = file.joints[1];
+  EXPECT_EQ(link.node, 5);
+  EXPECT_EQ(link.node_b, 6);
+  EXPECT_EQ(link.dof, Dof::rz);
+  EXPECT_EQ(link.terms, (std::vector<joints::Term>{joints::Term::k, joints::Term::fc}));
+  EXPECT_EQ(link.values, (std::vector<double>{0.0, 2.0}));
+}
+
+TEST_F(ModelFileTest, ReadsASpatialFrame) {
+  const std::string text =
+      "[model]\ndimension = 3\n"
+      "[[materials]]\nname = \"al\"\nE = 70e9\nrho = 2700\nnu = 0.33\n"
+      "[[sections]]\nname = \"tube\"\nA = 1e-4\nIz = 2e-9\nIy = 3e-9\nJ = 4e-9\n"
+      "[[sections]]\nname = \"post\"\nA = 2e-4\nIz = 5e-9\n"
+      "[mesh]\nnodes = [[10, 0, 0, 0], [20, 0, 0, 1.5], [30, 1, 0, 1.5]]\n"
+      "elements = [[100, 10, 20], [200, 20, 30]]\n"
+      "[[element_sets]]\nelements = [100]\ntype = \"frame3d\"\nmaterial = \"al\"\n"
+      "section = \"tube\"\nup = [1.0, 0.0, 0.0]\n"
+      "[[element_sets]]\nelements = [200]\ntype = \"frame3d\"\nmaterial = \"al\"\n"
+      "section = \"tube\"\n"
+      "[[supports]]\nnode = 10\nfix = [\"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\"]\n";
+  const ModelFile file = read_model(write(text));
+  const fem::Model& m = file.model;
+  EXPECT_EQ(m.dimension, 3);
+  EXPECT_EQ(m.nodes[1].x, Eigen::Vector3d(0.0, 0.0, 1.5));
+  EXPECT_EQ(m.sections[0].Iy, 3e-9);
+  EXPECT_EQ(m.sections[0].J, 4e-9);
+  EXPECT_EQ(m.sections[1].Iy, 0.0); // optional
+  ASSERT_EQ(m.elements.size(), 2u);
+  EXPECT_EQ(m.elements[0].type, fem::ElementType::frame3d);
+  EXPECT_EQ(m.elements[0].up, Eigen::Vector3d(1.0, 0.0, 0.0));
+  EXPECT_EQ(m.elements[1].up, Eigen::Vector3d::UnitZ()); // default
+  EXPECT_TRUE(file.joints.empty());
+}
+
+TEST_F(ModelFileTest, UnknownKeyNamesKeyAndLine) {
+  const std::string text = test::replaced(cantilever_toml(), "nu = 0.3", "nu = 0.3\nnuu = 0.3");
+  expect_error(text, test::line_of(text, "nuu"), {"'nuu'", "[[materials]]", "unknown key"});
+}
+
+TEST_F(ModelFileTest, UnknownTableNamesKeyAndLine) {
+  const std::string text = cantilever_toml() + "\n[dampnig]\nmodal = 0.02\n";
+  expect_error(text, test::line_of(text, "[dampnig]"), {"'dampnig'", "unknown key"});
+}
+
+TEST_F(ModelFileTest, ElementOnAMissingNode) {
+  const std::string text = test::replaced(cantilever_toml(), "[6, 6, 7]]", "[6, 6, 8]]");
+  expect_error(text, test::line_of(text, "elements = [[1"),
+               {"node 8 does not exist", "key 'elements', entry 6"});
+}
+
+TEST_F(ModelFileTest, SupportOnAMissingNode) {
+  const std::string text = test::replaced(cantilever_toml(), "node = 1\n", "node = 11\n");
+  expect_error(text, test::line_of(text, "node = 11"), {"node 11 does not exist", "key 'node'"});
+}
+
+TEST_F(ModelFileTest, JointOnAFixedDof) {
+  const std::string text = test::replaced(cantilever_toml(), "node = 7\n", "node = 1\n");
+  expect_error(text, test::line_of(text, "[[joints]]"),
+               {"joint 'tip'", "1:uy", "fixed by a support"});
+}
+
+TEST_F(ModelFileTest, JointOnAnAbsentDof) {
+  // Beam elements have no ux: the joint cannot act there.
+  const std::string text = test::replaced(cantilever_toml(), "dof = \"uy\"", "dof = \"ux\"");
+  expect_error(text, test::line_of(text, "[[joints]]"), {"joint 'tip'", "has no DOF ux"});
+}
+
+TEST_F(ModelFileTest, UnknownDofName) {
+  const std::string text = test::replaced(cantilever_toml(), "dof = \"uy\"", "dof = \"uw\"");
+  expect_error(
+      text, test::line_of(text, "dof = \"uw\""),
+      {"[[joints]] 'tip'", "key 'dof'", "expected one of ux, uy, uz, rx, ry, rz", "\"uw\""});
+}
+
+TEST_F(ModelFileTest, UnknownDofNameInASupport) {
+  const std::string text = test::replaced(cantilever_toml(), "\"rz\"]", "\"rr\"]");
+  expect_error(text, test::line_of(text, "fix ="), {"[[supports]] node 1", "key 'fix'", "\"rr\""});
+}
+
+TEST_F(ModelFileTest, SupportMayNameADofTheNodeLacks) {
+  // ux is not a DOF of beam nodes: naming it is fine (DESIGN.md).
+  const ModelFile file = read_model(write(cantilever_toml()));
+  EXPECT_EQ(file.model.supports[0].fixed.front(), Dof::ux);
+}
+
+TEST_F(ModelFileTest, WrongTypeNamesExpectedType) {
+  std::string text = test::replaced(cantilever_toml(), "E = 210e9", "E = \"210e9\"");
+  expect_error(text, test::line_of(text, "E = "),
+               {"[[materials]] 'steel'", "key 'E'", "expected a number"});
+  text = test::replaced(cantilever_toml(), "dimension = 2", "dimension = 2.0");
+  expect_error(text, test::line_of(text, "dimension"),
+               {"[model]", "key 'dimension'", "expected an integer"});
+}
+
+TEST_F(ModelFileTest, MissingKeyIsNamed) {
+  const std::string text = test::replaced(cantilever_toml(), "dof = \"uy\"\n", "");
+  expect_error(text, test::line_of(text, "[[joints]]"), {"[[joints]] 'tip'", "missing key 'dof'"});
+}
+
+TEST_F(ModelFileTest, BothDampingKindsAreAnError) {
+  const std::string text =
+      test::replaced(cantilever_toml(), "modal = 0.01", "modal = 0.01\nrayleigh = [0.1, 0.0]");
+  expect_error(text, test::line_of(text, "[damping]"), {"[damping]", "not both"});
+}
+
+TEST_F(ModelFileTest, ElementsOutsideEverySetAreNamed) {
+  const std::string text =
+      test::replaced(cantilever_toml(), "elements = \"all\"", "elements = [1, 2, 3, 4]");
+  expect_error(text, test::line_of(text, "elements = [[1"),
+               {"elements 5, 6", "no [[element_sets]]"});
+}
+
+TEST_F(ModelFileTest, ElementsInTwoSetsAreNamed) {
+  const std::string second =
+      "\n[[element_sets]]\nelements = [2, 5]\ntype = \"beam\"\nmaterial = \"steel\"\n"
+      "section = \"bar\"\n";
+  const std::string text = cantilever_toml() + second;
+  expect_error(
+      text, test::line_of(text, "elements = [2, 5]"),
+      {"[[element_sets]] #2", "elements 2, 5 are already in the element set at line " +
+                                  std::to_string(test::line_of(text, "[[element_sets]]"))});
+}
+
+TEST_F(ModelFileTest, UnknownMaterialNameListsTheKnownOnes) {
+  const std::string text =
+      test::replaced(cantilever_toml(), "material = \"steel\"", "material = \"steal\"");
+  expect_error(text, test::line_of(text, "material = "),
+               {"key 'material'", "\"steel\"", "\"steal\""});
+}
+
+TEST_F(ModelFileTest, JointValuesAndFixedMustNameListedTerms) {
+  std::string text = test::replaced(cantilever_toml(), "k3 = 1.6e8 }", "k3 = 1.6e8, c2 = 1.0 }");
+  expect_error(text, test::line_of(text, "c2 = 1.0"),
+               {"key 'values.c2'", "not among the joint's terms (k, c, k3)"});
+  text = test::replaced(cantilever_toml(), "k3 = 1.6e8 }", "k3 = 1.6e8 }\nfixed = [\"c3\"]");
+  expect_error(text, test::line_of(text, "fixed ="), {"key 'fixed'", "'c3'"});
+  text = test::replaced(cantilever_toml(), "terms = [\"k\", \"c\", \"k3\"]",
+                        "terms = [\"k\", \"c\", \"k4\"]");
+  expect_error(text, test::line_of(text, "terms ="),
+               {"key 'terms'", "\"k4\"", "expected one of k, c"});
+}
+
+TEST_F(ModelFileTest, GmshFileAndInlineMeshAreExclusive) {
+  const std::string text =
+      test::replaced(cantilever_toml(), "[mesh]\n", "[mesh]\nfile = \"frame.msh\"\n");
+  expect_error(text, test::line_of(text, "frame.msh"), {"key 'file'", "not both"});
+}
+
+TEST_F(ModelFileTest, GroupNamesNeedAGmshMesh) {
+  const std::string text = test::replaced(cantilever_toml(), "elements = \"all\"", "elements = \"columns\"");
+  expect_error(text, test::line_of(text, "\"columns\""), {"key 'elements'", "Gmsh mesh"});
+}
+
+TEST_F(ModelFileTest, DuplicateNodeId) {
+  const std::string text = test::replaced(cantilever_toml(), "[2, ", "[1, ");
+  expect_error(text, test::line_of(text, "nodes ="), {"node id 1 is already used"});
+}
+
+TEST_F(ModelFileTest, InvalidPhysicalValue) {
+  const std::string text = test::replaced(cantilever_toml(), "E = 210e9", "E = -210e9");
+  expect_error(text, test::line_of(text, "E = "), {"key 'E'", "> 0 Pa"});
+}
+
+TEST_F(ModelFileTest, InclinedBeamElementIsReportedAtItsLine) {
+  // A 'beam' must run along +x; the element's geometry is checked when reading.
+  const std::string text = test::replaced(cantilever_toml(), "[7, 2, 0.0]", "[7, 2, 0.5]");
+  expect_error(text, test::line_of(text, "elements = [[1"), {"element 6", "must run along +x"});
+}
+
+TEST_F(ModelFileTest, TomlSyntaxErrorGivesLineAndColumn) {
+  const std::string text = test::replaced(cantilever_toml(), "rho = 7850.0", "rho = 7850.0 kg");
+  const auto path = write(text);
+  try {
+    read_model(path);
+    FAIL() << "expected io::Error";
+  } catch (const Error& e) {
+    const std::string expected =
+        "cantilever.toml:" + std::to_string(test::line_of(text, "rho =")) + ":";
+    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ModelFileTest, MissingFileIsNamed) {
+  try {
+    read_model(dir / "nothing.toml");
+    FAIL() << "expected io::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nothing.toml"), std::string::npos) << e.what();
+  }
+}
+
+// Gmsh meshes: the shipped portal-frame example, and errors on a copy of it.
+class GmshModelTest : public ::testing::Test {
+protected:
+  std::string portal_toml() const { return read_file(source / "portal.toml"); }
+  std::filesystem::path write(const std::string& text) {
+    std::filesystem::copy_file(source / "portal.msh", dir / "portal.msh",
+                               std::filesystem::copy_options::overwrite_existing);
+    const auto path = dir / "portal.toml";
+    test::write_text(path, text);
+    return path;
+  }
+  void expect_error(const std::string& text, int line, std::initializer_list<std::string> parts) {
+    ASSERT_GT(line, 0) << "bad test: line not found";
+    try {
+      read_model(write(text));
+      FAIL() << "expected io::Error";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("portal.toml:" + std::to_string(line) + ":"), std::string::npos) << message;
+      for (const auto& p : parts)
+        EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' not in: " << message;
+    }
+  }
+  const std::filesystem::path source = std::filesystem::path(JOINTID_SOURCE_DIR) / "examples/portal_frame";
+  test::TempDir dir;
+};
+
+TEST_F(GmshModelTest, ReadsThePortalFrame) {
+  const ModelFile file = read_model(source / "portal.toml");
+  const fem::Model& m = file.model;
+  // portal.geo: 3 m columns and a 4 m beam meshed at 0.25 m: 12 + 16 + 12 elements.
+  EXPECT_EQ(m.elements.size(), 40u);
+  EXPECT_EQ(m.nodes.size(), 41u);
+  for (const auto& e : m.elements) EXPECT_EQ(e.type, fem::ElementType::frame2d);
+  ASSERT_EQ(m.supports.size(), 2u); // "base": both feet, nodes 1 and 4 of the mesh
+  EXPECT_EQ(m.supports[0].node, 1);
+  EXPECT_EQ(m.supports[1].node, 4);
+  ASSERT_EQ(file.joints.size(), 1u);
+  EXPECT_EQ(file.joints[0].node, 2); // "corner": the top of the left column
+  EXPECT_EQ(file.joints[0].dof, Dof::ux);
+  double length = 0.0;
+  for (const auto& e : m.elements)
+    length += (m.nodes[m.node_index(e.node_b)].x - m.nodes[m.node_index(e.node_a)].x).norm();
+  EXPECT_NEAR(length, 10.0, 1e-9);
+}
+
+TEST_F(GmshModelTest, ReadsTheTableFrame) {
+  const ModelFile file = read_model(source.parent_path() / "table_frame/table.toml");
+  int legs = 0;
+  for (const auto& e : file.model.elements) {
+    EXPECT_EQ(e.type, fem::ElementType::frame3d);
+    if (e.up == Eigen::Vector3d::UnitX()) ++legs;
+  }
+  EXPECT_EQ(legs, 4 * 8); // four 0.75 m legs meshed at 0.1 m
+  EXPECT_EQ(file.model.supports.size(), 4u);
+}
+
+TEST_F(GmshModelTest, AGroupWithoutElementSetIsNamed) {
+  std::string text = portal_toml();
+  const auto begin = text.find("[[element_sets]]\nelements = \"beam\"");
+  ASSERT_NE(begin, std::string::npos);
+  text.erase(begin, text.find("[[supports]]") - begin);
+  expect_error(text, test::line_of(text, "file = "), {"in no [[element_sets]]", "'beam'"});
+}
+
+TEST_F(GmshModelTest, UnknownGroupsAndAmbiguousNodesAreErrors) {
+  const std::string roof = test::replaced(portal_toml(), "elements = \"beam\"", "elements = \"roof\"");
+  expect_error(roof, test::line_of(roof, "\"roof\""), {"key 'elements'", "'roof'"});
+  const std::string two = test::replaced(portal_toml(), "node = \"corner\"", "node = \"base\"");
+  expect_error(two, test::line_of(two, "node = \"base\""), {"key 'node'", "holds 2 nodes"});
+  const std::string missing = test::replaced(portal_toml(), "file = \"portal.msh\"", "file = \"nowhere.msh\"");
+  try {
+    read_model(write(missing));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nowhere.msh"), std::string::npos) << e.what();
+  }
+}
+
+} // namespace
+} // namespace jointid::io

@@ -1,0 +1,317 @@
+#include "io/record_csv.hpp"
+
+#include "io/files.hpp"
+#include "io/test_files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <random>
+
+namespace jointid::io {
+namespace {
+
+using identify::Quantity;
+
+bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+identify::Record sample_record() {
+  identify::Record r;
+  const int n = 64;
+  const double f = 3.4, h = 1.0 / (f * 16);
+  r.t.resize(n);
+  for (int i = 0; i < n; ++i)
+    r.t(i) = i * h;
+  r.excitation_hz = f;
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd force(n), x(n), v(n);
+  for (int i = 0; i < n; ++i) {
+    force(i) = 80.0 * std::sin(2.0 * std::numbers::pi * f * r.t(i));
+    x(i) = 1e-3 * uniform(random) / 3.0;
+    v(i) = std::exp(40.0 * uniform(random)); // spans many decades
+  }
+  // Values whose decimal forms need all 17 digits, or none, or are at the edges of double.
+  x(0) = 0.1 + 0.2;
+  x(1) = -0.0;
+  x(2) = std::numeric_limits<double>::denorm_min();
+  x(3) = std::numeric_limits<double>::max();
+  x(4) = -std::numeric_limits<double>::min();
+  x(5) = 1.0 / 3.0;
+  r.channels.push_back({Quantity::force, {7, fem::Dof::uy}, force});
+  r.channels.push_back({Quantity::displacement, {7, fem::Dof::uy}, x});
+  r.channels.push_back({Quantity::velocity, {12, fem::Dof::rz}, v});
+  return r;
+}
+
+class RecordCsvTest : public ::testing::Test {
+protected:
+  std::filesystem::path write(const std::string& text, const std::string& name = "f3.4.csv") {
+    const auto path = dir / name;
+    test::write_text(path, text);
+    return path;
+  }
+  // Expects read_record to fail naming the file, `line` and every one of `parts`.
+  void expect_error(const std::string& text, int line, std::initializer_list<std::string> parts) {
+    const auto path = write(text);
+    try {
+      read_record(path);
+      FAIL() << "expected io::Error";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      const std::string where = line > 0 ? "f3.4.csv:" + std::to_string(line) + ":" : "f3.4.csv:";
+      EXPECT_NE(message.find(where), std::string::npos) << message;
+      for (const auto& p : parts)
+        EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' not in: " << message;
+    }
+  }
+  test::TempDir dir;
+};
+
+const std::string good_csv = "# bench test, 2024\n"
+                             "# excitation_hz = 2.0\n"
+                             "t,f@7:uy,x@7:uy\n"
+                             "0.0,0.0,1e-3\n"
+                             "0.125,1.0,2e-3\n"
+                             "0.25,0.0,3e-3\n"
+                             "0.375,-1.0,4e-3\n"
+                             "0.5,0.0,5e-3\n";
+
+TEST_F(RecordCsvTest, RoundTripIsBitExact) {
+  const identify::Record r = sample_record();
+  const auto path = dir / "round.csv";
+  write_record(path, r, {"simulated", "second line\nthird line"});
+  const identify::Record back = read_record(path);
+  EXPECT_EQ(back.source, path.string());
+  ASSERT_TRUE(back.excitation_hz.has_value());
+  EXPECT_TRUE(same_bits(*back.excitation_hz, *r.excitation_hz));
+  ASSERT_EQ(back.t.size(), r.t.size());
+  for (Eigen::Index i = 0; i < r.t.size(); ++i)
+    EXPECT_TRUE(same_bits(back.t(i), r.t(i))) << i;
+  ASSERT_EQ(back.channels.size(), r.channels.size());
+  for (std::size_t c = 0; c < r.channels.size(); ++c) {
+    EXPECT_EQ(back.channels[c].name(), r.channels[c].name());
+    EXPECT_EQ(back.channels[c].quantity, r.channels[c].quantity);
+    EXPECT_EQ(back.channels[c].at, r.channels[c].at);
+    for (Eigen::Index i = 0; i < r.t.size(); ++i)
+      EXPECT_TRUE(same_bits(back.channels[c].samples(i), r.channels[c].samples(i)))
+          << r.channels[c].name() << " row " << i << ": " << back.channels[c].samples(i) << " vs "
+          << r.channels[c].samples(i);
+  }
+  // The file: comments first, one '#' line per comment line, then the header.
+  const std::string text = test::read_text(path);
+  EXPECT_EQ(text.rfind("# simulated\n# second line\n# third line\n# excitation_hz = "
+                       "3.4\nt,f@7:uy,x@7:uy,v@12:rz\n",
+                       0),
+            0u)
+      << text.substr(0, 200);
+}
+
+TEST_F(RecordCsvTest, ReadsCommentsHeaderAndRows) {
+  const identify::Record r = read_record(write(good_csv));
+  ASSERT_TRUE(r.excitation_hz.has_value());
+  EXPECT_EQ(*r.excitation_hz, 2.0);
+  ASSERT_EQ(r.channels.size(), 2u);
+  EXPECT_EQ(r.channels[0].quantity, Quantity::force);
+  EXPECT_EQ(r.channels[1].quantity, Quantity::displacement);
+  EXPECT_EQ(r.channels[1].at, (fem::NodeDof{7, fem::Dof::uy}));
+  EXPECT_EQ(r.t, (Eigen::VectorXd(5) << 0.0, 0.125, 0.25, 0.375, 0.5).finished());
+  EXPECT_EQ(r.channels[1].samples, (Eigen::VectorXd(5) << 1e-3, 2e-3, 3e-3, 4e-3, 5e-3).finished());
+  EXPECT_DOUBLE_EQ(r.dt(), 0.125);
+}
+
+TEST_F(RecordCsvTest, AcceptsWindowsLineEndsAndSpacesAndNoExcitationComment) {
+  std::string text = "# other = 1\r\n t , f@7:uy , x@7:uy\r\n";
+  for (int i = 0; i < 4; ++i)
+    text += std::to_string(i) + ".0, +1.5 ,-2e-3\r\n";
+  const identify::Record r = read_record(write(text));
+  EXPECT_FALSE(r.excitation_hz.has_value());
+  EXPECT_EQ(r.t.size(), 4);
+  EXPECT_EQ(r.channels[0].samples(3), 1.5);
+  EXPECT_EQ(r.channels[1].samples(0), -2e-3);
+}
+
+TEST_F(RecordCsvTest, MissingHeader) {
+  const std::string text = "# no header\n0.0,1.0\n0.1,2.0\n0.2,3.0\n0.3,4.0\n";
+  expect_error(text, 2, {"missing header"});
+  expect_error("# only comments\n", 0, {"missing header"});
+}
+
+TEST_F(RecordCsvTest, FirstColumnMustBeTime) {
+  expect_error(test::replaced(good_csv, "t,f@7", "time,f@7"), 3,
+               {"first column must be 't'", "\"time\""});
+}
+
+TEST_F(RecordCsvTest, UnknownAndDuplicateChannels) {
+  expect_error(test::replaced(good_csv, "x@7:uy", "y@7:uy"), 3, {"column 3", "y@7:uy"});
+  expect_error(test::replaced(good_csv, "x@7:uy", "x@7:uw"), 3, {"column 3", "uw"});
+  expect_error(test::replaced(good_csv, "f@7:uy", "x@7:uy"), 3,
+               {"x@7:uy appears twice", "columns 2 and 3"});
+}
+
+TEST_F(RecordCsvTest, RaggedRow) {
+  expect_error(test::replaced(good_csv, "0.25,0.0,3e-3", "0.25,0.0"), 6,
+               {"row has 2 fields, expected 3", "t and 2 channels"});
+  expect_error(test::replaced(good_csv, "0.25,0.0,3e-3", "0.25,0.0,3e-3,4"), 6,
+               {"row has 4 fields, expected 3"});
+}
+
+TEST_F(RecordCsvTest, NonNumericNaNAndInfinity) {
+  expect_error(test::replaced(good_csv, "0.25,0.0,3e-3", "0.25,zero,3e-3"), 6,
+               {"column 2 (f@7:uy)", "expected a number", "\"zero\""});
+  expect_error(test::replaced(good_csv, "0.25,0.0,3e-3", "0.25,0.0,nan"), 6,
+               {"column 3 (x@7:uy)", "NaN"});
+  expect_error(test::replaced(good_csv, "0.25,0.0,3e-3", "0.25,-inf,3e-3"), 6,
+               {"column 2", "infinite"});
+  expect_error(test::replaced(good_csv, "0.25,0.0,3e-3", "0.25,,3e-3"), 6,
+               {"column 2", "empty field"});
+}
+
+TEST_F(RecordCsvTest, TooFewRows) {
+  const std::string text = "t,f@7:uy,x@7:uy\n0,0,0\n1,0,0\n2,0,0\n";
+  expect_error(text, 1, {"only 3 data rows, expected at least 4"});
+}
+
+TEST_F(RecordCsvTest, TimeMustIncreaseUniformly) {
+  expect_error(test::replaced(good_csv, "0.375,", "0.25,"), 7, {"does not increase"});
+  expect_error(test::replaced(good_csv, "0.375,", "0.376,"), 7, {"time step", "uniform"});
+  // A deviation below 1e-6 of the step is accepted (printed time values are rounded).
+  EXPECT_NO_THROW(read_record(write(test::replaced(good_csv, "0.375,", "0.37500001,"))));
+}
+
+TEST_F(RecordCsvTest, CommentAfterHeader) {
+  expect_error(test::replaced(good_csv, "0.25,0.0,3e-3\n", "0.25,0.0,3e-3\n# late\n"), 7,
+               {"comment"});
+}
+
+TEST_F(RecordCsvTest, BadExcitationComment) {
+  expect_error(test::replaced(good_csv, "excitation_hz = 2.0", "excitation_hz = fast"), 2,
+               {"excitation_hz", "\"fast\""});
+  expect_error(test::replaced(good_csv, "excitation_hz = 2.0", "excitation_hz = -2"), 2,
+               {"excitation_hz"});
+}
+
+TEST_F(RecordCsvTest, ReadRecordsReadsEveryFile) {
+  const auto a = write(good_csv, "a.csv");
+  const auto b =
+      write(test::replaced(good_csv, "excitation_hz = 2.0", "excitation_hz = 4.0"), "b.csv");
+  const auto records = read_records({a, b});
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0].source, a.string());
+  EXPECT_EQ(*records[1].excitation_hz, 4.0);
+  EXPECT_THROW(read_records({a, dir / "missing.csv"}), Error);
+}
+
+TEST_F(RecordCsvTest, WriterRefusesWhatTheReaderWouldRefuse) {
+  identify::Record r = sample_record();
+  const auto path = dir / "keep.csv";
+  test::write_text(path, "previous content\n");
+  r.channels[1].samples(10) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(write_record(path, r), Error);
+  r = sample_record();
+  r.channels[2].samples.conservativeResize(10);
+  EXPECT_THROW(write_record(path, r), Error);
+  EXPECT_EQ(test::read_text(path), "previous content\n"); // untouched
+}
+
+// A model's DOF map for the channel checks: the planar cantilever's nodes 1–7, node 1 fixed.
+fem::DofMap cantilever_dofs() {
+  fem::Model m;
+  for (int i = 0; i < 7; ++i)
+    m.nodes.push_back({i + 1, Eigen::Vector3d(i / 3.0, 0.0, 0.0)});
+  m.materials.push_back({"steel", 210e9, 7850.0, 0.3});
+  m.sections.push_back({"bar", 0.0036, 6.2208e-8, 0.0, 0.0});
+  for (int i = 0; i < 6; ++i) {
+    fem::Element e;
+    e.id = i + 1;
+    e.node_a = i + 1;
+    e.node_b = i + 2;
+    m.elements.push_back(e);
+  }
+  m.supports.push_back({1, {fem::Dof::ux, fem::Dof::uy, fem::Dof::rz}});
+  return fem::DofMap(m);
+}
+
+joints::Joint tip_joint() {
+  joints::Joint j;
+  j.name = "tip";
+  j.node = 7;
+  j.dof = fem::Dof::uy;
+  j.terms = {joints::Term::k};
+  j.values = {4800.0};
+  j.fixed = {false};
+  return j;
+}
+
+TEST_F(RecordCsvTest, MissingJointChannelAtIdentify) {
+  const fem::DofMap dofs = cantilever_dofs();
+  const auto path = write(test::replaced(good_csv, "x@7:uy", "x@6:uy"));
+  const identify::Record r = read_record(path);
+  try {
+    check_record_channels(r, dofs, {tip_joint()});
+    FAIL() << "expected io::Error";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("f3.4.csv"), std::string::npos) << message;
+    EXPECT_NE(message.find("x@7:uy"), std::string::npos) << message;
+    EXPECT_NE(message.find("'tip'"), std::string::npos) << message;
+  }
+  EXPECT_NO_THROW(check_record_channels(read_record(write(good_csv)), dofs, {tip_joint()}));
+}
+
+TEST_F(RecordCsvTest, ForceChannelMustActOnAFreeDof) {
+  const fem::DofMap dofs = cantilever_dofs();
+  const identify::Record r = read_record(write(test::replaced(good_csv, "f@7:uy", "f@1:uy")));
+  try {
+    check_record_channels(r, dofs, {tip_joint()});
+    FAIL() << "expected io::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("f@1:uy"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fixed"), std::string::npos) << e.what();
+  }
+}
+
+const std::string table_csv = "# stepped sine, 2 tests\n"
+                              "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im\n"
+                              "3.0,0.0,-10.0,1e-3,-2e-3\n"
+                              "3.5,0.0,-10.0,-4e-3,-5e-4\n";
+
+TEST_F(RecordCsvTest, ReadsASteppedSineTable) {
+  const SteppedSineTable t = read_stepped_sine(write(table_csv, "table.csv"));
+  EXPECT_EQ(t.freq_hz, (std::vector<double>{3.0, 3.5}));
+  EXPECT_EQ(t.channels, (std::vector<std::string>{"f@7:uy", "x@7:uy"}));
+  ASSERT_EQ(t.values.rows(), 2);
+  ASSERT_EQ(t.values.cols(), 2);
+  EXPECT_EQ(t.values(0, 0), std::complex<double>(0.0, -10.0));
+  EXPECT_EQ(t.values(1, 1), std::complex<double>(-4e-3, -5e-4));
+}
+
+TEST_F(RecordCsvTest, SteppedSineTableErrors) {
+  auto expect_table_error = [&](const std::string& text, int line, const std::string& part) {
+    try {
+      read_stepped_sine(write(text, "table.csv"));
+      FAIL() << "expected io::Error for " << part;
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("table.csv:" + std::to_string(line) + ":"), std::string::npos)
+          << message;
+      EXPECT_NE(message.find(part), std::string::npos) << message;
+    }
+  };
+  expect_table_error(test::replaced(table_csv, "x@7:uy.im", "x@7:uy.imag"), 2,
+                     "expected \"x@7:uy.im\"");
+  expect_table_error(test::replaced(table_csv, "freq_hz,", "f,"), 2, "'freq_hz'");
+  expect_table_error(test::replaced(table_csv, "3.5,0.0,", "3.5,"), 4,
+                     "row has 4 fields, expected 5");
+  expect_table_error(test::replaced(table_csv, "3.5,", "-3.5,"), 4, "> 0 Hz");
+  expect_table_error(test::replaced(table_csv, "-4e-3", "inf"), 4, "infinite");
+}
+
+} // namespace
+} // namespace jointid::io
