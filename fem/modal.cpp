@@ -1,5 +1,6 @@
 #include "fem/modal.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Spectra/MatOp/SparseSymMatProd.h>
@@ -22,10 +23,16 @@ double to_omega(double lambda) { return std::sqrt(std::max(lambda, 0.0)); }
 
 Modes dense_modes(const Assembled& s, const ModalOptions& o) {
   const Eigen::MatrixXd K(s.K), M(s.M);
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(K, M);
   Modes out;
-  if (solver.info() != Eigen::Success) {
+  // Eigen's generalised solver factorises M without checking the factorisation (3.4), so a
+  // massless DOF would come back as "success" with an infinite frequency: check M first.
+  if (Eigen::LLT<Eigen::MatrixXd>(M).info() != Eigen::Success) {
     out.status = ModalStatus::numerical_issue; // M not positive definite
+    return out;
+  }
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(K, M);
+  if (solver.info() != Eigen::Success) {
+    out.status = ModalStatus::numerical_issue;
     return out;
   }
   const Eigen::VectorXd& lambda = solver.eigenvalues();

@@ -32,8 +32,12 @@ ZeroModes zero_modes(const Model& model, const Assembled& system, const Modes& m
   z.rigid_expected = z.supported ? 0 : model.dimension == 3 ? 6 : (planar_beam_only && any_element) ? 2 : 3;
   z.mechanism = z.count > z.rigid_expected;
   if (z.mechanism) {
+    // Rank DOFs by their share of the mode's kinetic energy |φ_i (Mφ)_i|: comparing |φ_i|
+    // directly would weigh radians against metres.
+    const Eigen::VectorXd phi = modes.phi.col(z.rigid_expected);
+    const Eigen::VectorXd Mphi = system.M * phi;
     Eigen::Index worst = 0;
-    modes.phi.col(z.rigid_expected).cwiseAbs().maxCoeff(&worst);
+    phi.cwiseProduct(Mphi).cwiseAbs().maxCoeff(&worst);
     z.largest_motion = system.dofs.node_dof(static_cast<int>(worst));
   }
   return z;

@@ -17,8 +17,13 @@ ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& m
   phi_.resize(d, m);
   for (int i = 0; i < d; ++i) phi_.row(i) = modes.phi.row(dofs_[i]);
   omega_ = modes.omega;
-  zeta_.resize(m);
-  for (int r = 0; r < m; ++r) zeta_(r) = damping.ratio(omega_(r));
+  // Rayleigh damping gives 2 ζ_r ω_r = α + β ω_r² directly; going through ζ_r = α/2ω_r + βω_r/2
+  // would lose α for a rigid mode whose computed ω_r is exactly 0.
+  modal_damping_.resize(m);
+  for (int r = 0; r < m; ++r)
+    modal_damping_(r) = damping.kind == fem::Damping::Kind::rayleigh
+                            ? damping.alpha + damping.beta * omega_(r) * omega_(r)
+                            : 2.0 * damping.ratio(omega_(r)) * omega_(r);
   residual_ = Eigen::MatrixXd::Zero(d, d);
   const bool rigid = m > 0 && omega_(0) < 1e-6 * std::max(1.0, omega_(m - 1));
   if (options.residual_flexibility && !rigid && d > 0) {
@@ -47,7 +52,7 @@ CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows, std:
   const int m = static_cast<int>(omega_.size());
   CVector modal(m);
   for (int r = 0; r < m; ++r)
-    modal(r) = 1.0 / Complex(omega_(r) * omega_(r) - omega * omega, 2.0 * zeta_(r) * omega_(r) * omega);
+    modal(r) = 1.0 / Complex(omega_(r) * omega_(r) - omega * omega, modal_damping_(r) * omega);
   CMatrix H(rows.size(), cols.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const int pi = position(rows[i]);

@@ -50,7 +50,8 @@ private:
   int position(int equation) const;
   std::vector<int> dofs_;
   Eigen::MatrixXd phi_; ///< |dofs| × n_modes
-  Eigen::VectorXd omega_, zeta_;
+  Eigen::VectorXd omega_;
+  Eigen::VectorXd modal_damping_; ///< 2 ζ_r ω_r, 1/s (finite for rigid modes under αM damping)
   Eigen::MatrixXd residual_; ///< |dofs| × |dofs|
   bool has_residual_ = false;
 };

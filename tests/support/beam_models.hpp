@@ -12,10 +12,10 @@ namespace jointid::test {
 
 /// Uniform beam properties (SI).
 struct BeamProperties {
-  double E = 210e9;     ///< Pa
-  double rho = 7850.0;  ///< kg/m^3
-  double length = 2.0;  ///< m
-  double width = 0.25;  ///< m
+  double E = 210e9;             ///< Pa
+  double rho = 7850.0;          ///< kg/m^3
+  double length = 2.0;          ///< m
+  double width = 0.25;          ///< m
   double thickness = 0.0143623; ///< m (paper cantilever: first mode 3.0 Hz)
   double A() const { return width * thickness; }
   double I() const { return width * thickness * thickness * thickness / 12.0; }
@@ -32,7 +32,8 @@ inline fem::Model uniform_beam(int elements, const BeamProperties& p = {},
   m.sections.push_back({"strip", p.A(), p.I(), 0.0, 0.0});
   for (int i = 0; i <= elements; ++i)
     m.nodes.push_back({i + 1, Eigen::Vector3d(p.length * i / elements, 0.0, 0.0)});
-  for (int i = 0; i < elements; ++i) m.elements.push_back({i + 1, i + 1, i + 2, type, 0, 0});
+  for (int i = 0; i < elements; ++i)
+    m.elements.push_back({i + 1, i + 1, i + 2, type, 0, 0});
   return m;
 }
 
@@ -56,7 +57,8 @@ inline fem::Model oscillator(double mass, double stiffness) {
 
 inline std::vector<int> all_equations(const fem::Assembled& s) {
   std::vector<int> out(s.dofs.num_equations());
-  for (int i = 0; i < s.dofs.num_equations(); ++i) out[i] = i;
+  for (int i = 0; i < s.dofs.num_equations(); ++i)
+    out[i] = i;
   return out;
 }
 

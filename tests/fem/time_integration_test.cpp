@@ -1,0 +1,266 @@
+// Newmark time integration: linear steady state against the exact receptance, dry friction
+// against the analytic Coulomb oscillator, local (joint) forces against the same springs and
+// dampers placed in the linear model.
+#include "fem/time_integration.hpp"
+
+#include "fem/damping.hpp"
+#include "joints/joint.hpp"
+#include "support/beam_models.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+using namespace jointid;
+using fem::Dof;
+using Complex = std::complex<double>;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+constexpr double eps = std::numeric_limits<double>::epsilon();
+
+// Complex amplitude X of x(t) = Re(X e^{iωt}) by a DFT over whole periods (exact for a
+// periodic signal sampled uniformly with no aliasing at the fundamental).
+Complex fundamental(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double omega) {
+  Complex sum = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    sum += x(i) * std::polar(1.0, -omega * t(i));
+  return 2.0 / static_cast<double>(x.size()) * sum;
+}
+
+joints::Joint joint(std::string name, int node, int node_b, Dof dof,
+                    std::vector<joints::Term> terms, std::vector<double> values) {
+  joints::Joint j{std::move(name), node, node_b, dof, std::move(terms), std::move(values), {}};
+  j.fixed.assign(j.terms.size(), true);
+  return j;
+}
+
+} // namespace
+
+TEST(Newmark, LinearOscillatorSteadyStateMatchesTheReceptance) {
+  // m ẍ + c ẋ + k x = F0 sin ωt: X = −i F0 H(ω), H = 1/(k − mω² + icω). The average
+  // acceleration rule is the trapezoidal rule, whose steady state is exactly H at the warped
+  // frequency ω' = (2/h) tan(ωh/2) = ω (1 + (ωh)²/12 + …) — the period error. So
+  //  (1) X equals −i F0 H(ω') to the steady-state convergence (≈1e-10, 1e-8 asserted);
+  //  (2) |X| and arg X differ from the exact H(ω) by ≈ ω|H'/H| (ωh)²/12, the period error
+  //      amplified near resonance; asserted with a factor 2 and checked to be non-trivial.
+  const double m = 2.0, k = 800.0, zeta = 0.05, F0 = 3.0;
+  const double wn = std::sqrt(k / m), c = 2 * zeta * std::sqrt(k * m);
+  const fem::Assembled s = fem::assemble(test::oscillator(m, k));
+  fem::Damping d;
+  d.kind = fem::Damping::Kind::rayleigh;
+  d.alpha = c / m; // C = αM = c
+  const fem::SparseMatrix C = fem::damping_matrix(s, d);
+  fem::SteadyStateOptions o;
+  o.steps_per_period = 64; // coarse on purpose: the period error (ωh)²/12 ≈ 8e-4 is visible
+  o.output_periods = 2;
+  const std::vector<int> out{0};
+  for (double ratio : {0.5, 0.98, 2.0}) {
+    const double w = ratio * wn, h = 2 * pi / w / o.steps_per_period;
+    const fem::SteadyState ss = fem::steady_state(s, C, nullptr, {0, F0, w / (2 * pi)}, out, o);
+    ASSERT_EQ(ss.status, fem::SteadyStateStatus::converged) << ratio;
+    ASSERT_EQ(ss.u.rows(), o.output_periods * o.steps_per_period);
+    const Complex X = fundamental(ss.u.col(0), ss.t, w);
+    auto H = [&](double omega) { return 1.0 / Complex(k - m * omega * omega, c * omega); };
+    const Complex exact = Complex(0.0, -F0) * H(w);
+    const double w_warped = 2.0 / h * std::tan(w * h / 2.0);
+    const Complex trapezoidal = Complex(0.0, -F0) * H(w_warped);
+    EXPECT_LE(std::abs(X - trapezoidal), 1e-8 * std::abs(trapezoidal)) << ratio;
+
+    const Complex dH = -H(w) * H(w) * Complex(-2 * m * w, c); // dH/dω
+    const double predicted = w * std::abs(dH / H(w)) * std::pow(w * h, 2) / 12.0;
+    const double tol = 2.0 * predicted;
+    EXPECT_NEAR(std::abs(X), std::abs(exact), tol * std::abs(exact)) << ratio;
+    EXPECT_NEAR(std::arg(X / exact), 0.0, tol) << ratio;
+    // ... and the error really is the period error (first order in (ωh)², so > half of it).
+    EXPECT_GT(std::abs(X / exact - 1.0), 0.5 * predicted) << ratio;
+    // The sampled force is F0 sin ωt on the same time grid.
+    EXPECT_NEAR(ss.force(5), F0 * std::sin(w * ss.t(5)), 1e-12 * F0);
+  }
+}
+
+TEST(Newmark, SteadyStateReportsNotPeriodicWhenMaxPeriodsIsTooSmall) {
+  // ζ = 0.001: the transient decays by e^{-2πζ} ≈ 0.994 per period, nowhere near 1e-10 in
+  // 5 periods.
+  const double m = 1.0, k = 100.0;
+  const fem::Assembled s = fem::assemble(test::oscillator(m, k));
+  fem::Damping d;
+  d.kind = fem::Damping::Kind::rayleigh;
+  d.alpha = 2 * 0.001 * std::sqrt(k / m);
+  const fem::SparseMatrix C = fem::damping_matrix(s, d);
+  fem::SteadyStateOptions o;
+  o.steps_per_period = 32;
+  o.output_periods = 1;
+  o.max_periods = 5;
+  const std::vector<int> out{0};
+  const fem::SteadyState ss = fem::steady_state(s, C, nullptr, {0, 1.0, 1.3}, out, o);
+  EXPECT_EQ(ss.status, fem::SteadyStateStatus::not_periodic);
+  EXPECT_EQ(ss.periods_run, 5);
+  EXPECT_GT(ss.period_change, o.tolerance);
+  o.max_periods = 2; // fewer than output_periods + 2
+  EXPECT_THROW(fem::steady_state(s, C, nullptr, {0, 1.0, 1.3}, out, o), std::invalid_argument);
+}
+
+namespace {
+
+// Single-DOF oscillator with a Coulomb joint to ground, stepped by hand.
+struct CoulombOscillator {
+  double m = 1.0, k = 400.0, F = 2.0;
+  fem::Assembled system = fem::assemble(test::oscillator(m, k));
+  fem::SparseMatrix C = fem::SparseMatrix(1, 1); // no viscous damping
+  joints::JointForces friction{{joint("dry", 1, 0, Dof::ux, {joints::Term::fc}, {F})}, system.dofs};
+  double omega() const { return std::sqrt(k / m); }
+};
+
+} // namespace
+
+TEST(Newmark, CoulombFreeDecayLosesFourFOverKPerCycleAndSticksInTheBand) {
+  // Released from x0 at rest: half-cycles of the linear oscillator about ±F/k, so the extreme
+  // values are x_n = (−1)ⁿ (x0 − 2nF/k) (4F/k per full cycle) until the first |x_n| ≤ F/k,
+  // where the spring cannot overcome friction and the mass sticks for good. x0 is chosen so
+  // that the final x_10 = x0 − 20F/k = 1.3 mm lies well inside the band |x| ≤ 5 mm.
+  // Tolerance: between reversals the trapezoidal rule conserves the oscillator's energy exactly,
+  // so the errors come from sampling the peaks (≤ A(ωh)²/8) and from the reversal steps (the
+  // friction switches within a step where ẋ = O(h)): O(h²) overall; x0·(ωh)² is a safe bound
+  // and still far below the 2F/k = 10 mm between consecutive peaks.
+  const CoulombOscillator sys;
+  const double x0 = 0.1013, F_k = sys.F / sys.k;
+  const int N = 200; // steps per period of the linear oscillator
+  const double h = 2 * pi / sys.omega() / N;
+  fem::Newmark integrator(sys.system, sys.C, &sys.friction, h);
+  Eigen::VectorXd u(1), v(1), f = Eigen::VectorXd::Zero(1);
+  u << x0;
+  v << 0.0;
+  integrator.set_state(u, v, f);
+  std::vector<double> x{x0};
+  for (int i = 0; i < 8 * N; ++i) {
+    ASSERT_EQ(integrator.step(f), fem::StepStatus::success) << "step " << i;
+    x.push_back(integrator.u()(0));
+  }
+  // Extremes: where the sampled x stops increasing/decreasing.
+  // Changes below 1e-12 x0 are rounding of a held position, not motion.
+  auto motion = [&](double dx) { return std::abs(dx) <= 1e-12 * x0 ? 0.0 : dx; };
+  std::vector<double> peaks{x0};
+  for (std::size_t i = 1; i + 1 < x.size(); ++i) {
+    const double before = motion(x[i] - x[i - 1]), after = motion(x[i + 1] - x[i]);
+    if (before * after < 0.0 || (before != 0.0 && after == 0.0)) peaks.push_back(x[i]);
+  }
+  const double tol = x0 * std::pow(sys.omega() * h, 2);
+  int expected_peaks = 1;
+  while (x0 - 2 * (expected_peaks - 1) * F_k > F_k)
+    ++expected_peaks;
+  ASSERT_EQ(static_cast<int>(peaks.size()), expected_peaks);
+  for (std::size_t n = 0; n < peaks.size(); ++n) {
+    const double exact = (n % 2 == 0 ? 1.0 : -1.0) * (x0 - 2.0 * n * F_k);
+    EXPECT_NEAR(peaks[n], exact, tol) << "extreme " << n;
+    if (n >= 2) {
+      EXPECT_NEAR(std::abs(peaks[n - 2]) - std::abs(peaks[n]), 4 * F_k, 2 * tol) << n;
+    }
+  }
+  // Rest at the last extreme, inside the band.
+  const int last = expected_peaks - 1;
+  EXPECT_LE(std::abs(x.back()), F_k);
+  EXPECT_NEAR(x.back(), (last % 2 == 0 ? 1.0 : -1.0) * (x0 - 2.0 * last * F_k), tol);
+}
+
+TEST(Newmark, StickPhaseIsHeld) {
+  // After the decay above, the mass sticks: ẋ = 0 to rounding (ẋ is a difference of terms of
+  // size a1·|x| ≈ (2/h)|x|), x constant up to that rounding velocity integrated over the
+  // elapsed time, and the friction force within its limit. The
+  // trapezoidal rule cannot damp the jump of ẍ at the onset of stick, so ẍ (and with it the
+  // friction force λ = −kx − mẍ) alternates step by step about equilibrium; the two-step mean
+  // of λ is the static value −kx exactly (ẍ_{n+1} = −ẍ_n while u is held).
+  const CoulombOscillator sys;
+  const double x0 = 0.1013;
+  const int N = 200;
+  const double h = 2 * pi / sys.omega() / N;
+  fem::Newmark integrator(sys.system, sys.C, &sys.friction, h);
+  Eigen::VectorXd u(1), v(1), f = Eigen::VectorXd::Zero(1);
+  u << x0;
+  v << 0.0;
+  integrator.set_state(u, v, f);
+  for (int i = 0; i < 7 * N; ++i)
+    ASSERT_EQ(integrator.step(f), fem::StepStatus::success);
+  const double x_stop = integrator.u()(0);
+  const double rounding = 64 * eps * (2.0 / h) * std::abs(x_stop);
+  double previous_force = integrator.local_force()(0);
+  for (int i = 0; i < N; ++i) {
+    ASSERT_EQ(integrator.step(f), fem::StepStatus::success);
+    EXPECT_LE(std::abs(integrator.v()(0)), rounding) << i;
+    EXPECT_NEAR(integrator.u()(0), x_stop, 4 * eps * std::abs(x_stop) + rounding * (i + 1) * h)
+        << i;
+    const double force = integrator.local_force()(0);
+    EXPECT_LE(std::abs(force), sys.F) << i;
+    EXPECT_NEAR(0.5 * (force + previous_force), -sys.k * x_stop, 1e-9 * sys.F) << i;
+    previous_force = force;
+  }
+}
+
+TEST(Newmark, ForceBelowTheFrictionLimitNeverSlips) {
+  // F0 sin ωt with F0 < F from rest: the joint sticks throughout, x ≡ 0 and the friction force
+  // carries the whole load, λ = f(t), to rounding.
+  const CoulombOscillator sys;
+  const double F0 = 0.8 * sys.F, w = 0.7 * sys.omega(), h = 2 * pi / w / 100;
+  fem::Newmark integrator(sys.system, sys.C, &sys.friction, h);
+  Eigen::VectorXd zero = Eigen::VectorXd::Zero(1), f(1);
+  integrator.set_state(zero, zero, zero);
+  for (int i = 1; i <= 300; ++i) {
+    f(0) = F0 * std::sin(w * i * h);
+    ASSERT_EQ(integrator.step(f), fem::StepStatus::success);
+    EXPECT_LE(std::abs(integrator.u()(0)), 1e-15 * F0 / sys.k) << i;
+    EXPECT_NEAR(integrator.local_force()(0), f(0), 1e-12 * sys.F) << i;
+  }
+}
+
+TEST(Newmark, JointForcesEqualTheSameSpringsInTheModel) {
+  // A linear joint is just a spring and a dashpot: integrating K + k_j, C + c_j with no local
+  // forces must give the same history as the condensed local solve. The two routes differ by
+  // the Newton tolerance (1e-13) and rounding amplified by cond(K_eff) (≈1e3) per step, carried
+  // undamped by the trapezoidal rule over 2000 steps: ≲ 2000 · 3e-13 ≈ 6e-10; 5e-9 asserted.
+  // Joint to ground at the tip and between nodes 2 and 4 (sign of B).
+  const double k_tip = 5e3, c_tip = 20.0, k_mid = 2e4;
+  fem::Model with_springs = test::cantilever(4, {});
+  with_springs.springs.push_back({5, 0, Dof::uy, k_tip});
+  with_springs.springs.push_back({2, 4, Dof::uy, k_mid});
+  const fem::Model bare = test::cantilever(4, {});
+  const fem::Assembled sa = fem::assemble(with_springs), sb = fem::assemble(bare);
+  ASSERT_EQ(sa.dofs.num_equations(), sb.dofs.num_equations());
+  const int tip = sb.dofs.equation({5, Dof::uy});
+  fem::SparseMatrix Ca(sa.dofs.num_equations(), sa.dofs.num_equations());
+  Ca.insert(tip, tip) = c_tip;
+  const fem::SparseMatrix Cb(sb.dofs.num_equations(), sb.dofs.num_equations());
+  const joints::JointForces forces(
+      {joint("tip", 5, 0, Dof::uy, {joints::Term::k, joints::Term::c}, {k_tip, c_tip}),
+       joint("mid", 2, 4, Dof::uy, {joints::Term::k}, {k_mid})},
+      sb.dofs);
+  const double h = 1e-4;
+  fem::Newmark a(sa, Ca, nullptr, h), b(sb, Cb, &forces, h);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(sa.dofs.num_equations());
+  a.set_state(zero, zero, zero);
+  b.set_state(zero, zero, zero);
+  Eigen::VectorXd f = zero;
+  for (int i = 1; i <= 2000; ++i) {
+    f(tip) = 100.0 * std::sin(2 * pi * 7.0 * i * h);
+    ASSERT_EQ(a.step(f), fem::StepStatus::success);
+    ASSERT_EQ(b.step(f), fem::StepStatus::success);
+  }
+  EXPECT_LE((a.u() - b.u()).norm(), 5e-9 * a.u().norm());
+  EXPECT_LE((a.v() - b.v()).norm(), 5e-9 * a.v().norm());
+  // The local force reported is the joints' force g = k y + c ẏ.
+  const double y_tip = b.u()(tip), v_tip = b.v()(tip);
+  EXPECT_NEAR(b.local_force()(0), k_tip * y_tip + c_tip * v_tip, 1e-9 * std::abs(k_tip * y_tip));
+  const double y_mid =
+      b.u()(sb.dofs.equation({2, Dof::uy})) - b.u()(sb.dofs.equation({4, Dof::uy}));
+  EXPECT_NEAR(b.local_force()(1), k_mid * y_mid, 1e-9 * std::abs(k_mid * y_mid));
+}
+
+TEST(Newmark, BadTimeStepThrows) {
+  const fem::Assembled s = fem::assemble(test::oscillator(1.0, 1.0));
+  const fem::SparseMatrix C(1, 1);
+  EXPECT_THROW(fem::Newmark(s, C, nullptr, 0.0), std::invalid_argument);
+}

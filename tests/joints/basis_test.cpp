@@ -1,0 +1,121 @@
+// Joint force basis functions: the METHOD.md table, derivatives against finite differences.
+#include "joints/basis.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+using namespace jointid::joints;
+
+namespace {
+
+// g(y, ẏ) written out from the METHOD.md table, independently of the library.
+double table(Term t, double y, double v) {
+  switch (t) {
+  case Term::k:
+    return y;
+  case Term::c:
+    return v;
+  case Term::k2:
+    return y * y;
+  case Term::k3:
+    return std::pow(y, 3);
+  case Term::c2:
+    return v * std::fabs(v);
+  case Term::c3:
+    return std::pow(v, 3);
+  case Term::fc:
+    return v == 0.0 ? 0.0 : std::copysign(1.0, v);
+  }
+  return NAN;
+}
+
+const std::vector<double> samples{-1.3, -0.4, -0.013, 0.002, 0.37, 1.9};
+
+std::string error_of(std::string_view name) {
+  try {
+    parse_term(name);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+} // namespace
+
+TEST(Basis, ValuesFollowTheMethodTable) {
+  for (Term t : all_terms)
+    for (double y : samples)
+      for (double v : samples)
+        EXPECT_DOUBLE_EQ(basis(t, y, v), table(t, y, v)) << term_name(t) << " " << y << " " << v;
+  // Coulomb friction is 0 at rest (the identification basis), odd in ẏ elsewhere.
+  EXPECT_EQ(basis(Term::fc, 0.3, 0.0), 0.0);
+  EXPECT_EQ(basis(Term::fc, 0.3, -1e-300), -1.0);
+}
+
+TEST(Basis, DerivativesMatchCentralDifferences) {
+  // Central differences with step δ = 1e-5 (1 + |x|): truncation δ²|g'''|/6 ≤ 1e-10 (1+|x|)²·
+  // (at most 6 for the cubics), cancellation eps|g|/δ ≈ 1e-10; 1e-7 (1 + |g'|) leaves margin
+  // while a wrong factor (e.g. 2y for 3y²) is off by order 1.
+  for (Term t : all_terms)
+    for (double y : samples)
+      for (double v : samples) {
+        const double dy = 1e-5 * (1 + std::abs(y)), dv = 1e-5 * (1 + std::abs(v));
+        const double fd_y = (basis(t, y + dy, v) - basis(t, y - dy, v)) / (2 * dy);
+        const double fd_v = (basis(t, y, v + dv) - basis(t, y, v - dv)) / (2 * dv);
+        const double gy = basis_dy(t, y, v), gv = basis_dydot(t, y, v);
+        EXPECT_NEAR(gy, fd_y, 1e-7 * (1 + std::abs(gy)))
+            << term_name(t) << " y=" << y << " v=" << v;
+        EXPECT_NEAR(gv, fd_v, 1e-7 * (1 + std::abs(gv)))
+            << term_name(t) << " y=" << y << " v=" << v;
+      }
+  // At ẏ = 0, ẏ|ẏ| is still differentiable (slope 0) and the FD agrees.
+  EXPECT_NEAR(basis_dydot(Term::c2, 0.1, 0.0), 0.0, 1e-12);
+  // The sign function's derivative is taken as 0 (set-valued friction is handled elsewhere).
+  EXPECT_EQ(basis_dydot(Term::fc, 0.1, 0.0), 0.0);
+}
+
+TEST(Basis, NamesEffectsAndUnitsFollowTheMethodTable) {
+  // Name, key words of the effect column, and the unit of b such that b·g is a force (N): g
+  // has the units of y^p ẏ^q.
+  struct Row {
+    Term term;
+    std::string name;
+    std::vector<std::string> effect_words;
+    std::string unit;
+  };
+  const std::vector<Row> rows{
+      {Term::k, "k", {"linear", "stiffness"}, "N/m"},
+      {Term::c, "c", {"viscous", "damping"}, "N s/m"},
+      {Term::k2, "k2", {"quadratic", "stiffness"}, "N/m^2"},
+      {Term::k3, "k3", {"cubic", "stiffness"}, "N/m^3"},
+      {Term::c2, "c2", {"velocity-squared", "damping"}, "N s^2/m^2"},
+      {Term::c3, "c3", {"cubic", "damping"}, "N s^3/m^3"},
+      {Term::fc, "fc", {"Coulomb", "friction"}, "N"},
+  };
+  ASSERT_EQ(rows.size(), all_terms.size());
+  for (const auto& row : rows) {
+    EXPECT_EQ(term_name(row.term), row.name);
+    EXPECT_EQ(parse_term(row.name), row.term);
+    const std::string effect(term_effect(row.term));
+    for (const auto& word : row.effect_words)
+      EXPECT_NE(effect.find(word), std::string::npos) << row.name << ": '" << effect << "'";
+    EXPECT_EQ(term_unit(row.term), row.unit) << row.name;
+    EXPECT_EQ(is_dry_friction(row.term), row.term == Term::fc);
+  }
+}
+
+TEST(Basis, ParseTermRejectsUnknownNames) {
+  for (std::string_view bad : {"k4", "", "K", "fc ", "friction"}) {
+    const std::string message = error_of(bad);
+    ASSERT_FALSE(message.empty()) << "'" << bad << "' was accepted";
+    std::string quoted(1, '\'');
+    quoted.append(bad).push_back('\'');
+    EXPECT_NE(message.find(quoted), std::string::npos) << message;
+    EXPECT_NE(message.find("k, c, k2, k3, c2, c3, fc"), std::string::npos) << message;
+  }
+}
