@@ -2,6 +2,7 @@
 
 #include "fem/assembly.hpp"
 #include "fem/damping.hpp"
+#include "fem/zero_modes.hpp"
 #include "fem/modal.hpp"
 #include "fem/time_integration.hpp"
 #include "frf/harmonic_balance.hpp"
@@ -12,6 +13,7 @@
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
 #include "io/results_json.hpp"
+#include "io/vtk_output.hpp"
 #include "joints/joint.hpp"
 
 #include <fmt/format.h>
@@ -377,15 +379,34 @@ void modes(const ModesOptions& o) {
   options.num_modes = count;
   const fem::Modes modes = fem::modal_analysis(system, options);
   if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error("modal analysis failed to converge");
-  const std::string json = io::modes_json(modes, count);
+    throw std::runtime_error(modes.status == fem::ModalStatus::not_converging
+                                 ? "modal analysis did not converge"
+                                 : "modal analysis failed: the mass matrix is not positive "
+                                   "definite (a DOF without mass?)");
+  std::vector<std::string> warnings;
+  if (const fem::ZeroModes z = fem::zero_modes(file.model, system, modes); z.count > 0)
+    warnings.push_back(z.describe());
   make_output_dir(o.output_dir);
   const fs::path out = o.output_dir / "modes.json";
-  io::write_json(out, json);
+  io::write_json(out, io::modes_json(modes, count, warnings));
+  io::write_modes_vtk(o.output_dir, file.model, system.dofs, modes);
   fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
   for (int r = 0; r < std::min(count, modes.num_modes()); ++r)
     fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
-  fmt::print("wrote {}\n", out.string());
+  fmt::print("wrote {}, {} and {} (ParaView)\n", out.string(), (o.output_dir / "modes.vtu").string(),
+             (o.output_dir / "mode_<r>.pvd").string());
+  if (o.pictures > 0) {
+    const fs::path png = o.output_dir / "modes.png";
+    const char* display = std::getenv("DISPLAY");
+    if (display && *display) {
+      io::render_modes_png(png, file.model, system.dofs, modes, std::min(o.pictures, modes.num_modes()));
+      fmt::print("wrote {}\n", png.string());
+    } else {
+      warnings.push_back("no X display: modes.png not drawn (install xvfb, or run under xvfb-run -a)");
+    }
+  }
+  for (const auto& w : warnings)
+    warn(w);
 }
 
 } // namespace jointid::cli

@@ -38,9 +38,14 @@ struct ModesOptions {
   std::filesystem::path model;
   std::filesystem::path output_dir;
   int count = 10;
+  int pictures = 4; ///< modes drawn in DIR/modes.png (0: no picture)
 };
 
-/// Writes DIR/modes.json with the lowest `count` natural frequencies.
+/// Writes DIR/modes.json with the lowest `count` natural frequencies (and warnings about
+/// rigid-body modes or mechanisms), the VTK files of the mode shapes (DIR/modes.vtu,
+/// DIR/mesh.vtu, DIR/mode_<r>.pvd animations) and DIR/modes.png with the first `pictures` modes.
+/// The picture needs an X display (main() re-runs the command under xvfb-run when there is
+/// none); without one it is skipped with a warning.
 void modes(const ModesOptions& options);
 
 } // namespace jointid::cli

@@ -4,7 +4,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include <unistd.h>
+
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
+#include <vector>
 #include <iostream>
 #include <string>
 
@@ -17,6 +22,27 @@ std::string one_line(std::string text) {
   while (!text.empty() && text.back() == ' ')
     text.pop_back();
   return text;
+}
+
+// Debian's VTK draws through GLX and needs an X server. Without a display, run this same
+// command again under `xvfb-run -a` (a virtual one), once; if that is impossible, carry on and
+// the picture is skipped with a warning.
+void rerun_with_display(char** argv) {
+  const char* display = std::getenv("DISPLAY");
+  if ((display && *display) || std::getenv("JOINTID_UNDER_XVFB")) return;
+  setenv("JOINTID_UNDER_XVFB", "1", 1);
+  std::vector<char*> args{const_cast<char*>("xvfb-run"), const_cast<char*>("-a"),
+                          const_cast<char*>("-s"), const_cast<char*>("-screen 0 1600x1200x24")};
+  static std::string self = "/proc/self/exe";
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) self = exe.string();
+  args.push_back(self.data());
+  for (char** a = argv + 1; *a; ++a)
+    args.push_back(*a);
+  args.push_back(nullptr);
+  std::cout.flush();
+  execvp("xvfb-run", args.data()); // returns only on failure (xvfb-run not installed)
 }
 
 } // namespace
@@ -75,11 +101,14 @@ int main(int argc, char** argv) {
   modes->add_option("-o,--output", mod.output_dir, "Output directory (created if missing)")
       ->required();
   modes->add_option("--count", mod.count, "Number of modes")->capture_default_str();
+  modes->add_option("--pictures", mod.pictures, "Modes drawn in DIR/modes.png (0: none)")
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);
     if (simulate->parsed()) cli::simulate(sim);
     if (identify->parsed()) cli::identify(ident);
+    if (modes->parsed() && mod.pictures > 0) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
     return 0;
   } catch (const CLI::ParseError& e) {

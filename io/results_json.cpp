@@ -59,7 +59,7 @@ std::string identify_result_json(const identify::FitResult& result,
   return text(out);
 }
 
-std::string modes_json(const fem::Modes& modes, int count) {
+std::string modes_json(const fem::Modes& modes, int count, const std::vector<std::string>& warnings) {
   const int n = count < 0 ? modes.num_modes() : std::min(count, modes.num_modes());
   Json list = Json::array();
   for (int r = 0; r < n; ++r) {
@@ -70,6 +70,7 @@ std::string modes_json(const fem::Modes& modes, int count) {
   }
   Json out;
   out["modes"] = std::move(list);
+  out["warnings"] = warnings;
   return text(out);
 }
 

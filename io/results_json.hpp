@@ -19,7 +19,8 @@ std::string identify_result_json(const identify::FitResult& result,
 
 /// {"modes": [{"mode": 1, "frequency_hz": ...}, ...]} for the first `count` modes (all when
 /// count < 0 or larger than the number of modes).
-std::string modes_json(const fem::Modes& modes, int count = -1);
+std::string modes_json(const fem::Modes& modes, int count = -1,
+                       const std::vector<std::string>& warnings = {});
 
 /// Writes JSON text atomically (see write_file_atomically).
 void write_json(const std::filesystem::path& path, const std::string& json);

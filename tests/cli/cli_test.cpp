@@ -205,6 +205,40 @@ TEST_F(CliTest, ModesMatchTheCantileverTheory) {
   }
 }
 
+TEST_F(CliTest, ModesWriteParaViewFilesAndAPicture) {
+  const fs::path out = dir() / "modes_vtk";
+  const Outcome run = jointid({"modes", model().string(), "-o", out.string(), "--count", "4"}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(fs::exists(out / "mesh.vtu"));
+  EXPECT_TRUE(fs::exists(out / "modes.vtu"));
+  EXPECT_TRUE(fs::exists(out / "mode_4.pvd"));
+  // The picture needs an X display: jointid runs itself under xvfb-run when there is none.
+  ASSERT_TRUE(fs::exists(out / "modes.png")) << run.out << run.err;
+  EXPECT_GT(fs::file_size(out / "modes.png"), 10000u);
+}
+
+TEST_F(CliTest, ModesOfAFreeStructureWarnAboutRigidBodyModes) {
+  const fs::path free = dir() / "free.toml";
+  std::string text = test::cantilever_toml();
+  const auto begin = text.find("[[supports]]");
+  ASSERT_NE(begin, std::string::npos);
+  text.erase(begin, text.find("[damping]") - begin);
+  // Without supports the joint to ground still holds the beam at one point (k = 4800 N/m)...
+  test::write_text(free, text);
+  const fs::path out = dir() / "modes_free";
+  const Outcome run = jointid({"modes", free.string(), "-o", out.string(), "--pictures", "0"}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  // ...but joints are not part of the linear substructure: a free beam has 2 rigid-body modes
+  // (uy translation, rz rotation) at 0 Hz.
+  const json j = json::parse(test::read_text(out / "modes.json"));
+  EXPECT_NEAR(j["modes"][0]["frequency_hz"].get<double>(), 0.0, 1e-3);
+  EXPECT_NEAR(j["modes"][1]["frequency_hz"].get<double>(), 0.0, 1e-3);
+  EXPECT_GT(j["modes"][2]["frequency_hz"].get<double>(), 1.0);
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_NE(j["warnings"][0].get<std::string>().find("2 rigid-body modes"), std::string::npos);
+  EXPECT_NE(run.err.find("rigid-body"), std::string::npos);
+}
+
 TEST_F(CliTest, BadModelFailsAndKeepsTheOldResult) {
   ASSERT_EQ(simulate_.status, 0) << simulate_.err;
   const fs::path bad = dir() / "bad_model.toml";
