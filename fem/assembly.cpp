@@ -13,9 +13,11 @@ Assembled assemble(const Model& model) {
   const int n = dofs.num_equations();
   if (n == 0) throw std::invalid_argument("the model has no free DOFs");
   std::vector<Eigen::Triplet<double>> k_entries, m_entries;
+  const std::unordered_map<int, int> index = model.node_positions();
 
   for (const auto& e : model.elements) {
-    const ElementMatrices em = element_matrices(model, e);
+    const ElementMatrices em =
+        element_matrices(model, e, model.nodes[index.at(e.node_a)].x, model.nodes[index.at(e.node_b)].x);
     const auto local = element_dofs(e.type);
     const int per_node = static_cast<int>(local.size());
     std::vector<int> eq(2 * per_node);

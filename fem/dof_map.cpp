@@ -15,7 +15,8 @@ DofMap::DofMap(const Model& model) {
   node_ids_.reserve(n);
   for (const auto& node : model.nodes) node_ids_.push_back(node.id);
   eq_.assign(n, {absent, absent, absent, absent, absent, absent});
-  auto use = [&](int node_id, Dof dof) { eq_[model.node_index(node_id)][static_cast<int>(dof)] = 0; };
+  index_ = model.node_positions();
+  auto use = [&](int node_id, Dof dof) { eq_[index_.at(node_id)][static_cast<int>(dof)] = 0; };
   for (const auto& e : model.elements)
     for (Dof d : element_dofs(e.type)) {
       use(e.node_a, d);
@@ -27,7 +28,7 @@ DofMap::DofMap(const Model& model) {
   }
   for (const auto& s : model.supports)
     for (Dof d : s.fixed) {
-      int& slot = eq_[model.node_index(s.node)][static_cast<int>(d)];
+      int& slot = eq_[index_.at(s.node)][static_cast<int>(d)];
       if (slot != absent) slot = fixed;
     }
   for (std::size_t i = 0; i < n; ++i)
@@ -39,9 +40,8 @@ DofMap::DofMap(const Model& model) {
 }
 
 int DofMap::index_of(int node_id) const {
-  for (std::size_t i = 0; i < node_ids_.size(); ++i)
-    if (node_ids_[i] == node_id) return static_cast<int>(i);
-  return -1;
+  const auto it = index_.find(node_id);
+  return it == index_.end() ? -1 : it->second;
 }
 
 DofMap::State DofMap::state(const NodeDof& nd) const {

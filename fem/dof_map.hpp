@@ -5,6 +5,7 @@
 #include "fem/model.hpp"
 
 #include <array>
+#include <unordered_map>
 #include <vector>
 
 namespace jointid::fem {
@@ -29,6 +30,7 @@ public:
 private:
   int index_of(int node_id) const;
   std::vector<int> node_ids_;
+  std::unordered_map<int, int> index_; // node id → position in node_ids_
   std::vector<std::array<int, 6>> eq_; // -2 absent, -1 fixed, >= 0 equation
   std::vector<NodeDof> by_equation_;
 };

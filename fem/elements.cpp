@@ -186,10 +186,13 @@ std::span<const Dof> element_dofs(ElementType type) {
 }
 
 ElementMatrices element_matrices(const Model& model, const Element& e) {
+  return element_matrices(model, e, model.nodes[model.node_index(e.node_a)].x, model.nodes[model.node_index(e.node_b)].x);
+}
+
+ElementMatrices element_matrices(const Model& model, const Element& e, const Eigen::Vector3d& xa,
+                                 const Eigen::Vector3d& xb) {
   const Material& mat = model.materials.at(e.material);
   const Section& sec = model.sections.at(e.section);
-  const Eigen::Vector3d xa = model.nodes[model.node_index(e.node_a)].x;
-  const Eigen::Vector3d xb = model.nodes[model.node_index(e.node_b)].x;
   const bool lumped = model.mass_options.lumped;
   const double rho_A = mat.rho * sec.A;
   switch (e.type) {

@@ -38,6 +38,10 @@ struct ElementMatrices {
   Eigen::MatrixXd K;
   Eigen::MatrixXd M;
 };
+/// Looks the nodes up by id (linear search; see the overload for loops).
 ElementMatrices element_matrices(const Model& model, const Element& element);
+/// Same, with the positions of node_a and node_b given.
+ElementMatrices element_matrices(const Model& model, const Element& element, const Eigen::Vector3d& xa,
+                                 const Eigen::Vector3d& xb);
 
 } // namespace jointid::fem

@@ -23,6 +23,15 @@ int Model::node_index(int id) const {
   throw std::out_of_range("node " + std::to_string(id) + " does not exist");
 }
 
+std::unordered_map<int, int> Model::node_positions() const {
+  std::unordered_map<int, int> index;
+  index.reserve(nodes.size());
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (!index.emplace(nodes[i].id, static_cast<int>(i)).second)
+      throw std::invalid_argument("duplicate node id " + std::to_string(nodes[i].id));
+  return index;
+}
+
 bool Model::has_node(int id) const {
   for (const auto& n : nodes)
     if (n.id == id) return true;
@@ -32,9 +41,8 @@ bool Model::has_node(int id) const {
 void Model::validate() const {
   auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
   if (dimension != 2 && dimension != 3) fail("dimension must be 2 or 3");
-  std::set<int> ids;
-  for (const auto& n : nodes)
-    if (!ids.insert(n.id).second) fail("duplicate node id " + std::to_string(n.id));
+  const std::unordered_map<int, int> index = node_positions(); // also rejects duplicate ids
+  const auto exists = [&](int id) { return index.count(id) > 0; };
   for (const auto& m : materials) {
     if (!(m.E > 0.0)) fail("material '" + m.name + "': E must be > 0 Pa");
     if (!(m.rho >= 0.0)) fail("material '" + m.name + "': rho must be >= 0 kg/m^3");
@@ -45,14 +53,14 @@ void Model::validate() const {
   for (const auto& e : elements) {
     const std::string which = "element " + std::to_string(e.id);
     if (!element_ids.insert(e.id).second) fail("duplicate element id " + std::to_string(e.id));
-    if (!has_node(e.node_a) || !has_node(e.node_b))
+    if (!exists(e.node_a) || !exists(e.node_b))
       fail(which + " refers to a node that does not exist");
     if (e.node_a == e.node_b) fail(which + " connects node " + std::to_string(e.node_a) + " to itself");
     if (e.material < 0 || e.material >= static_cast<int>(materials.size()))
       fail(which + " has no material");
     if (e.section < 0 || e.section >= static_cast<int>(sections.size()))
       fail(which + " has no section");
-    const double length = (nodes[node_index(e.node_b)].x - nodes[node_index(e.node_a)].x).norm();
+    const double length = (nodes[index.at(e.node_b)].x - nodes[index.at(e.node_a)].x).norm();
     if (!(length > 0.0)) fail(which + " has zero length");
     if (e.type == ElementType::frame3d) {
       const auto& s = sections[e.section];
@@ -63,14 +71,14 @@ void Model::validate() const {
       fail(which + ": frame3d element in a 2D model (set [model] dimension = 3)");
   }
   for (const auto& s : supports)
-    if (!has_node(s.node)) fail("support at node " + std::to_string(s.node) + ": no such node");
+    if (!exists(s.node)) fail("support at node " + std::to_string(s.node) + ": no such node");
   for (const auto& m : masses) {
-    if (!has_node(m.node)) fail("point mass at node " + std::to_string(m.node) + ": no such node");
+    if (!exists(m.node)) fail("point mass at node " + std::to_string(m.node) + ": no such node");
     if (!(m.mass >= 0.0) || !(m.inertia.minCoeff() >= 0.0))
       fail("point mass at node " + std::to_string(m.node) + ": mass and inertia must be >= 0");
   }
   for (const auto& s : springs) {
-    if (!has_node(s.node) || (s.node_b != 0 && !has_node(s.node_b)))
+    if (!exists(s.node) || (s.node_b != 0 && !exists(s.node_b)))
       fail("spring at node " + std::to_string(s.node) + ": no such node");
     if (!(s.stiffness >= 0.0))
       fail("spring at node " + std::to_string(s.node) + ": stiffness must be >= 0");

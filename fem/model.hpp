@@ -4,6 +4,7 @@
 #include "fem/dof.hpp"
 
 #include <map>
+#include <unordered_map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,8 +97,12 @@ struct Model {
   Damping damping;
   MassOptions mass_options;
 
-  /// Index of the node with this id in `nodes`; throws std::out_of_range naming the id.
+  /// Index of the node with this id in `nodes` (a linear search: for one-off look-ups; use
+  /// node_positions() in loops); throws std::out_of_range naming the id.
   int node_index(int id) const;
+  /// Node id → index in `nodes`, built once (O(n)); throws std::invalid_argument on a
+  /// duplicate id.
+  std::unordered_map<int, int> node_positions() const;
   bool has_node(int id) const;
   /// Checks ids, references and physical values; throws std::invalid_argument on the first
   /// problem, naming the item.

@@ -759,9 +759,11 @@ private:
     } catch (const std::invalid_argument& e) {
       file_.fail(0, e.what());
     }
+    const auto index = model().node_positions();
     for (const auto& e : model().elements) {
       try {
-        fem::element_matrices(model(), e);
+        fem::element_matrices(model(), e, model().nodes[index.at(e.node_a)].x,
+                              model().nodes[index.at(e.node_b)].x);
       } catch (const std::exception& err) {
         if (const auto it = element_origin_.find(e.id); it != element_origin_.end())
           throw Error(it->second + ": " + err.what());
