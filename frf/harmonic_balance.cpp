@@ -140,21 +140,8 @@ HarmonicBalanceResult harmonic_balance(const ModalSynthesis& H, const std::vecto
   P.joints = &joints;
   P.width = o.friction_width;
   // Joint DOFs (node and node_b) and the B matrix restricted to them.
-  std::vector<int> jdofs;
-  std::vector<std::pair<int, int>> jpos; // (position of node DOF, position of node_b DOF or -1)
-  auto add = [&](int eq) {
-    for (std::size_t i = 0; i < jdofs.size(); ++i)
-      if (jdofs[i] == eq) return static_cast<int>(i);
-    jdofs.push_back(eq);
-    return static_cast<int>(jdofs.size()) - 1;
-  };
-  for (const auto& j : joints)
-    jpos.emplace_back(add(dofs.equation({j.node, j.dof})), j.to_ground() ? -1 : add(dofs.equation({j.node_b, j.dof})));
-  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(static_cast<int>(jdofs.size()), P.nj);
-  for (int j = 0; j < P.nj; ++j) {
-    B(jpos[j].first, j) = 1.0;
-    if (jpos[j].second >= 0) B(jpos[j].second, j) = -1.0;
-  }
+  const std::vector<int> jdofs = joints::joint_dof_set(joints, dofs);
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, jdofs);
   const std::vector<int> force{force_equation};
   std::vector<CMatrix> HoB(P.K + 1);
   std::vector<CVector> HoF(P.K + 1);

@@ -51,18 +51,6 @@ Eigen::VectorXd derive_velocity(const Eigen::VectorXd& t, const Eigen::VectorXd&
 
 } // namespace
 
-std::vector<int> joint_dof_set(const std::vector<joints::Joint>& joints, const fem::DofMap& dofs) {
-  std::vector<int> set2;
-  auto add = [&](int eq) {
-    if (std::find(set2.begin(), set2.end(), eq) == set2.end()) set2.push_back(eq);
-  };
-  for (const auto& j : joints) {
-    add(dofs.equation({j.node, j.dof}));
-    if (!j.to_ground()) add(dofs.equation({j.node_b, j.dof}));
-  }
-  return set2;
-}
-
 TestSpectrum extract_spectrum(const Record& r, const fem::DofMap& dofs, const std::vector<joints::Joint>& joints,
                               int K, std::vector<std::string>& warnings, const FitOptions& options) {
   auto fail = [&](const std::string& what) { throw std::invalid_argument(r.source + ": " + what); };
@@ -129,15 +117,12 @@ TestSpectrum extract_spectrum(const Record& r, const fem::DofMap& dofs, const st
     }
   }
 
-  // Basis functions on the measured deformation y = x(node) − x(node_b).
-  for (const auto& j : joints) {
-    const auto pa = std::find(set2.begin(), set2.end(), dofs.equation({j.node, j.dof})) - set2.begin();
-    Eigen::VectorXd y = x2.col(pa), ydot = v2.col(pa);
-    if (!j.to_ground()) {
-      const auto pb = std::find(set2.begin(), set2.end(), dofs.equation({j.node_b, j.dof})) - set2.begin();
-      y -= x2.col(pb);
-      ydot -= v2.col(pb);
-    }
+  // Basis functions on the measured deformation y = x(node) − x(node_b), i.e. Y = X2 B.
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
+  const Eigen::MatrixXd Y = x2 * B, Ydot = v2 * B;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const joints::Joint& j = joints[i];
+    const Eigen::VectorXd y = Y.col(i), ydot = Ydot.col(i);
     if (j.term_index(joints::Term::fc) >= 0) {
       // While a dry-friction joint sticks (ẏ = 0) its force lies anywhere in [−fc, fc], but the
       // basis sign(ẏ) says 0: the stuck part of the record is not described by the model.
@@ -179,12 +164,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs, const std::vector<
   const int nu = static_cast<int>(unknowns.size());
   if (nu == 0) throw std::invalid_argument("identify: every joint term is fixed; nothing to identify");
   // B: set-2 position of each joint's node (+1) and node_b (−1).
-  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(n2, joints.size());
-  for (std::size_t i = 0; i < joints.size(); ++i) {
-    B(std::find(set2.begin(), set2.end(), dofs.equation({joints[i].node, joints[i].dof})) - set2.begin(), i) = 1.0;
-    if (!joints[i].to_ground())
-      B(std::find(set2.begin(), set2.end(), dofs.equation({joints[i].node_b, joints[i].dof})) - set2.begin(), i) = -1.0;
-  }
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
 
   std::vector<Eigen::RowVectorXd> rows;
   std::vector<double> rhs;

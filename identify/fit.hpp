@@ -69,7 +69,7 @@ struct TestSpectrum {
 };
 
 /// The joints' DOFs (set 2), in the order used by TestSpectrum::X2.
-std::vector<int> joint_dof_set(const std::vector<joints::Joint>& joints, const fem::DofMap& dofs);
+using joints::joint_dof_set;
 
 /// Extracts a test's harmonics: checks the channels (a force channel, x at every joint DOF;
 /// v derived from x when absent), trims to whole periods, and adds warnings (not periodic,

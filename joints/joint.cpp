@@ -1,5 +1,6 @@
 #include "joints/joint.hpp"
 
+#include <algorithm>
 #include <set>
 #include <stdexcept>
 
@@ -49,6 +50,33 @@ fem::SparseMatrix joint_coordinates(const std::vector<Joint>& joints, const fem:
   }
   fem::SparseMatrix B(dofs.num_equations(), static_cast<int>(joints.size()));
   B.setFromTriplets(entries.begin(), entries.end());
+  return B;
+}
+
+std::vector<int> joint_dof_set(const std::vector<Joint>& joints, const fem::DofMap& dofs) {
+  std::vector<int> set2;
+  auto add = [&](int eq) {
+    if (std::find(set2.begin(), set2.end(), eq) == set2.end()) set2.push_back(eq);
+  };
+  for (const auto& j : joints) {
+    add(dofs.equation({j.node, j.dof}));
+    if (!j.to_ground()) add(dofs.equation({j.node_b, j.dof}));
+  }
+  return set2;
+}
+
+Eigen::MatrixXd joint_coordinates_on(const std::vector<Joint>& joints, const fem::DofMap& dofs,
+                                     const std::vector<int>& set2) {
+  auto position = [&](int node, fem::Dof dof) {
+    const auto it = std::find(set2.begin(), set2.end(), dofs.equation({node, dof}));
+    if (it == set2.end()) throw std::invalid_argument("joint DOF " + fem::to_string({node, dof}) + " is not in set 2");
+    return static_cast<int>(it - set2.begin());
+  };
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(static_cast<int>(set2.size()), static_cast<int>(joints.size()));
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    B(position(joints[i].node, joints[i].dof), i) = 1.0;
+    if (!joints[i].to_ground()) B(position(joints[i].node_b, joints[i].dof), i) = -1.0;
+  }
   return B;
 }
 

@@ -50,4 +50,10 @@ private:
 /// B (n_eq × n_joints): +1 at a joint's node DOF, −1 at node_b's.
 fem::SparseMatrix joint_coordinates(const std::vector<Joint>& joints, const fem::DofMap& dofs);
 
+/// The joints' DOFs (set 2 of the partition), as equation numbers, each once, in joint order.
+std::vector<int> joint_dof_set(const std::vector<Joint>& joints, const fem::DofMap& dofs);
+/// B restricted to set 2 (|set2| × n_joints): y = Bᵀ x2, and the joints' forces on set 2 are −B g.
+Eigen::MatrixXd joint_coordinates_on(const std::vector<Joint>& joints, const fem::DofMap& dofs,
+                                     const std::vector<int>& set2);
+
 } // namespace jointid::joints
