@@ -2,9 +2,9 @@
 
 #include "fem/assembly.hpp"
 #include "fem/damping.hpp"
-#include "fem/zero_modes.hpp"
 #include "fem/modal.hpp"
 #include "fem/time_integration.hpp"
+#include "fem/zero_modes.hpp"
 #include "frf/harmonic_balance.hpp"
 #include "frf/receptance.hpp"
 #include "identify/fit.hpp"
@@ -393,16 +393,18 @@ void modes(const ModesOptions& o) {
   fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
   for (int r = 0; r < std::min(count, modes.num_modes()); ++r)
     fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
-  fmt::print("wrote {}, {} and {} (ParaView)\n", out.string(), (o.output_dir / "modes.vtu").string(),
-             (o.output_dir / "mode_<r>.pvd").string());
+  fmt::print("wrote {}, {} and {} (ParaView)\n", out.string(),
+             (o.output_dir / "modes.vtu").string(), (o.output_dir / "mode_<r>.pvd").string());
   if (o.pictures > 0) {
     const fs::path png = o.output_dir / "modes.png";
     const char* display = std::getenv("DISPLAY");
     if (display && *display) {
-      io::render_modes_png(png, file.model, system.dofs, modes, std::min(o.pictures, modes.num_modes()));
+      io::render_modes_png(png, file.model, system.dofs, modes,
+                           std::min(o.pictures, modes.num_modes()));
       fmt::print("wrote {}\n", png.string());
     } else {
-      warnings.push_back("no X display: modes.png not drawn (install xvfb, or run under xvfb-run -a)");
+      warnings.push_back(
+          "no X display: modes.png not drawn (install xvfb, or run under xvfb-run -a)");
     }
   }
   for (const auto& w : warnings)

@@ -9,9 +9,9 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <vector>
 #include <iostream>
 #include <string>
+#include <vector>
 
 namespace {
 

@@ -16,8 +16,8 @@ Assembled assemble(const Model& model) {
   const std::unordered_map<int, int> index = model.node_positions();
 
   for (const auto& e : model.elements) {
-    const ElementMatrices em =
-        element_matrices(model, e, model.nodes[index.at(e.node_a)].x, model.nodes[index.at(e.node_b)].x);
+    const ElementMatrices em = element_matrices(model, e, model.nodes[index.at(e.node_a)].x,
+                                                model.nodes[index.at(e.node_b)].x);
     const auto local = element_dofs(e.type);
     const int per_node = static_cast<int>(local.size());
     std::vector<int> eq(2 * per_node);

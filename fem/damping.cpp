@@ -17,7 +17,8 @@ SparseMatrix damping_matrix(const Assembled& s, const Damping& d, const Modes* a
                                   " modes of the model; for large models use Rayleigh damping");
     const Eigen::MatrixXd MPhi = s.M * all_modes->phi;
     Eigen::VectorXd c(n);
-    for (int r = 0; r < n; ++r) c(r) = 2.0 * d.ratio(all_modes->omega(r)) * all_modes->omega(r);
+    for (int r = 0; r < n; ++r)
+      c(r) = 2.0 * d.ratio(all_modes->omega(r)) * all_modes->omega(r);
     const Eigen::MatrixXd C = MPhi * c.asDiagonal() * MPhi.transpose();
     return C.sparseView(1e-14 * C.cwiseAbs().maxCoeff(), 1.0);
   }

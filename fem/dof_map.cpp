@@ -13,7 +13,8 @@ constexpr int absent = -2, fixed = -1;
 DofMap::DofMap(const Model& model) {
   const std::size_t n = model.nodes.size();
   node_ids_.reserve(n);
-  for (const auto& node : model.nodes) node_ids_.push_back(node.id);
+  for (const auto& node : model.nodes)
+    node_ids_.push_back(node.id);
   eq_.assign(n, {absent, absent, absent, absent, absent, absent});
   index_ = model.node_positions();
   auto use = [&](int node_id, Dof dof) { eq_[index_.at(node_id)][static_cast<int>(dof)] = 0; };
@@ -59,8 +60,7 @@ int DofMap::equation(const NodeDof& nd) const {
     throw std::invalid_argument("node " + std::to_string(nd.node) + " has no DOF " +
                                 std::string(dof_name(nd.dof)) +
                                 " (no element or spring at the node uses it)");
-  if (e == fixed)
-    throw std::invalid_argument("DOF " + to_string(nd) + " is fixed by a support");
+  if (e == fixed) throw std::invalid_argument("DOF " + to_string(nd) + " is fixed by a support");
   return e;
 }
 
@@ -68,7 +68,8 @@ std::array<int, 6> DofMap::node_equations(int node_id) const {
   const int i = index_of(node_id);
   if (i < 0) throw std::invalid_argument("node " + std::to_string(node_id) + " does not exist");
   std::array<int, 6> out;
-  for (int d = 0; d < 6; ++d) out[d] = eq_[i][d] >= 0 ? eq_[i][d] : -1;
+  for (int d = 0; d < 6; ++d)
+    out[d] = eq_[i][d] >= 0 ? eq_[i][d] : -1;
   return out;
 }
 

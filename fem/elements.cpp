@@ -8,18 +8,18 @@ namespace jointid::fem {
 
 Matrix4 beam_stiffness(double EI, double L) {
   Matrix4 k;
-  k << 12, 6 * L, -12, 6 * L,         //
+  k << 12, 6 * L, -12, 6 * L,              //
       6 * L, 4 * L * L, -6 * L, 2 * L * L, //
-      -12, -6 * L, 12, -6 * L,         //
+      -12, -6 * L, 12, -6 * L,             //
       6 * L, 2 * L * L, -6 * L, 4 * L * L;
   return k * (EI / (L * L * L));
 }
 
 Matrix4 beam_consistent_mass(double rho_A, double L) {
   Matrix4 m;
-  m << 156, 22 * L, 54, -13 * L,            //
+  m << 156, 22 * L, 54, -13 * L,             //
       22 * L, 4 * L * L, 13 * L, -3 * L * L, //
-      54, 13 * L, 156, -22 * L,             //
+      54, 13 * L, 156, -22 * L,              //
       -13 * L, -3 * L * L, -22 * L, 4 * L * L;
   return m * (rho_A * L / 420.0);
 }
@@ -39,7 +39,8 @@ Matrix6 frame2d_local_stiffness(double EA, double EI, double L) {
   const Matrix4 kb = beam_stiffness(EI, L);
   const int map[4] = {1, 2, 4, 5};
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) k(map[i], map[j]) = kb(i, j);
+    for (int j = 0; j < 4; ++j)
+      k(map[i], map[j]) = kb(i, j);
   return k;
 }
 
@@ -55,7 +56,8 @@ Matrix6 frame2d_local_mass(double rho_A, double L, bool lumped) {
   const Matrix4 mb = lumped ? beam_lumped_mass(rho_A, L) : beam_consistent_mass(rho_A, L);
   const int map[4] = {1, 2, 4, 5};
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) m(map[i], map[j]) = mb(i, j);
+    for (int j = 0; j < 4; ++j)
+      m(map[i], map[j]) = mb(i, j);
   return m;
 }
 
@@ -73,12 +75,14 @@ Matrix6 frame2d_rotation(const Eigen::Vector2d& xa, const Eigen::Vector2d& xb) {
 
 } // namespace
 
-Matrix6 frame2d_stiffness(double EA, double EI, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb) {
+Matrix6 frame2d_stiffness(double EA, double EI, const Eigen::Vector2d& xa,
+                          const Eigen::Vector2d& xb) {
   const Matrix6 T = frame2d_rotation(xa, xb);
   return T.transpose() * frame2d_local_stiffness(EA, EI, (xb - xa).norm()) * T;
 }
 
-Matrix6 frame2d_mass(double rho_A, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb, bool lumped) {
+Matrix6 frame2d_mass(double rho_A, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
+                     bool lumped) {
   const Matrix6 T = frame2d_rotation(xa, xb);
   return T.transpose() * frame2d_local_mass(rho_A, (xb - xa).norm(), lumped) * T;
 }
@@ -103,7 +107,8 @@ Eigen::Matrix3d frame3d_axes(const Eigen::Vector3d& xa, const Eigen::Vector3d& x
 
 Matrix12 frame3d_transform(const Eigen::Matrix3d& r) {
   Matrix12 T = Matrix12::Zero();
-  for (int b = 0; b < 4; ++b) T.block<3, 3>(3 * b, 3 * b) = r;
+  for (int b = 0; b < 4; ++b)
+    T.block<3, 3>(3 * b, 3 * b) = r;
   return T;
 }
 
@@ -136,9 +141,11 @@ Matrix12 frame3d_local_mass(const Material& mat, const Section& sec, double L, b
   const double rho_A = mat.rho * sec.A, total = rho_A * L;
   const double polar = mat.rho * (sec.Iy + sec.Iz) * L; // torsional inertia of the element
   if (lumped) {
-    for (int i : {0, 1, 2, 6, 7, 8}) m(i, i) = total / 2;
+    for (int i : {0, 1, 2, 6, 7, 8})
+      m(i, i) = total / 2;
     m(3, 3) = m(9, 9) = polar / 2;
-    for (int i : {4, 5, 10, 11}) m(i, i) = total * L * L / 78.0;
+    for (int i : {4, 5, 10, 11})
+      m(i, i) = total * L * L / 78.0;
     return m;
   }
   m(0, 0) = m(6, 6) = total / 3;
@@ -159,8 +166,9 @@ Matrix12 frame3d_local_mass(const Material& mat, const Section& sec, double L, b
 
 } // namespace
 
-Matrix12 frame3d_stiffness(const Material& material, const Section& section, const Eigen::Vector3d& xa,
-                           const Eigen::Vector3d& xb, const Eigen::Vector3d& up) {
+Matrix12 frame3d_stiffness(const Material& material, const Section& section,
+                           const Eigen::Vector3d& xa, const Eigen::Vector3d& xb,
+                           const Eigen::Vector3d& up) {
   const Matrix12 T = frame3d_transform(frame3d_axes(xa, xb, up));
   return T.transpose() * frame3d_local_stiffness(material, section, (xb - xa).norm()) * T;
 }
@@ -186,7 +194,8 @@ std::span<const Dof> element_dofs(ElementType type) {
 }
 
 ElementMatrices element_matrices(const Model& model, const Element& e) {
-  return element_matrices(model, e, model.nodes[model.node_index(e.node_a)].x, model.nodes[model.node_index(e.node_b)].x);
+  return element_matrices(model, e, model.nodes[model.node_index(e.node_a)].x,
+                          model.nodes[model.node_index(e.node_b)].x);
 }
 
 ElementMatrices element_matrices(const Model& model, const Element& e, const Eigen::Vector3d& xa,
@@ -211,10 +220,12 @@ ElementMatrices element_matrices(const Model& model, const Element& e, const Eig
       throw std::invalid_argument("element " + std::to_string(e.id) +
                                   ": a 'frame2d' element must lie in the x–y plane (z = 0)");
     const Eigen::Vector2d a = xa.head<2>(), b = xb.head<2>();
-    return {frame2d_stiffness(mat.E * sec.A, mat.E * sec.Iz, a, b), frame2d_mass(rho_A, a, b, lumped)};
+    return {frame2d_stiffness(mat.E * sec.A, mat.E * sec.Iz, a, b),
+            frame2d_mass(rho_A, a, b, lumped)};
   }
   case ElementType::frame3d:
-    return {frame3d_stiffness(mat, sec, xa, xb, e.up), frame3d_mass(mat, sec, xa, xb, e.up, lumped)};
+    return {frame3d_stiffness(mat, sec, xa, xb, e.up),
+            frame3d_mass(mat, sec, xa, xb, e.up, lumped)};
   }
   throw std::logic_error("unknown element type");
 }

@@ -20,13 +20,16 @@ Matrix4 beam_lumped_mass(double rho_A, double length);
 
 /// Planar frame element from node a at xa to node b at xb (x–y plane), global DOFs
 /// [ux_a, uy_a, rz_a, ux_b, uy_b, rz_b].
-Matrix6 frame2d_stiffness(double EA, double EI, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb);
-Matrix6 frame2d_mass(double rho_A, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb, bool lumped);
+Matrix6 frame2d_stiffness(double EA, double EI, const Eigen::Vector2d& xa,
+                          const Eigen::Vector2d& xb);
+Matrix6 frame2d_mass(double rho_A, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
+                     bool lumped);
 
 /// Spatial frame element (axial EA, torsion GJ, bending EIz in the local x–y plane and EIy in
 /// the local x–z plane). `up` lies in the local x–y plane. Global DOFs, 6 per node.
-Matrix12 frame3d_stiffness(const Material& material, const Section& section, const Eigen::Vector3d& xa,
-                           const Eigen::Vector3d& xb, const Eigen::Vector3d& up);
+Matrix12 frame3d_stiffness(const Material& material, const Section& section,
+                           const Eigen::Vector3d& xa, const Eigen::Vector3d& xb,
+                           const Eigen::Vector3d& up);
 Matrix12 frame3d_mass(const Material& material, const Section& section, const Eigen::Vector3d& xa,
                       const Eigen::Vector3d& xb, const Eigen::Vector3d& up, bool lumped);
 
@@ -41,7 +44,7 @@ struct ElementMatrices {
 /// Looks the nodes up by id (linear search; see the overload for loops).
 ElementMatrices element_matrices(const Model& model, const Element& element);
 /// Same, with the positions of node_a and node_b given.
-ElementMatrices element_matrices(const Model& model, const Element& element, const Eigen::Vector3d& xa,
-                                 const Eigen::Vector3d& xb);
+ElementMatrices element_matrices(const Model& model, const Element& element,
+                                 const Eigen::Vector3d& xa, const Eigen::Vector3d& xb);
 
 } // namespace jointid::fem

@@ -13,13 +13,17 @@
 
 namespace jointid::fem {
 
-double Modes::frequency_hz(int r) const { return omega(r) / (2.0 * std::numbers::pi); }
+double Modes::frequency_hz(int r) const {
+  return omega(r) / (2.0 * std::numbers::pi);
+}
 
 namespace {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
 
-double to_omega(double lambda) { return std::sqrt(std::max(lambda, 0.0)); }
+double to_omega(double lambda) {
+  return std::sqrt(std::max(lambda, 0.0));
+}
 
 Modes dense_modes(const Assembled& s, const ModalOptions& o) {
   const Eigen::MatrixXd K(s.K), M(s.M);
@@ -40,7 +44,8 @@ Modes dense_modes(const Assembled& s, const ModalOptions& o) {
   int count = o.num_modes > 0 ? std::min(o.num_modes, n) : n;
   if (o.max_frequency_hz > 0.0) {
     count = 0;
-    while (count < n && to_omega(lambda(count)) < two_pi * o.max_frequency_hz) ++count;
+    while (count < n && to_omega(lambda(count)) < two_pi * o.max_frequency_hz)
+      ++count;
   }
   out.omega = lambda.head(count).unaryExpr(&to_omega);
   out.phi = solver.eigenvectors().leftCols(count);
@@ -57,9 +62,11 @@ public:
   void set_shift(double sigma) {
     llt_.compute(K_ - sigma * M_);
     if (llt_.info() != Eigen::Success)
-      throw std::invalid_argument("shift-invert: K - sigma*M is not positive definite for sigma = " +
-                                  std::to_string(sigma) + " (the shift must lie below the lowest eigenvalue "
-                                  "and M must be positive definite)");
+      throw std::invalid_argument(
+          "shift-invert: K - sigma*M is not positive definite for sigma = " +
+          std::to_string(sigma) +
+          " (the shift must lie below the lowest eigenvalue "
+          "and M must be positive definite)");
   }
   void perform_op(const double* x_in, double* y_out) const {
     Eigen::Map<const Eigen::VectorXd> x(x_in, rows());
@@ -107,7 +114,8 @@ Modes sparse_modes(const Assembled& s, const ModalOptions& o) {
     const double omega_max = two_pi * o.max_frequency_hz;
     if (m.omega(m.num_modes() - 1) >= omega_max || nev == n - 1) {
       int count = 0;
-      while (count < m.num_modes() && m.omega(count) < omega_max) ++count;
+      while (count < m.num_modes() && m.omega(count) < omega_max)
+        ++count;
       m.omega.conservativeResize(count);
       m.phi.conservativeResize(Eigen::NoChange, count);
       return m;
@@ -122,13 +130,16 @@ Modes modal_analysis(const Assembled& s, const ModalOptions& o) {
   const int n = s.dofs.num_equations();
   if (o.num_modes < 0) throw std::invalid_argument("num_modes must be >= 0");
   if (o.max_frequency_hz <= 0.0 && o.num_modes > n)
-    throw std::invalid_argument("asked for " + std::to_string(o.num_modes) + " modes but the model has only " +
-                                std::to_string(n) + " free DOFs");
+    throw std::invalid_argument("asked for " + std::to_string(o.num_modes) +
+                                " modes but the model has only " + std::to_string(n) +
+                                " free DOFs");
   ModalEngine engine = o.engine;
-  if (engine == ModalEngine::automatic) engine = n <= o.dense_limit ? ModalEngine::dense : ModalEngine::sparse;
+  if (engine == ModalEngine::automatic)
+    engine = n <= o.dense_limit ? ModalEngine::dense : ModalEngine::sparse;
   if (engine == ModalEngine::sparse) {
     if (o.max_frequency_hz <= 0.0 && (o.num_modes == 0 || o.num_modes >= n))
-      throw std::invalid_argument("the sparse engine finds fewer modes than DOFs (" + std::to_string(n) +
+      throw std::invalid_argument("the sparse engine finds fewer modes than DOFs (" +
+                                  std::to_string(n) +
                                   "); ask for fewer modes or use the dense engine");
     return sparse_modes(s, o);
   }

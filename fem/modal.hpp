@@ -15,10 +15,10 @@ struct ModalOptions {
   int num_modes = 10;            ///< lowest modes wanted; 0 = all (dense engine only)
   double max_frequency_hz = 0.0; ///< > 0: every mode below this frequency, instead of a count
   ModalEngine engine = ModalEngine::automatic;
-  int dense_limit = 1500;        ///< automatic: dense engine up to this many equations
-  double shift_hz = 1.0;         ///< sparse: σ = -(2π·shift_hz)², below every ω² (rigid modes too)
-  double tolerance = 1e-10;      ///< sparse: Spectra convergence tolerance
-  int max_iterations = 1000;     ///< sparse: restarts
+  int dense_limit = 1500;   ///< automatic: dense engine up to this many equations
+  double shift_hz = 1.0;    ///< sparse: σ = -(2π·shift_hz)², below every ω² (rigid modes too)
+  double tolerance = 1e-10; ///< sparse: Spectra convergence tolerance
+  int max_iterations = 1000; ///< sparse: restarts
 };
 
 struct Modes {

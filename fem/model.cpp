@@ -55,7 +55,8 @@ void Model::validate() const {
     if (!element_ids.insert(e.id).second) fail("duplicate element id " + std::to_string(e.id));
     if (!exists(e.node_a) || !exists(e.node_b))
       fail(which + " refers to a node that does not exist");
-    if (e.node_a == e.node_b) fail(which + " connects node " + std::to_string(e.node_a) + " to itself");
+    if (e.node_a == e.node_b)
+      fail(which + " connects node " + std::to_string(e.node_a) + " to itself");
     if (e.material < 0 || e.material >= static_cast<int>(materials.size()))
       fail(which + " has no material");
     if (e.section < 0 || e.section >= static_cast<int>(sections.size()))
@@ -83,7 +84,8 @@ void Model::validate() const {
     if (!(s.stiffness >= 0.0))
       fail("spring at node " + std::to_string(s.node) + ": stiffness must be >= 0");
   }
-  if (damping.kind == Damping::Kind::modal && !(damping.modal_ratio >= 0.0 && damping.modal_ratio < 1.0))
+  if (damping.kind == Damping::Kind::modal &&
+      !(damping.modal_ratio >= 0.0 && damping.modal_ratio < 1.0))
     fail("damping: modal ratio must be in [0, 1)");
   if (damping.kind == Damping::Kind::rayleigh && !(damping.alpha >= 0.0 && damping.beta >= 0.0))
     fail("damping: rayleigh alpha and beta must be >= 0");

@@ -4,9 +4,9 @@
 #include "fem/dof.hpp"
 
 #include <map>
-#include <unordered_map>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -56,7 +56,7 @@ struct Support {
 /// A lumped mass at a node: m on the translations, inertia on the rotations.
 struct PointMass {
   int node = 0;
-  double mass = 0.0;                                ///< kg
+  double mass = 0.0;                                 ///< kg
   Eigen::Vector3d inertia = Eigen::Vector3d::Zero(); ///< kg·m^2 about x, y, z
 };
 

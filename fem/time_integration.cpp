@@ -9,8 +9,8 @@
 
 namespace jointid::fem {
 
-Newmark::Newmark(const Assembled& system, const SparseMatrix& C, const LocalForces* forces, double h,
-                 const NewmarkOptions& options)
+Newmark::Newmark(const Assembled& system, const SparseMatrix& C, const LocalForces* forces,
+                 double h, const NewmarkOptions& options)
     : system_(system), C_(C), forces_(forces), h_(h), o_(options) {
   if (!(h > 0.0)) throw std::invalid_argument("time step must be > 0");
   const double b = o_.beta, g = o_.gamma;
@@ -37,7 +37,8 @@ Newmark::Newmark(const Assembled& system, const SparseMatrix& C, const LocalForc
   y_ = lambda_ = g_total_ = Eigen::VectorXd::Zero(nc);
 }
 
-void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& f) {
+void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                        const Eigen::VectorXd& f) {
   u_ = u;
   v_ = v;
   Eigen::VectorXd rhs = f - system_.K * u;
@@ -53,7 +54,8 @@ void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, cons
     rhs -= B * g;
   }
   Eigen::SimplicialLDLT<SparseMatrix> mass(system_.M);
-  a_ = mass.info() == Eigen::Success ? Eigen::VectorXd(mass.solve(rhs)) : Eigen::VectorXd::Zero(u.size());
+  a_ = mass.info() == Eigen::Success ? Eigen::VectorXd(mass.solve(rhs))
+                                     : Eigen::VectorXd::Zero(u.size());
 }
 
 // Solves  R1 = y − y_pred + W (g(y, a1 y + e) + λ) = 0  and, for each dry-friction coordinate,
@@ -63,7 +65,8 @@ bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& 
   const int nc = static_cast<int>(y_pred.size());
   Eigen::VectorXd y = y_, lambda = lambda_, g, gy, gv;
   Eigen::VectorXd r(nc);
-  for (int i = 0; i < nc; ++i) r(i) = 1.0 / (a1_ * W_(i, i));
+  for (int i = 0; i < nc; ++i)
+    r(i) = 1.0 / (a1_ * W_(i, i));
   Eigen::MatrixXd J(2 * nc, 2 * nc);
   Eigen::VectorXd R(2 * nc);
   const double scale = std::max({y_pred.cwiseAbs().maxCoeff(), y_.cwiseAbs().maxCoeff(), 1e-300});
@@ -87,7 +90,8 @@ bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& 
         R(nc + i) = -r(i) * ydot(i);
         J(nc + i, i) = -r(i) * a1_;
         // ẏ = a1 y + e is a difference of large numbers: zero to within its rounding.
-        const double rounding = 64.0 * std::numeric_limits<double>::epsilon() * (std::abs(a1_ * y(i)) + std::abs(e(i)));
+        const double rounding =
+            64.0 * std::numeric_limits<double>::epsilon() * (std::abs(a1_ * y(i)) + std::abs(e(i)));
         friction_ok = friction_ok && std::abs(ydot(i)) <= rounding;
       } else { // slip
         R(nc + i) = lambda(i) - F * (trial > 0 ? 1.0 : -1.0);
@@ -129,14 +133,19 @@ StepStatus Newmark::step(const Eigen::VectorXd& f_next) {
 }
 
 SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const LocalForces* forces,
-                         const SineLoad& load, std::span<const int> outputs, const SteadyStateOptions& o) {
+                         const SineLoad& load, std::span<const int> outputs,
+                         const SteadyStateOptions& o) {
   const int n = system.dofs.num_equations();
-  if (load.equation < 0 || load.equation >= n) throw std::invalid_argument("sine load: bad equation");
-  if (!(load.frequency_hz > 0.0)) throw std::invalid_argument("sine load: frequency must be > 0 Hz");
+  if (load.equation < 0 || load.equation >= n)
+    throw std::invalid_argument("sine load: bad equation");
+  if (!(load.frequency_hz > 0.0))
+    throw std::invalid_argument("sine load: frequency must be > 0 Hz");
   if (o.steps_per_period < 8 || o.output_periods < 1 || o.max_periods < o.output_periods + 2)
-    throw std::invalid_argument("steady state: need >= 8 steps per period and max_periods > output_periods + 1");
+    throw std::invalid_argument(
+        "steady state: need >= 8 steps per period and max_periods > output_periods + 1");
   const int N = o.steps_per_period, nout = static_cast<int>(outputs.size());
-  const double T = 1.0 / load.frequency_hz, h = T / N, omega = 2.0 * std::numbers::pi * load.frequency_hz;
+  const double T = 1.0 / load.frequency_hz, h = T / N,
+               omega = 2.0 * std::numbers::pi * load.frequency_hz;
   Newmark integrator(system, C, forces, h, o.newmark);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
   integrator.set_state(Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n), f);

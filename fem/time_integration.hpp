@@ -95,11 +95,11 @@ enum class SteadyStateStatus { converged, not_periodic, newton_failed };
 struct SteadyState {
   SteadyStateStatus status = SteadyStateStatus::converged;
   int periods_run = 0;
-  double period_change = 0.0;  ///< last relative period-to-period change
-  Eigen::VectorXd t;           ///< uniformly sampled whole periods, s (starting at 0)
-  Eigen::VectorXd force;       ///< applied force at the samples
-  Eigen::MatrixXd u;           ///< n_samples × n_outputs displacements
-  Eigen::MatrixXd v;           ///< n_samples × n_outputs velocities
+  double period_change = 0.0; ///< last relative period-to-period change
+  Eigen::VectorXd t;          ///< uniformly sampled whole periods, s (starting at 0)
+  Eigen::VectorXd force;      ///< applied force at the samples
+  Eigen::MatrixXd u;          ///< n_samples × n_outputs displacements
+  Eigen::MatrixXd v;          ///< n_samples × n_outputs velocities
 };
 
 /// Runs from rest until a periodic steady state; returns the last `output_periods` periods

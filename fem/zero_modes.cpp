@@ -10,10 +10,11 @@ std::string ZeroModes::describe() const {
   const std::string where = " (largest motion at " + to_string(largest_motion) + ")";
   if (supported)
     return "mechanism: " + n + " zero-frequency mode" + (count > 1 ? "s" : "") +
-           " although the model is supported; it cannot carry load in " + (count > 1 ? "those shapes" : "that shape") +
-           where + ": add supports, stiffer connections or springs";
-  return "mechanism: " + n + " zero-frequency modes, more than the " + std::to_string(rigid_expected) +
-         " rigid-body modes of a free structure" + where;
+           " although the model is supported; it cannot carry load in " +
+           (count > 1 ? "those shapes" : "that shape") + where +
+           ": add supports, stiffer connections or springs";
+  return "mechanism: " + n + " zero-frequency modes, more than the " +
+         std::to_string(rigid_expected) + " rigid-body modes of a free structure" + where;
 }
 
 ZeroModes zero_modes(const Model& model, const Assembled& system, const Modes& modes) {
@@ -29,7 +30,10 @@ ZeroModes zero_modes(const Model& model, const Assembled& system, const Modes& m
   bool planar_beam_only = model.dimension == 2, any_element = !model.elements.empty();
   for (const auto& e : model.elements)
     if (e.type != ElementType::beam) planar_beam_only = false;
-  z.rigid_expected = z.supported ? 0 : model.dimension == 3 ? 6 : (planar_beam_only && any_element) ? 2 : 3;
+  z.rigid_expected = z.supported                         ? 0
+                     : model.dimension == 3              ? 6
+                     : (planar_beam_only && any_element) ? 2
+                                                         : 3;
   z.mechanism = z.count > z.rigid_expected;
   if (z.mechanism) {
     // Rank DOFs by their share of the mode's kinetic energy |φ_i (Mφ)_i|: comparing |φ_i|

@@ -14,7 +14,8 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 double smooth_force(const joints::Joint& j, double y, double v, double width) {
   double g = 0.0;
   for (std::size_t t = 0; t < j.terms.size(); ++t)
-    g += j.values[t] * (joints::is_dry_friction(j.terms[t]) ? std::tanh(v / width) : joints::basis(j.terms[t], y, v));
+    g += j.values[t] * (joints::is_dry_friction(j.terms[t]) ? std::tanh(v / width)
+                                                            : joints::basis(j.terms[t], y, v));
   return g;
 }
 
@@ -32,7 +33,8 @@ struct Problem {
     for (int j = 0; j < nj; ++j) {
       const int o = j * (2 * K + 1);
       Y(0, j) = z(o);
-      for (int k = 1; k <= K; ++k) Y(k, j) = Complex(z(o + 2 * k - 1), z(o + 2 * k));
+      for (int k = 1; k <= K; ++k)
+        Y(k, j) = Complex(z(o + 2 * k - 1), z(o + 2 * k));
     }
     return Y;
   }
@@ -41,7 +43,8 @@ struct Problem {
     for (int j = 0; j < nj; ++j) {
       const int o = j * (2 * K + 1);
       z(o) = Y(0, j).real();
-      for (int k = 1; k <= K; ++k) z(o + 2 * k - 1) = Y(k, j).real(), z(o + 2 * k) = Y(k, j).imag();
+      for (int k = 1; k <= K; ++k)
+        z(o + 2 * k - 1) = Y(k, j).real(), z(o + 2 * k) = Y(k, j).imag();
     }
     return z;
   }
@@ -59,7 +62,8 @@ struct Problem {
         }
         const double g = smooth_force((*joints)[j], y, v, width);
         G(0, j) += g / Nt;
-        for (int k = 1; k <= K; ++k) G(k, j) += 2.0 / Nt * g * std::polar(1.0, -k * theta);
+        for (int k = 1; k <= K; ++k)
+          G(k, j) += 2.0 / Nt * g * std::polar(1.0, -k * theta);
       }
     }
     return G;
@@ -68,7 +72,8 @@ struct Problem {
     const Eigen::MatrixXcd Y = unpack(z), G = forces(Y);
     Eigen::MatrixXcd R(K + 1, nj);
     for (int k = 0; k <= K; ++k) {
-      const Complex Fk = k == 1 ? Complex(0.0, -amplitude) : Complex(0.0); // F0 sin ωt = Re(−i F0 e^{iωt})
+      const Complex Fk =
+          k == 1 ? Complex(0.0, -amplitude) : Complex(0.0); // F0 sin ωt = Re(−i F0 e^{iωt})
       R.row(k) = (Y.row(k).transpose() - HyF[k] * Fk + Hyy[k] * G.row(k).transpose()).transpose();
     }
     Eigen::VectorXd r = pack(R);
@@ -76,8 +81,8 @@ struct Problem {
   }
 };
 
-bool newton(const Problem& P, Eigen::VectorXd& z, double amplitude, const HarmonicBalanceOptions& o, int& iterations,
-            double& res_norm) {
+bool newton(const Problem& P, Eigen::VectorXd& z, double amplitude, const HarmonicBalanceOptions& o,
+            int& iterations, double& res_norm) {
   const int n = P.size();
   Eigen::VectorXd r = P.residual(z, amplitude);
   for (int it = 0; it < o.max_iterations; ++it) {
@@ -114,24 +119,28 @@ bool newton(const Problem& P, Eigen::VectorXd& z, double amplitude, const Harmon
 double HarmonicBalanceResult::displacement(int j, double t) const {
   const double omega = two_pi * frequency_hz;
   double x = X(0, j).real();
-  for (int k = 1; k < X.rows(); ++k) x += (X(k, j) * std::polar(1.0, k * omega * t)).real();
+  for (int k = 1; k < X.rows(); ++k)
+    x += (X(k, j) * std::polar(1.0, k * omega * t)).real();
   return x;
 }
 
 double HarmonicBalanceResult::velocity(int j, double t) const {
   const double omega = two_pi * frequency_hz;
   double v = 0.0;
-  for (int k = 1; k < X.rows(); ++k) v += (Complex(0.0, k * omega) * X(k, j) * std::polar(1.0, k * omega * t)).real();
+  for (int k = 1; k < X.rows(); ++k)
+    v += (Complex(0.0, k * omega) * X(k, j) * std::polar(1.0, k * omega * t)).real();
   return v;
 }
 
-HarmonicBalanceResult harmonic_balance(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
-                                       const fem::DofMap& dofs, int force_equation, double amplitude,
-                                       double frequency_hz, std::span<const int> outputs,
-                                       const HarmonicBalanceOptions& o) {
+HarmonicBalanceResult
+harmonic_balance(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
+                 const fem::DofMap& dofs, int force_equation, double amplitude, double frequency_hz,
+                 std::span<const int> outputs, const HarmonicBalanceOptions& o) {
   if (o.harmonics < 1) throw std::invalid_argument("harmonic balance: need at least 1 harmonic");
-  if (!(frequency_hz > 0.0)) throw std::invalid_argument("harmonic balance: frequency must be > 0 Hz");
-  if (!(o.friction_width > 0.0)) throw std::invalid_argument("harmonic balance: friction_width must be > 0");
+  if (!(frequency_hz > 0.0))
+    throw std::invalid_argument("harmonic balance: frequency must be > 0 Hz");
+  if (!(o.friction_width > 0.0))
+    throw std::invalid_argument("harmonic balance: friction_width must be > 0");
   Problem P;
   P.K = o.harmonics;
   P.nj = static_cast<int>(joints.size());
@@ -182,7 +191,8 @@ HarmonicBalanceResult harmonic_balance(const ModalSynthesis& H, const std::vecto
     z = z_start / o.continuation_steps;
     out.converged = true;
     for (int s = 1; s <= o.continuation_steps && out.converged; ++s)
-      out.converged = newton(P, z, amplitude * s / o.continuation_steps, o, out.iterations, out.residual);
+      out.converged =
+          newton(P, z, amplitude * s / o.continuation_steps, o, out.iterations, out.residual);
   }
   out.Y = P.unpack(z);
   const Eigen::MatrixXcd G = P.forces(out.Y);

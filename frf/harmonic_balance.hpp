@@ -11,12 +11,12 @@
 namespace jointid::frf {
 
 struct HarmonicBalanceOptions {
-  int harmonics = 9;              ///< K, harmonics 0 … K
-  int time_samples = 0;           ///< AFT samples per period; 0: 32 (K + 1)
-  double friction_width = 1e-4;   ///< m/s (or rad/s): tanh regularisation of Coulomb friction
-  double tolerance = 1e-12;       ///< on the residual, relative to |Y|
+  int harmonics = 9;            ///< K, harmonics 0 … K
+  int time_samples = 0;         ///< AFT samples per period; 0: 32 (K + 1)
+  double friction_width = 1e-4; ///< m/s (or rad/s): tanh regularisation of Coulomb friction
+  double tolerance = 1e-12;     ///< on the residual, relative to |Y|
   int max_iterations = 60;
-  int continuation_steps = 20;    ///< amplitude steps tried when the direct solve fails
+  int continuation_steps = 20; ///< amplitude steps tried when the direct solve fails
 };
 
 struct HarmonicBalanceResult {
@@ -32,9 +32,9 @@ struct HarmonicBalanceResult {
 };
 
 /// `synthesis` must cover the joint DOFs, the force DOF and the outputs.
-HarmonicBalanceResult harmonic_balance(const ModalSynthesis& synthesis, const std::vector<joints::Joint>& joints,
-                                       const fem::DofMap& dofs, int force_equation, double amplitude,
-                                       double frequency_hz, std::span<const int> outputs,
-                                       const HarmonicBalanceOptions& options = {});
+HarmonicBalanceResult
+harmonic_balance(const ModalSynthesis& synthesis, const std::vector<joints::Joint>& joints,
+                 const fem::DofMap& dofs, int force_equation, double amplitude, double frequency_hz,
+                 std::span<const int> outputs, const HarmonicBalanceOptions& options = {});
 
 } // namespace jointid::frf

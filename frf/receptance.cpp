@@ -7,15 +7,21 @@
 
 namespace jointid::frf {
 
-ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& modes, const fem::Damping& damping,
-                               std::vector<int> dofs, const ModalSynthesisOptions& options)
+ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& modes,
+                               const fem::Damping& damping, std::vector<int> dofs,
+                               const ModalSynthesisOptions& options)
     : dofs_(std::move(dofs)) {
-  if (modes.status != fem::ModalStatus::success) throw std::invalid_argument("modal synthesis: the modal analysis failed");
-  const int n = system.dofs.num_equations(), m = modes.num_modes(), d = static_cast<int>(dofs_.size());
+  if (modes.status != fem::ModalStatus::success)
+    throw std::invalid_argument("modal synthesis: the modal analysis failed");
+  const int n = system.dofs.num_equations(), m = modes.num_modes(),
+            d = static_cast<int>(dofs_.size());
   for (int e : dofs_)
-    if (e < 0 || e >= n) throw std::invalid_argument("modal synthesis: equation " + std::to_string(e) + " out of range");
+    if (e < 0 || e >= n)
+      throw std::invalid_argument("modal synthesis: equation " + std::to_string(e) +
+                                  " out of range");
   phi_.resize(d, m);
-  for (int i = 0; i < d; ++i) phi_.row(i) = modes.phi.row(dofs_[i]);
+  for (int i = 0; i < d; ++i)
+    phi_.row(i) = modes.phi.row(dofs_[i]);
   omega_ = modes.omega;
   // Rayleigh damping gives 2 ζ_r ω_r = α + β ω_r² directly; going through ζ_r = α/2ω_r + βω_r/2
   // would lose α for a rigid mode whose computed ω_r is exactly 0.
@@ -30,10 +36,13 @@ ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& m
     Eigen::CholmodSupernodalLLT<fem::SparseMatrix, Eigen::Lower> llt(system.K);
     if (llt.info() == Eigen::Success) {
       Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(n, d);
-      for (int j = 0; j < d; ++j) unit(dofs_[j], j) = 1.0;
+      for (int j = 0; j < d; ++j)
+        unit(dofs_[j], j) = 1.0;
       const Eigen::MatrixXd flex = llt.solve(unit); // n × d columns of K⁻¹
-      for (int i = 0; i < d; ++i) residual_.row(i) = flex.row(dofs_[i]);
-      residual_ -= phi_ * omega_.array().square().inverse().matrix().asDiagonal() * phi_.transpose();
+      for (int i = 0; i < d; ++i)
+        residual_.row(i) = flex.row(dofs_[i]);
+      residual_ -=
+          phi_ * omega_.array().square().inverse().matrix().asDiagonal() * phi_.transpose();
       residual_ = 0.5 * (residual_ + residual_.transpose()).eval();
       has_residual_ = true;
     }
@@ -48,7 +57,8 @@ int ModalSynthesis::position(int equation) const {
   return static_cast<int>(it - dofs_.begin());
 }
 
-CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows, std::span<const int> cols) const {
+CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows,
+                                   std::span<const int> cols) const {
   const int m = static_cast<int>(omega_.size());
   CVector modal(m);
   for (int r = 0; r < m; ++r)
@@ -59,7 +69,12 @@ CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows, std:
     for (std::size_t j = 0; j < cols.size(); ++j) {
       const int pj = position(cols[j]);
       // Σ_r φ_ir φ_jr / d_r (no conjugation: receptance is symmetric, not Hermitian)
-      const Complex h = (phi_.row(pi).transpose().cwiseProduct(phi_.row(pj).transpose()).cast<Complex>().cwiseProduct(modal)).sum();
+      const Complex h = (phi_.row(pi)
+                             .transpose()
+                             .cwiseProduct(phi_.row(pj).transpose())
+                             .cast<Complex>()
+                             .cwiseProduct(modal))
+                            .sum();
       H(i, j) = h + residual_(pi, pj);
     }
   }
@@ -67,8 +82,8 @@ CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows, std:
 }
 
 Blocks ModalSynthesis::blocks(double omega, const Partition& p) const {
-  return {receptance(omega, p.set1, p.set1), receptance(omega, p.set1, p.set2), receptance(omega, p.set2, p.set1),
-          receptance(omega, p.set2, p.set2)};
+  return {receptance(omega, p.set1, p.set1), receptance(omega, p.set1, p.set2),
+          receptance(omega, p.set2, p.set1), receptance(omega, p.set2, p.set2)};
 }
 
 CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix& C, double omega,
@@ -80,12 +95,15 @@ CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix&
   D.makeCompressed();
   Eigen::UmfPackLU<CSparse> lu(D);
   if (lu.info() != Eigen::Success)
-    throw std::runtime_error("direct receptance: K - w^2 M + i w C is singular at w = " + std::to_string(omega) + " rad/s");
+    throw std::runtime_error("direct receptance: K - w^2 M + i w C is singular at w = " +
+                             std::to_string(omega) + " rad/s");
   Eigen::MatrixXcd unit = Eigen::MatrixXcd::Zero(n, static_cast<int>(cols.size()));
-  for (std::size_t j = 0; j < cols.size(); ++j) unit(cols[j], j) = 1.0;
+  for (std::size_t j = 0; j < cols.size(); ++j)
+    unit(cols[j], j) = 1.0;
   const Eigen::MatrixXcd X = lu.solve(unit);
   CMatrix H(rows.size(), cols.size());
-  for (std::size_t i = 0; i < rows.size(); ++i) H.row(i) = X.row(rows[i]);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    H.row(i) = X.row(rows[i]);
   return H;
 }
 

@@ -52,7 +52,7 @@ private:
   Eigen::MatrixXd phi_; ///< |dofs| × n_modes
   Eigen::VectorXd omega_;
   Eigen::VectorXd modal_damping_; ///< 2 ζ_r ω_r, 1/s (finite for rigid modes under αM damping)
-  Eigen::MatrixXd residual_; ///< |dofs| × |dofs|
+  Eigen::MatrixXd residual_;      ///< |dofs| × |dofs|
   bool has_residual_ = false;
 };
 

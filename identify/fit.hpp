@@ -19,7 +19,8 @@
 namespace jointid::identify {
 
 /// Receptance of the substructure: H(ω) restricted to rows × cols (equation numbers), m/N.
-using ReceptanceFn = std::function<frf::CMatrix(double omega, std::span<const int> rows, std::span<const int> cols)>;
+using ReceptanceFn =
+    std::function<frf::CMatrix(double omega, std::span<const int> rows, std::span<const int> cols)>;
 
 struct FitOptions {
   /// Harmonics whose equations are used: {1} is the paper's method; {1, 2, 3} adds the
@@ -35,10 +36,10 @@ struct FitOptions {
 struct TermEstimate {
   joints::Term term = joints::Term::k;
   double value = 0.0;
-  double std = 0.0;     ///< standard deviation from the residual (NaN if no redundancy)
-  double ci_low = 0.0;  ///< 95 % confidence interval (Student's t)
+  double std = 0.0;    ///< standard deviation from the residual (NaN if no redundancy)
+  double ci_low = 0.0; ///< 95 % confidence interval (Student's t)
   double ci_high = 0.0;
-  bool fixed = false;   ///< held at the model's value, not identified
+  bool fixed = false; ///< held at the model's value, not identified
 };
 
 struct JointEstimate {
@@ -50,8 +51,8 @@ struct FitResult {
   std::vector<JointEstimate> joints;
   int equations = 0;
   int unknowns = 0;
-  double condition_number = 0.0; ///< of the column-scaled Q
-  double residual_rms = 0.0;     ///< rms of Q b − p, m
+  double condition_number = 0.0;  ///< of the column-scaled Q
+  double residual_rms = 0.0;      ///< rms of Q b − p, m
   double residual_relative = 0.0; ///< |Q b − p| / |p|
   std::vector<std::string> warnings;
   /// The joints with their identified values (fixed terms unchanged).
@@ -74,15 +75,17 @@ using joints::joint_dof_set;
 /// Extracts a test's harmonics: checks the channels (a force channel, x at every joint DOF;
 /// v derived from x when absent), trims to whole periods, and adds warnings (not periodic,
 /// clipped, short, derived velocity). Throws std::invalid_argument naming the record.
-TestSpectrum extract_spectrum(const Record& record, const fem::DofMap& dofs, const std::vector<joints::Joint>& joints,
-                              int max_harmonic, std::vector<std::string>& warnings, const FitOptions& options = {});
+TestSpectrum extract_spectrum(const Record& record, const fem::DofMap& dofs,
+                              const std::vector<joints::Joint>& joints, int max_harmonic,
+                              std::vector<std::string>& warnings, const FitOptions& options = {});
 
 /// Identifies the non-fixed terms of every joint from the tests. Throws std::invalid_argument
 /// when there are fewer equations than unknowns or the unknowns are not separable.
-FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs, const std::vector<joints::Joint>& joints,
-              const std::vector<TestSpectrum>& tests, const FitOptions& options = {},
-              std::vector<std::string> warnings = {});
-FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs, const std::vector<joints::Joint>& joints,
-              const std::vector<Record>& records, const FitOptions& options = {});
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
+              const std::vector<joints::Joint>& joints, const std::vector<TestSpectrum>& tests,
+              const FitOptions& options = {}, std::vector<std::string> warnings = {});
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
+              const std::vector<joints::Joint>& joints, const std::vector<Record>& records,
+              const FitOptions& options = {});
 
 } // namespace jointid::identify

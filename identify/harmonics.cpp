@@ -7,12 +7,13 @@
 
 namespace jointid::identify {
 
-Eigen::MatrixXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::MatrixXd& x, double omega, int K) {
+Eigen::MatrixXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::MatrixXd& x, double omega,
+                               int K) {
   const int n = static_cast<int>(t.size());
   if (K < 0) throw std::invalid_argument("fit_harmonics: K must be >= 0");
   if (n < 2 * K + 1)
-    throw std::invalid_argument("fit_harmonics: " + std::to_string(n) + " samples cannot determine " +
-                                std::to_string(K) + " harmonics");
+    throw std::invalid_argument("fit_harmonics: " + std::to_string(n) +
+                                " samples cannot determine " + std::to_string(K) + " harmonics");
   Eigen::MatrixXd D(n, 2 * K + 1);
   const double t0 = t(0); // fit on t − t0 for conditioning, then shift the phase back
   for (int i = 0; i < n; ++i) {
@@ -28,12 +29,14 @@ Eigen::MatrixXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::MatrixXd& 
   for (int j = 0; j < x.cols(); ++j) {
     X(0, j) = c(0, j);
     for (int k = 1; k <= K; ++k)
-      X(k, j) = std::complex<double>(c(2 * k - 1, j), -c(2 * k, j)) * std::polar(1.0, -k * omega * t0);
+      X(k, j) =
+          std::complex<double>(c(2 * k - 1, j), -c(2 * k, j)) * std::polar(1.0, -k * omega * t0);
   }
   return X;
 }
 
-Eigen::VectorXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double omega, int K) {
+Eigen::VectorXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double omega,
+                               int K) {
   return fit_harmonics(t, Eigen::MatrixXd(x), omega, K).col(0);
 }
 
@@ -66,7 +69,8 @@ double estimate_frequency(const Eigen::VectorXd& t, const Eigen::VectorXd& x) {
     const double w = 2.0 * std::numbers::pi * f;
     const Eigen::VectorXcd X = fit_harmonics(t, x, w, 1);
     double ss = 0.0;
-    for (int i = 0; i < n; ++i) ss += std::pow(x(i) - X(0).real() - (X(1) * std::polar(1.0, w * t(i))).real(), 2);
+    for (int i = 0; i < n; ++i)
+      ss += std::pow(x(i) - X(0).real() - (X(1) * std::polar(1.0, w * t(i))).real(), 2);
     return -ss;
   };
   double a = std::max(best_f - df, 1e-12), b = best_f + df;

@@ -10,9 +10,11 @@
 namespace jointid::identify {
 
 /// Returns X_0 … X_K (K+1 values; X_0 real). Throws if there are fewer samples than unknowns.
-Eigen::VectorXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double omega, int K);
+Eigen::VectorXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double omega,
+                               int K);
 /// Same fit for several signals sharing t: one column per signal, (K+1) × n_signals.
-Eigen::MatrixXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::MatrixXd& x, double omega, int K);
+Eigen::MatrixXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::MatrixXd& x, double omega,
+                               int K);
 
 /// Frequency (Hz) of the dominant sinusoid in x: a DFT peak search refined by maximising the
 /// least-squares sine-fit amplitude. Throws if the record is shorter than 4 samples.

@@ -18,12 +18,16 @@ char quantity_letter(Quantity q) {
   return '?';
 }
 
-std::string Channel::name() const { return std::string(1, quantity_letter(quantity)) + "@" + fem::to_string(at); }
+std::string Channel::name() const {
+  return std::string(1, quantity_letter(quantity)) + "@" + fem::to_string(at);
+}
 
 Channel parse_channel_name(const std::string& name) {
   const auto at = name.find('@');
   if (at != 1)
-    throw std::invalid_argument("channel '" + name + "' is not <quantity>@<node>:<dof> (e.g. x@7:uy; quantity f, x, v or a)");
+    throw std::invalid_argument(
+        "channel '" + name +
+        "' is not <quantity>@<node>:<dof> (e.g. x@7:uy; quantity f, x, v or a)");
   Channel c;
   switch (name[0]) {
   case 'f':

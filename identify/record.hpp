@@ -24,8 +24,8 @@ struct Channel {
 Channel parse_channel_name(const std::string& name);
 
 struct Record {
-  std::string source;                ///< file name, for messages
-  Eigen::VectorXd t;                 ///< s, uniform
+  std::string source; ///< file name, for messages
+  Eigen::VectorXd t;  ///< s, uniform
   std::vector<Channel> channels;
   std::optional<double> excitation_hz;
   /// The channel of this quantity at this DOF, or nullptr.

@@ -37,7 +37,8 @@ double beta_fraction(double a, double b, double x) {
 double incomplete_beta(double a, double b, double x) {
   if (x <= 0.0) return 0.0;
   if (x >= 1.0) return 1.0;
-  const double log_front = std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
+  const double log_front =
+      std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
   if (x < (a + 1.0) / (a + b + 2.0)) return std::exp(log_front) * beta_fraction(a, b, x) / a;
   return 1.0 - std::exp(log_front) * beta_fraction(b, a, 1.0 - x) / b;
 }
@@ -52,7 +53,8 @@ double student_t_cdf(double t, double dof) {
 }
 
 double student_t_quantile(double p, double dof) {
-  if (!(p > 0.0 && p < 1.0) || !(dof > 0.0)) throw std::invalid_argument("student_t_quantile: need 0 < p < 1 and dof > 0");
+  if (!(p > 0.0 && p < 1.0) || !(dof > 0.0))
+    throw std::invalid_argument("student_t_quantile: need 0 < p < 1 and dof > 0");
   double lo = -1e3, hi = 1e3;
   for (int it = 0; it < 200; ++it) {
     const double mid = 0.5 * (lo + hi);

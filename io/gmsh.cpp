@@ -15,29 +15,47 @@ constexpr int line2 = 1, point1 = 15;
 // Number of nodes of the Gmsh element types we may meet, to skip or name them.
 int nodes_of(int type) {
   switch (type) {
-  case 1: return 2;  // 2-node line
-  case 2: return 3;  // triangle
-  case 3: return 4;  // quadrangle
-  case 4: return 4;  // tetrahedron
-  case 5: return 8;  // hexahedron
-  case 6: return 6;  // prism
-  case 7: return 5;  // pyramid
-  case 8: return 3;  // 3-node line
-  case 9: return 6;  // 6-node triangle
-  case 15: return 1; // point
-  default: return -1;
+  case 1:
+    return 2; // 2-node line
+  case 2:
+    return 3; // triangle
+  case 3:
+    return 4; // quadrangle
+  case 4:
+    return 4; // tetrahedron
+  case 5:
+    return 8; // hexahedron
+  case 6:
+    return 6; // prism
+  case 7:
+    return 5; // pyramid
+  case 8:
+    return 3; // 3-node line
+  case 9:
+    return 6; // 6-node triangle
+  case 15:
+    return 1; // point
+  default:
+    return -1;
   }
 }
 
 std::string type_name(int type) {
   switch (type) {
-  case 2: return "triangle";
-  case 3: return "quadrangle";
-  case 4: return "tetrahedron";
-  case 5: return "hexahedron";
-  case 8: return "3-node (second-order) line";
-  case 9: return "6-node triangle";
-  default: return "element type " + std::to_string(type);
+  case 2:
+    return "triangle";
+  case 3:
+    return "quadrangle";
+  case 4:
+    return "tetrahedron";
+  case 5:
+    return "hexahedron";
+  case 8:
+    return "3-node (second-order) line";
+  case 9:
+    return "6-node triangle";
+  default:
+    return "element type " + std::to_string(type);
   }
 }
 
@@ -89,11 +107,12 @@ void add_node(GmshMesh& mesh, std::set<int>& ids, Reader& r, int id, double x, d
   mesh.nodes.push_back({id, Eigen::Vector3d(x, y, z)});
 }
 
-void add_element(GmshMesh& mesh, std::set<int>& ids, Reader& r, int id, int type, const std::vector<int>& nodes,
-                 const std::vector<int>& groups) {
+void add_element(GmshMesh& mesh, std::set<int>& ids, Reader& r, int id, int type,
+                 const std::vector<int>& nodes, const std::vector<int>& groups) {
   if (type != line2 && type != point1)
     r.fail("unsupported element " + std::to_string(id) + " (" + type_name(type) +
-           "): jointid reads 2-node lines (type 1) and points (type 15); mesh the curves with first-order "
+           "): jointid reads 2-node lines (type 1) and points (type 15); mesh the curves with "
+           "first-order "
            "elements only (Mesh.ElementOrder = 1) and leave surfaces unmeshed");
   if (type == point1) {
     mesh.points.push_back({nodes[0], groups});
@@ -110,8 +129,10 @@ void read_physical_names(GmshMesh& mesh, Reader& r) {
     std::istringstream s = r.line("a physical name: dim tag \"name\"");
     int dim = 0, tag = 0;
     std::string rest;
-    if (!(s >> dim >> tag) || !std::getline(s >> std::ws, rest)) r.fail("expected a physical name: dim tag \"name\"");
-    if (rest.size() >= 2 && rest.front() == '"' && rest.back() == '"') rest = rest.substr(1, rest.size() - 2);
+    if (!(s >> dim >> tag) || !std::getline(s >> std::ws, rest))
+      r.fail("expected a physical name: dim tag \"name\"");
+    if (rest.size() >= 2 && rest.front() == '"' && rest.back() == '"')
+      rest = rest.substr(1, rest.size() - 2);
     mesh.names[{dim, tag}] = rest;
   }
   r.expect("$EndPhysicalNames");
@@ -139,15 +160,22 @@ void read_v2(GmshMesh& mesh, Reader& r) {
       for (int i = 0; i < n; ++i) {
         std::istringstream s = r.line("an element: id type ntags tags... nodes...");
         int id = 0, type = 0, ntags = 0;
-        if (!(s >> id >> type >> ntags) || ntags < 0) r.fail("expected an element: id type ntags tags... nodes...");
+        if (!(s >> id >> type >> ntags) || ntags < 0)
+          r.fail("expected an element: id type ntags tags... nodes...");
         std::vector<int> tags(ntags);
         for (int& t : tags)
-          if (!(s >> t)) r.fail("element " + std::to_string(id) + ": expected " + std::to_string(ntags) + " tags");
+          if (!(s >> t))
+            r.fail("element " + std::to_string(id) + ": expected " + std::to_string(ntags) +
+                   " tags");
         const int nn = nodes_of(type);
-        if (nn < 0) r.fail("unknown element type " + std::to_string(type) + " for element " + std::to_string(id));
+        if (nn < 0)
+          r.fail("unknown element type " + std::to_string(type) + " for element " +
+                 std::to_string(id));
         std::vector<int> nodes(nn);
         for (int& v : nodes)
-          if (!(s >> v)) r.fail("element " + std::to_string(id) + ": expected " + std::to_string(nn) + " node ids");
+          if (!(s >> v))
+            r.fail("element " + std::to_string(id) + ": expected " + std::to_string(nn) +
+                   " node ids");
         // Format 2.2: the first tag is the physical group (0: none), the second the entity.
         std::vector<int> groups;
         if (ntags >= 1 && tags[0] != 0) groups.push_back(tags[0]);
@@ -163,7 +191,8 @@ void read_v2(GmshMesh& mesh, Reader& r) {
 void read_v4(GmshMesh& mesh, Reader& r) {
   std::string l;
   std::set<int> node_ids, element_ids;
-  std::map<std::pair<int, int>, std::vector<int>> entity_groups; // (dim, entity tag) → physical tags
+  std::map<std::pair<int, int>, std::vector<int>>
+      entity_groups; // (dim, entity tag) → physical tags
   while (r.next_line(l)) {
     if (l == "$PhysicalNames") {
       read_physical_names(mesh, r);
@@ -177,12 +206,16 @@ void read_v4(GmshMesh& mesh, Reader& r) {
           double box[6];
           const int nbox = dim == 0 ? 3 : 6;
           s >> tag;
-          for (int k = 0; k < nbox; ++k) s >> box[k];
+          for (int k = 0; k < nbox; ++k)
+            s >> box[k];
           std::size_t nphys = 0;
-          if (!(s >> nphys)) r.fail("expected an entity: tag, coordinates, number of physical tags");
+          if (!(s >> nphys))
+            r.fail("expected an entity: tag, coordinates, number of physical tags");
           std::vector<int> phys(nphys);
           for (int& p : phys)
-            if (!(s >> p)) r.fail("entity " + std::to_string(tag) + ": expected " + std::to_string(nphys) + " physical tags");
+            if (!(s >> p))
+              r.fail("entity " + std::to_string(tag) + ": expected " + std::to_string(nphys) +
+                     " physical tags");
           entity_groups[{dim, tag}] = phys;
         }
       r.expect("$EndEntities");
@@ -194,7 +227,8 @@ void read_v4(GmshMesh& mesh, Reader& r) {
         std::size_t count = 0;
         r.read("entityDim entityTag parametric numNodesInBlock", dim, tag, parametric, count);
         std::vector<int> ids(count);
-        for (int& id : ids) r.read("a node tag", id);
+        for (int& id : ids)
+          r.read("a node tag", id);
         for (int id : ids) {
           std::istringstream s = r.line("node coordinates x y z");
           double x = 0, y = 0, z = 0;
@@ -205,7 +239,8 @@ void read_v4(GmshMesh& mesh, Reader& r) {
       r.expect("$EndNodes");
     } else if (l == "$Elements") {
       std::size_t blocks = 0, total = 0, min_tag = 0, max_tag = 0;
-      r.read("numEntityBlocks numElements minElementTag maxElementTag", blocks, total, min_tag, max_tag);
+      r.read("numEntityBlocks numElements minElementTag maxElementTag", blocks, total, min_tag,
+             max_tag);
       for (std::size_t b = 0; b < blocks; ++b) {
         int dim = 0, tag = 0, type = 0;
         std::size_t count = 0;
@@ -220,7 +255,9 @@ void read_v4(GmshMesh& mesh, Reader& r) {
           std::vector<int> nodes(nn);
           if (!(s >> id)) r.fail("expected an element tag");
           for (int& v : nodes)
-            if (!(s >> v)) r.fail("element " + std::to_string(id) + ": expected " + std::to_string(nn) + " node ids");
+            if (!(s >> v))
+              r.fail("element " + std::to_string(id) + ": expected " + std::to_string(nn) +
+                     " node ids");
           add_element(mesh, element_ids, r, id, type, nodes, groups);
         }
       }
@@ -254,7 +291,8 @@ std::vector<int> GmshMesh::nodes_in(const std::string& group) const {
   if (point_tag < 0 && line_tag < 0)
     throw Error(path.string() + ": no physical group of points or lines named '" + group + "'");
   for (const auto& p : points)
-    if (point_tag >= 0 && std::find(p.groups.begin(), p.groups.end(), point_tag) != p.groups.end()) ids.insert(p.node);
+    if (point_tag >= 0 && std::find(p.groups.begin(), p.groups.end(), point_tag) != p.groups.end())
+      ids.insert(p.node);
   for (const auto& l : lines)
     if (line_tag >= 0 && std::find(l.groups.begin(), l.groups.end(), line_tag) != l.groups.end())
       ids.insert(l.node_a), ids.insert(l.node_b);
@@ -271,25 +309,32 @@ GmshMesh read_gmsh(const std::filesystem::path& path) {
   r.read("version file-type data-size", version, file_type, data_size);
   const bool v2 = version == "2.2" || version == "2.0" || version == "2.1", v4 = version == "4.1";
   if (!v2 && !v4) r.fail("unsupported .msh format " + version + " (expected 2.2 or 4.1)");
-  if (file_type != 0) r.fail("binary .msh files are not supported; save as ASCII (Mesh.Binary = 0)");
+  if (file_type != 0)
+    r.fail("binary .msh files are not supported; save as ASCII (Mesh.Binary = 0)");
   r.expect("$EndMeshFormat");
-  if (v2) read_v2(mesh, r);
-  else read_v4(mesh, r);
+  if (v2)
+    read_v2(mesh, r);
+  else
+    read_v4(mesh, r);
 
   // References and geometry, with the line of the offending element.
   std::map<int, Eigen::Vector3d> at;
-  for (const auto& n : mesh.nodes) at[n.id] = n.x;
+  for (const auto& n : mesh.nodes)
+    at[n.id] = n.x;
   for (const auto& l : mesh.lines) {
-    const std::string where = path.string() + ":" + std::to_string(l.source_line) + ": element " + std::to_string(l.id);
+    const std::string where =
+        path.string() + ":" + std::to_string(l.source_line) + ": element " + std::to_string(l.id);
     for (int v : {l.node_a, l.node_b})
-      if (!at.count(v)) throw Error(where + " refers to node " + std::to_string(v) + ", which is not in $Nodes");
+      if (!at.count(v))
+        throw Error(where + " refers to node " + std::to_string(v) + ", which is not in $Nodes");
     if ((at[l.node_a] - at[l.node_b]).norm() == 0.0)
-      throw Error(where + " has zero length (nodes " + std::to_string(l.node_a) + " and " + std::to_string(l.node_b) +
-                  " coincide)");
+      throw Error(where + " has zero length (nodes " + std::to_string(l.node_a) + " and " +
+                  std::to_string(l.node_b) + " coincide)");
   }
   for (const auto& p : mesh.points)
     if (!at.count(p.node))
-      throw Error(path.string() + ": point element refers to node " + std::to_string(p.node) + ", which is not in $Nodes");
+      throw Error(path.string() + ": point element refers to node " + std::to_string(p.node) +
+                  ", which is not in $Nodes");
   if (mesh.lines.empty()) throw Error(path.string() + ": the mesh has no 2-node line elements");
   return mesh;
 }

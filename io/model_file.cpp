@@ -502,7 +502,8 @@ private:
           t.fail_at(which, "key 'elements'", e.what());
         }
         if (members.empty())
-          t.fail_at(which, "key 'elements'", "the physical group " + shown(which) + " has no lines");
+          t.fail_at(which, "key 'elements'",
+                    "the physical group " + shown(which) + " has no lines");
       } else {
         const toml::array& ids = t.to_array(which, "key 'elements'", "element ids (or \"all\")");
         for (const auto& n : ids) {
@@ -578,7 +579,8 @@ private:
       if (one && many) t.fail("give either node or nodes, not both");
       if (!one && !many) t.fail("missing key 'node' (a node id) or 'nodes' (ids or a Gmsh group)");
       if (one) nodes.push_back(node_key(t, "node"));
-      if (many && many->is_string()) nodes = group_nodes(t, *many, "key 'nodes'");
+      if (many && many->is_string())
+        nodes = group_nodes(t, *many, "key 'nodes'");
       else if (many)
         for (const auto& n : t.to_array(*many, "key 'nodes'", "node ids or a Gmsh group name"))
           nodes.push_back(node_id(t, n, "key 'nodes'"));

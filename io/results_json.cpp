@@ -59,7 +59,8 @@ std::string identify_result_json(const identify::FitResult& result,
   return text(out);
 }
 
-std::string modes_json(const fem::Modes& modes, int count, const std::vector<std::string>& warnings) {
+std::string modes_json(const fem::Modes& modes, int count,
+                       const std::vector<std::string>& warnings) {
   const int n = count < 0 ? modes.num_modes() : std::min(count, modes.num_modes());
   Json list = Json::array();
   for (int r = 0; r < n; ++r) {

@@ -21,9 +21,15 @@ constexpr std::array<Info, 7> info{{
 }};
 } // namespace
 
-std::string_view term_name(Term t) { return info[static_cast<int>(t)].name; }
-std::string_view term_effect(Term t) { return info[static_cast<int>(t)].effect; }
-std::string_view term_unit(Term t) { return info[static_cast<int>(t)].unit; }
+std::string_view term_name(Term t) {
+  return info[static_cast<int>(t)].name;
+}
+std::string_view term_effect(Term t) {
+  return info[static_cast<int>(t)].effect;
+}
+std::string_view term_unit(Term t) {
+  return info[static_cast<int>(t)].unit;
+}
 
 Term parse_term(std::string_view name) {
   for (Term t : all_terms)

@@ -8,7 +8,8 @@
 namespace jointid::joints {
 
 enum class Term { k, c, k2, k3, c2, c3, fc };
-inline constexpr std::array<Term, 7> all_terms{Term::k, Term::c, Term::k2, Term::k3, Term::c2, Term::c3, Term::fc};
+inline constexpr std::array<Term, 7> all_terms{Term::k,  Term::c,  Term::k2, Term::k3,
+                                               Term::c2, Term::c3, Term::fc};
 
 std::string_view term_name(Term term);   ///< "k", "c", ...
 std::string_view term_effect(Term term); ///< "linear stiffness", ...
@@ -24,6 +25,8 @@ double basis(Term term, double y, double ydot);
 double basis_dy(Term term, double y, double ydot);
 double basis_dydot(Term term, double y, double ydot);
 /// True for the set-valued dry-friction term.
-inline bool is_dry_friction(Term term) { return term == Term::fc; }
+inline bool is_dry_friction(Term term) {
+  return term == Term::fc;
+}
 
 } // namespace jointid::joints

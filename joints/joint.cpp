@@ -8,7 +8,8 @@ namespace jointid::joints {
 
 double Joint::force(double y, double ydot) const {
   double g = 0.0;
-  for (std::size_t j = 0; j < terms.size(); ++j) g += values[j] * basis(terms[j], y, ydot);
+  for (std::size_t j = 0; j < terms.size(); ++j)
+    g += values[j] * basis(terms[j], y, ydot);
   return g;
 }
 
@@ -23,15 +24,19 @@ void validate_joints(const std::vector<Joint>& joints, const fem::DofMap& dofs) 
   for (const auto& j : joints) {
     const std::string which = "joint '" + j.name + "'";
     if (j.name.empty()) throw std::invalid_argument("a joint has no name");
-    if (!names.insert(j.name).second) throw std::invalid_argument("duplicate joint name '" + j.name + "'");
+    if (!names.insert(j.name).second)
+      throw std::invalid_argument("duplicate joint name '" + j.name + "'");
     if (j.terms.empty()) throw std::invalid_argument(which + " has no terms");
     if (j.values.size() != j.terms.size() || j.fixed.size() != j.terms.size())
       throw std::invalid_argument(which + ": values and terms differ in number");
     std::set<Term> seen;
     for (Term t : j.terms)
       if (!seen.insert(t).second)
-        throw std::invalid_argument(which + " lists term '" + std::string(term_name(t)) + "' twice");
-    if (j.node == j.node_b) throw std::invalid_argument(which + " connects node " + std::to_string(j.node) + " to itself");
+        throw std::invalid_argument(which + " lists term '" + std::string(term_name(t)) +
+                                    "' twice");
+    if (j.node == j.node_b)
+      throw std::invalid_argument(which + " connects node " + std::to_string(j.node) +
+                                  " to itself");
     try {
       dofs.equation({j.node, j.dof});
       if (!j.to_ground()) dofs.equation({j.node_b, j.dof});
@@ -46,7 +51,8 @@ fem::SparseMatrix joint_coordinates(const std::vector<Joint>& joints, const fem:
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto& j = joints[i];
     entries.emplace_back(dofs.equation({j.node, j.dof}), static_cast<int>(i), 1.0);
-    if (!j.to_ground()) entries.emplace_back(dofs.equation({j.node_b, j.dof}), static_cast<int>(i), -1.0);
+    if (!j.to_ground())
+      entries.emplace_back(dofs.equation({j.node_b, j.dof}), static_cast<int>(i), -1.0);
   }
   fem::SparseMatrix B(dofs.num_equations(), static_cast<int>(joints.size()));
   B.setFromTriplets(entries.begin(), entries.end());
@@ -69,10 +75,12 @@ Eigen::MatrixXd joint_coordinates_on(const std::vector<Joint>& joints, const fem
                                      const std::vector<int>& set2) {
   auto position = [&](int node, fem::Dof dof) {
     const auto it = std::find(set2.begin(), set2.end(), dofs.equation({node, dof}));
-    if (it == set2.end()) throw std::invalid_argument("joint DOF " + fem::to_string({node, dof}) + " is not in set 2");
+    if (it == set2.end())
+      throw std::invalid_argument("joint DOF " + fem::to_string({node, dof}) + " is not in set 2");
     return static_cast<int>(it - set2.begin());
   };
-  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(static_cast<int>(set2.size()), static_cast<int>(joints.size()));
+  Eigen::MatrixXd B =
+      Eigen::MatrixXd::Zero(static_cast<int>(set2.size()), static_cast<int>(joints.size()));
   for (std::size_t i = 0; i < joints.size(); ++i) {
     B(position(joints[i].node, joints[i].dof), i) = 1.0;
     if (!joints[i].to_ground()) B(position(joints[i].node_b, joints[i].dof), i) = -1.0;
@@ -80,18 +88,21 @@ Eigen::MatrixXd joint_coordinates_on(const std::vector<Joint>& joints, const fem
   return B;
 }
 
-JointForces::JointForces(std::vector<Joint> joints, const fem::DofMap& dofs) : joints_(std::move(joints)) {
+JointForces::JointForces(std::vector<Joint> joints, const fem::DofMap& dofs)
+    : joints_(std::move(joints)) {
   validate_joints(joints_, dofs);
   for (const auto& j : joints_) {
     const int i = j.term_index(Term::fc);
     if (i >= 0 && j.values[i] < 0.0)
-      throw std::invalid_argument("joint '" + j.name + "': Coulomb friction fc must be >= 0 N to simulate");
+      throw std::invalid_argument("joint '" + j.name +
+                                  "': Coulomb friction fc must be >= 0 N to simulate");
   }
   B_ = joint_coordinates(joints_, dofs);
 }
 
-void JointForces::evaluate(const Eigen::VectorXd& y, const Eigen::VectorXd& ydot, Eigen::VectorXd& g,
-                           Eigen::VectorXd& dg_dy, Eigen::VectorXd& dg_dydot) const {
+void JointForces::evaluate(const Eigen::VectorXd& y, const Eigen::VectorXd& ydot,
+                           Eigen::VectorXd& g, Eigen::VectorXd& dg_dy,
+                           Eigen::VectorXd& dg_dydot) const {
   const int n = static_cast<int>(joints_.size());
   g.setZero(n);
   dg_dy.setZero(n);

@@ -72,12 +72,14 @@ std::vector<PaperModel> paper_models() {
 
 class PaperStudy {
 public:
-  PaperStudy(const std::string& model_path, int steps) : file_(io::read_model(model_path)), steps_(steps) {}
+  PaperStudy(const std::string& model_path, int steps)
+      : file_(io::read_model(model_path)), steps_(steps) {}
 
   nlohmann::json run() {
     setup_system();
     nlohmann::json out;
-    out["substructure_modes_hz"] = {modes_.frequency_hz(0), modes_.frequency_hz(1), modes_.frequency_hz(2)};
+    out["substructure_modes_hz"] = {modes_.frequency_hz(0), modes_.frequency_hz(1),
+                                    modes_.frequency_hz(2)};
     out["steps_per_period"] = steps_;
     const std::vector<Case> cases = paper_cases();
     for (const auto& model : paper_models()) {
@@ -90,10 +92,11 @@ public:
           print_table(model, test_case.name, c, harmonics, r);
           if (harmonics.size() == 1)
             for (std::size_t t = 0; t < model.terms.size(); ++t)
-              worst_[model.name] = std::max(worst_[model.name],
-                                            std::abs(r.joints[0].terms[t].value / model.exact[t] - 1.0));
-          out["models"][model.name][test_case.name][harmonics.size() == 1 ? "harmonic_1" : "harmonics_1_3"] =
-              nlohmann::json::parse(io::identify_result_json(r));
+              worst_[model.name] = std::max(
+                  worst_[model.name], std::abs(r.joints[0].terms[t].value / model.exact[t] - 1.0));
+          out["models"][model.name][test_case.name]
+             [harmonics.size() == 1 ? "harmonic_1" : "harmonics_1_3"] =
+                 nlohmann::json::parse(io::identify_result_json(r));
         }
       }
     }
@@ -106,8 +109,8 @@ public:
     bool ok = true;
     for (const auto& [name, limit] : {std::pair<std::string, double>{"I", 5e-4}, {"II", 1e-2}}) {
       const double worst = worst_.at(name);
-      std::printf("check: model %s worst relative error %.4f %% (limit %.2f %%) %s\n", name.c_str(), 100 * worst,
-                  100 * limit, worst <= limit ? "ok" : "FAILED");
+      std::printf("check: model %s worst relative error %.4f %% (limit %.2f %%) %s\n", name.c_str(),
+                  100 * worst, 100 * limit, worst <= limit ? "ok" : "FAILED");
       ok = ok && worst <= limit;
     }
     return ok;
@@ -121,9 +124,11 @@ private:
   void diagnose_stick_slip(nlohmann::json& out) const {
     const PaperModel model = paper_models()[1];
     Case slipping{"I (2.2-4.6 Hz)", {}};
-    for (int i = 3; i < 10; ++i) slipping.tests.push_back({1.0 + 0.4 * i, 80.0});
+    for (int i = 3; i < 10; ++i)
+      slipping.tests.push_back({1.0 + 0.4 * i, 80.0});
     const auto records = measure(model, slipping);
-    std::printf("\nStick-slip diagnosis, model II, case I without the tests that stick (1.0-1.8 Hz):\n");
+    std::printf(
+        "\nStick-slip diagnosis, model II, case I without the tests that stick (1.0-1.8 Hz):\n");
     const identify::FitResult r = identify(model, records, {1, 2, 3});
     print_table(model, "I*", 0, {1, 2, 3}, r);
     out["stick_slip_diagnosis"] = nlohmann::json::parse(io::identify_result_json(r));
@@ -133,9 +138,11 @@ private:
   void setup_system() {
     system_ = fem::assemble(file_.model);
     modes_ = fem::modal_analysis(system_, {.num_modes = 0});
-    if (modes_.status != fem::ModalStatus::success) throw std::runtime_error("modal analysis failed");
+    if (modes_.status != fem::ModalStatus::success)
+      throw std::runtime_error("modal analysis failed");
     C_ = fem::damping_matrix(system_, file_.model.damping, &modes_);
-    if (file_.joints.size() != 1) throw std::runtime_error("the paper study expects one joint in the model file");
+    if (file_.joints.size() != 1)
+      throw std::runtime_error("the paper study expects one joint in the model file");
     tip_ = system_.dofs.equation({file_.joints[0].node, file_.joints[0].dof});
     synthesis_.emplace(system_, modes_, file_.model.damping, std::vector<int>{tip_});
     std::printf("Substructure: %d DOFs, modes %.4f Hz, %.4f Hz, %.4f Hz (modal damping %.3g)\n",
@@ -161,7 +168,8 @@ private:
         fem::SteadyStateOptions opt;
         opt.steps_per_period = steps_;
         const std::array<int, 1> outputs{tip_};
-        const fem::SteadyState s = fem::steady_state(system_, C_, &forces, {tip_, amp, freq}, outputs, opt);
+        const fem::SteadyState s =
+            fem::steady_state(system_, C_, &forces, {tip_, amp, freq}, outputs, opt);
         if (s.status != fem::SteadyStateStatus::converged)
           throw std::runtime_error("no steady state at " + std::to_string(freq) + " Hz");
         identify::Record r;
@@ -176,14 +184,16 @@ private:
         return r;
       }));
     std::vector<identify::Record> records;
-    for (auto& j : jobs) records.push_back(j.get());
+    for (auto& j : jobs)
+      records.push_back(j.get());
     return records;
   }
 
   // Step 3: identify the joint from the records and the substructure's FRFs.
   identify::FitResult identify(const PaperModel& m, const std::vector<identify::Record>& records,
                                const std::vector<int>& harmonics) const {
-    const identify::ReceptanceFn H = [this](double w, std::span<const int> rows, std::span<const int> cols) {
+    const identify::ReceptanceFn H = [this](double w, std::span<const int> rows,
+                                            std::span<const int> cols) {
       return synthesis_->receptance(w, rows, cols);
     };
     return identify::fit(H, system_.dofs, {joint_of(m)}, records, {.harmonics = harmonics});
@@ -193,7 +203,8 @@ private:
   static void print_table(const PaperModel& m, const char* case_name, std::size_t c,
                           const std::vector<int>& harmonics, const identify::FitResult& r) {
     std::printf("  case %-3s harmonics %-5s  %-4s %14s %14s %9s %14s %9s\n", case_name,
-                harmonics.size() == 1 ? "1" : "1-3", "term", "exact", "paper", "paper err", "jointid", "our err");
+                harmonics.size() == 1 ? "1" : "1-3", "term", "exact", "paper", "paper err",
+                "jointid", "our err");
     for (std::size_t t = 0; t < m.terms.size(); ++t) {
       const double exact = m.exact[t], paper = m.paper[c][t], ours = r.joints[0].terms[t].value;
       std::printf("  %25s %-4s %14.6g %14.6g %8.3f%% %14.8g %8.4f%%\n", "",
@@ -202,7 +213,8 @@ private:
     }
     std::printf("  %25s equations %d, condition %.3g, residual %.3g (relative)\n", "", r.equations,
                 r.condition_number, r.residual_relative);
-    for (const auto& w : r.warnings) std::printf("  %25s warning: %s\n", "", w.c_str());
+    for (const auto& w : r.warnings)
+      std::printf("  %25s warning: %s\n", "", w.c_str());
   }
 
   static std::string describe(const PaperModel& m) {
@@ -232,14 +244,19 @@ int main(int argc, char** argv) {
     bool check = false;
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
-      if (a == "--steps" && i + 1 < argc) steps = std::stoi(argv[++i]);
-      else if (a == "--check") check = true;
-      else if (a == "--json" && i + 1 < argc) json_path = argv[++i];
+      if (a == "--steps" && i + 1 < argc)
+        steps = std::stoi(argv[++i]);
+      else if (a == "--check")
+        check = true;
+      else if (a == "--json" && i + 1 < argc)
+        json_path = argv[++i];
       else if (a == "--help" || a == "-h") {
-        std::puts("paper_cantilever [MODEL.toml] [--steps N (time steps per period, default 2048)] [--json FILE]\n"
+        std::puts("paper_cantilever [MODEL.toml] [--steps N (time steps per period, default 2048)] "
+                  "[--json FILE]\n"
                   "  [--check: exit 2 unless model I is within 0.05 % and model II within 1 %]");
         return 0;
-      } else model = a;
+      } else
+        model = a;
     }
     PaperStudy study(model, steps);
     const nlohmann::json result = study.run();

@@ -207,7 +207,8 @@ TEST_F(CliTest, ModesMatchTheCantileverTheory) {
 
 TEST_F(CliTest, ModesWriteParaViewFilesAndAPicture) {
   const fs::path out = dir() / "modes_vtk";
-  const Outcome run = jointid({"modes", model().string(), "-o", out.string(), "--count", "4"}, dir());
+  const Outcome run =
+      jointid({"modes", model().string(), "-o", out.string(), "--count", "4"}, dir());
   ASSERT_EQ(run.status, 0) << run.err;
   EXPECT_TRUE(fs::exists(out / "mesh.vtu"));
   EXPECT_TRUE(fs::exists(out / "modes.vtu"));
@@ -226,7 +227,8 @@ TEST_F(CliTest, ModesOfAFreeStructureWarnAboutRigidBodyModes) {
   // Without supports the joint to ground still holds the beam at one point (k = 4800 N/m)...
   test::write_text(free, text);
   const fs::path out = dir() / "modes_free";
-  const Outcome run = jointid({"modes", free.string(), "-o", out.string(), "--pictures", "0"}, dir());
+  const Outcome run =
+      jointid({"modes", free.string(), "-o", out.string(), "--pictures", "0"}, dir());
   ASSERT_EQ(run.status, 0) << run.err;
   // ...but joints are not part of the linear substructure: a free beam has 2 rigid-body modes
   // (uy translation, rz rotation) at 0 Hz.

@@ -39,7 +39,8 @@ void add_member(Model& m, int a, int b, int n, ElementType type, int material, i
   int previous = a;
   for (int i = 1; i <= n; ++i) {
     const int next = i == n ? b : add_node(m, xa + (xb - xa) * i / n);
-    m.elements.push_back({static_cast<int>(m.elements.size()) + 1, previous, next, type, material, section, up});
+    m.elements.push_back(
+        {static_cast<int>(m.elements.size()) + 1, previous, next, type, material, section, up});
     previous = next;
   }
 }
@@ -53,7 +54,8 @@ double sway_omega(int n, double EI, double EA, double h, double a, double m_sway
   K << n * 12 * EI / (h * h * h), n * 6 * EI / (h * h), //
       n * 6 * EI / (h * h), n * (4 * EI / h + EA * a * a / h);
   M << m_sway, 0, 0, j_rot;
-  return std::sqrt(Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d>(K, M).eigenvalues()(0));
+  return std::sqrt(
+      Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d>(K, M).eigenvalues()(0));
 }
 
 TEST(FrameModes, PortalSwayWithRigidGirder) {
@@ -68,15 +70,18 @@ TEST(FrameModes, PortalSwayWithRigidGirder) {
   add_member(m, foot_l, top_l, 6, ElementType::frame2d, 0, 0);
   add_member(m, top_r, foot_r, 6, ElementType::frame2d, 0, 0);
   add_member(m, top_l, top_r, 1, ElementType::frame2d, 1, 1); // massless: no inner nodes
-  for (int foot : {foot_l, foot_r}) m.supports.push_back({foot, {Dof::ux, Dof::uy, Dof::rz}});
-  for (int top : {top_l, top_r}) m.masses.push_back({top, M, Eigen::Vector3d::Zero()});
+  for (int foot : {foot_l, foot_r})
+    m.supports.push_back({foot, {Dof::ux, Dof::uy, Dof::rz}});
+  for (int top : {top_l, top_r})
+    m.masses.push_back({top, M, Eigen::Vector3d::Zero()});
   const Modes modes = modal_analysis(assemble(m), {.num_modes = 1});
   ASSERT_EQ(modes.status, ModalStatus::success);
   const double column = rho * A * h, a = span / 2;
   const double expected = sway_omega(2, E * I, E * A, h, a, 2 * M + 2 * 13.0 / 35.0 * column,
                                      (2 * M + 2 * column / 3.0) * a * a);
   // Without the column's axial strain the sway would be 0.6 % stiffer in ω: the model matters.
-  const double no_overturning = std::sqrt(2 * 12 * E * I / (h * h * h) / (2 * M + 2 * 13.0 / 35.0 * column));
+  const double no_overturning =
+      std::sqrt(2 * 12 * E * I / (h * h * h) / (2 * M + 2 * 13.0 / 35.0 * column));
   EXPECT_GT(std::abs(no_overturning / expected - 1.0), 5e-3);
   // Neglected: mass couplings O(m/M) ≈ 2.5 % of the columns' small share; girder flexibility.
   EXPECT_NEAR(modes.omega(0), expected, 5e-4 * expected);
@@ -105,23 +110,28 @@ TEST(FrameModes, TableSwayAndTorsionWithRigidTop) {
     m.masses.push_back({tops[c], M, Eigen::Vector3d::Zero()});
   }
   // The top is massless (material 1, rho = 0): one element per side, no inner nodes.
-  for (int c = 0; c < 4; ++c) add_member(m, tops[c], tops[(c + 1) % 4], 1, ElementType::frame3d, 1, 1);
+  for (int c = 0; c < 4; ++c)
+    add_member(m, tops[c], tops[(c + 1) % 4], 1, ElementType::frame3d, 1, 1);
   m.materials[1].E = E;
   const Modes modes = modal_analysis(assemble(m), {.num_modes = 3});
   ASSERT_EQ(modes.status, ModalStatus::success);
 
   const double leg = rho * A * H, H3 = H * H * H, G = E / (2 * (1 + nu));
   const double m_sway = 4 * M + 4 * 13.0 / 35.0 * leg;
-  const double sway_x = sway_omega(4, E * Iz, E * A, H, Lx / 2, m_sway, (4 * M + 4 * leg / 3.0) * Lx * Lx / 4);
-  const double sway_y = sway_omega(4, E * Iy, E * A, H, Ly / 2, m_sway, (4 * M + 4 * leg / 3.0) * Ly * Ly / 4);
+  const double sway_x =
+      sway_omega(4, E * Iz, E * A, H, Lx / 2, m_sway, (4 * M + 4 * leg / 3.0) * Lx * Lx / 4);
+  const double sway_y =
+      sway_omega(4, E * Iy, E * A, H, Ly / 2, m_sway, (4 * M + 4 * leg / 3.0) * Ly * Ly / 4);
   // Torsion about the vertical axis through the centre: each leg top moves θ·r tangentially
   // (θ·ry along x, θ·rx along y) with its top held from rotating, and twists by θ (GJ/H).
   const double rx = Lx / 2, ry = Ly / 2, r2 = rx * rx + ry * ry;
-  const double k_theta = 4.0 * (12.0 * E * Iz / H3 * ry * ry + 12.0 * E * Iy / H3 * rx * rx + G * J / H);
+  const double k_theta =
+      4.0 * (12.0 * E * Iz / H3 * ry * ry + 12.0 * E * Iy / H3 * rx * rx + G * J / H);
   const double torsion = std::sqrt(k_theta / (4.0 * (M + 13.0 / 35.0 * leg) * r2));
   std::vector<double> expected{sway_y, sway_x, torsion};
   std::sort(expected.begin(), expected.end());
   // Tolerance: the top's flexibility (its rotational restraint is ~1600 × the legs') and mass
   // couplings O(m/M) of the legs' small share.
-  for (int r = 0; r < 3; ++r) EXPECT_NEAR(modes.omega(r), expected[r], 1e-3 * expected[r]) << "mode " << r + 1;
+  for (int r = 0; r < 3; ++r)
+    EXPECT_NEAR(modes.omega(r), expected[r], 1e-3 * expected[r]) << "mode " << r + 1;
 }

@@ -13,10 +13,12 @@ Model chain(ElementType type, int n, int dimension) {
   m.materials.push_back({"steel", 210e9, 7850.0, 0.3});
   m.sections.push_back({"s", 1e-3, 1e-6, 1e-6, 2e-6});
   for (int i = 0; i <= n; ++i) {
-    const Eigen::Vector3d x = dimension == 3 ? Eigen::Vector3d(0.5 * i, 0.3 * i, 0.2 * i) : Eigen::Vector3d(0.5 * i, 0.0, 0.0);
+    const Eigen::Vector3d x = dimension == 3 ? Eigen::Vector3d(0.5 * i, 0.3 * i, 0.2 * i)
+                                             : Eigen::Vector3d(0.5 * i, 0.0, 0.0);
     m.nodes.push_back({i + 1, x});
   }
-  for (int i = 0; i < n; ++i) m.elements.push_back({i + 1, i + 1, i + 2, type, 0, 0});
+  for (int i = 0; i < n; ++i)
+    m.elements.push_back({i + 1, i + 1, i + 2, type, 0, 0});
   return m;
 }
 

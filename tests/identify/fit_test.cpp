@@ -19,8 +19,10 @@ namespace {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
 
-joints::Joint make_joint(std::string name, int node, int node_b, std::vector<Term> terms, std::vector<double> values) {
-  joints::Joint j{std::move(name), node, node_b, fem::Dof::uy, std::move(terms), std::move(values), {}};
+joints::Joint make_joint(std::string name, int node, int node_b, std::vector<Term> terms,
+                         std::vector<double> values) {
+  joints::Joint j{std::move(name),   node, node_b, fem::Dof::uy, std::move(terms),
+                  std::move(values), {}};
   j.fixed.assign(j.terms.size(), false);
   return j;
 }
@@ -33,21 +35,26 @@ protected:
     modes = fem::modal_analysis(system, {.num_modes = 0});
     C = fem::damping_matrix(system, model.damping, &modes);
     std::vector<int> all(system.dofs.num_equations());
-    for (int i = 0; i < system.dofs.num_equations(); ++i) all[i] = i;
+    for (int i = 0; i < system.dofs.num_equations(); ++i)
+      all[i] = i;
     synthesis.emplace(system, modes, model.damping, all);
-    H = [this](double w, std::span<const int> r, std::span<const int> c) { return synthesis->receptance(w, r, c); };
+    H = [this](double w, std::span<const int> r, std::span<const int> c) {
+      return synthesis->receptance(w, r, c);
+    };
   }
   int eq(int node) const { return system.dofs.equation({node, fem::Dof::uy}); }
 
   // A steady-state record by time integration, channels at the joint DOFs and the force DOF.
-  identify::Record time_record(const std::vector<joints::Joint>& js, int force_node, double f, double amp,
-                               int steps = 1024) const {
+  identify::Record time_record(const std::vector<joints::Joint>& js, int force_node, double f,
+                               double amp, int steps = 1024) const {
     const joints::JointForces forces(js, system.dofs);
     std::vector<int> out;
-    for (int n : record_nodes(js, force_node)) out.push_back(eq(n));
+    for (int n : record_nodes(js, force_node))
+      out.push_back(eq(n));
     fem::SteadyStateOptions o;
     o.steps_per_period = steps;
-    const fem::SteadyState s = fem::steady_state(system, C, &forces, {eq(force_node), amp, f}, out, o);
+    const fem::SteadyState s =
+        fem::steady_state(system, C, &forces, {eq(force_node), amp, f}, out, o);
     EXPECT_EQ(s.status, fem::SteadyStateStatus::converged);
     identify::Record r;
     r.source = "ti_" + std::to_string(f);
@@ -56,19 +63,22 @@ protected:
     r.channels.push_back({identify::Quantity::force, {force_node, fem::Dof::uy}, s.force});
     const auto nodes = record_nodes(js, force_node);
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-      r.channels.push_back({identify::Quantity::displacement, {nodes[i], fem::Dof::uy}, s.u.col(i)});
+      r.channels.push_back(
+          {identify::Quantity::displacement, {nodes[i], fem::Dof::uy}, s.u.col(i)});
       r.channels.push_back({identify::Quantity::velocity, {nodes[i], fem::Dof::uy}, s.v.col(i)});
     }
     return r;
   }
 
   // The same record from harmonic balance (15 harmonics), sampled 512 times a period.
-  identify::Record hb_record(const std::vector<joints::Joint>& js, int force_node, double f, double amp) const {
+  identify::Record hb_record(const std::vector<joints::Joint>& js, int force_node, double f,
+                             double amp) const {
     const auto nodes = record_nodes(js, force_node);
     std::vector<int> out;
-    for (int n : nodes) out.push_back(eq(n));
-    const frf::HarmonicBalanceResult hb =
-        frf::harmonic_balance(*synthesis, js, system.dofs, eq(force_node), amp, f, out, {.harmonics = 15});
+    for (int n : nodes)
+      out.push_back(eq(n));
+    const frf::HarmonicBalanceResult hb = frf::harmonic_balance(
+        *synthesis, js, system.dofs, eq(force_node), amp, f, out, {.harmonics = 15});
     EXPECT_TRUE(hb.converged);
     const int N = 512, periods = 2;
     identify::Record r;
@@ -76,11 +86,13 @@ protected:
     r.excitation_hz = f;
     r.t.resize(N * periods);
     Eigen::VectorXd force(N * periods);
-    for (int i = 0; i < N * periods; ++i) r.t(i) = i / (f * N), force(i) = amp * std::sin(two_pi * f * r.t(i));
+    for (int i = 0; i < N * periods; ++i)
+      r.t(i) = i / (f * N), force(i) = amp * std::sin(two_pi * f * r.t(i));
     r.channels.push_back({identify::Quantity::force, {force_node, fem::Dof::uy}, force});
     for (std::size_t j = 0; j < nodes.size(); ++j) {
       Eigen::VectorXd x(N * periods), v(N * periods);
-      for (int i = 0; i < N * periods; ++i) x(i) = hb.displacement(j, r.t(i)), v(i) = hb.velocity(j, r.t(i));
+      for (int i = 0; i < N * periods; ++i)
+        x(i) = hb.displacement(j, r.t(i)), v(i) = hb.velocity(j, r.t(i));
       r.channels.push_back({identify::Quantity::displacement, {nodes[j], fem::Dof::uy}, x});
       r.channels.push_back({identify::Quantity::velocity, {nodes[j], fem::Dof::uy}, v});
     }
@@ -92,7 +104,8 @@ protected:
     auto add = [&](int n) {
       if (n != 0 && std::find(nodes.begin(), nodes.end(), n) == nodes.end()) nodes.push_back(n);
     };
-    for (const auto& j : js) add(j.node), add(j.node_b);
+    for (const auto& j : js)
+      add(j.node), add(j.node_b);
     return nodes;
   }
 
@@ -104,20 +117,24 @@ protected:
   identify::ReceptanceFn H;
 };
 
-void expect_values(const identify::FitResult& r, const std::vector<joints::Joint>& truth, double rel) {
+void expect_values(const identify::FitResult& r, const std::vector<joints::Joint>& truth,
+                   double rel) {
   ASSERT_EQ(r.joints.size(), truth.size());
   for (std::size_t i = 0; i < truth.size(); ++i)
     for (std::size_t t = 0; t < truth[i].terms.size(); ++t)
-      EXPECT_NEAR(r.joints[i].terms[t].value, truth[i].values[t], rel * std::abs(truth[i].values[t]))
+      EXPECT_NEAR(r.joints[i].terms[t].value, truth[i].values[t],
+                  rel * std::abs(truth[i].values[t]))
           << truth[i].name << "." << joints::term_name(truth[i].terms[t]);
 }
 
 } // namespace
 
 TEST_F(FitTest, PaperModelIFromTimeIntegrationFrequencySweep) {
-  const std::vector<joints::Joint> truth{make_joint("tip", 7, 0, {Term::k, Term::c, Term::c2, Term::k3}, {4800, 20, 500, 1.6e8})};
+  const std::vector<joints::Joint> truth{
+      make_joint("tip", 7, 0, {Term::k, Term::c, Term::c2, Term::k3}, {4800, 20, 500, 1.6e8})};
   std::vector<identify::Record> records;
-  for (int i = 0; i < 10; ++i) records.push_back(time_record(truth, 7, 1.0 + 0.4 * i, 80.0));
+  for (int i = 0; i < 10; ++i)
+    records.push_back(time_record(truth, 7, 1.0 + 0.4 * i, 80.0));
   const identify::FitResult r = identify::fit(H, system.dofs, truth, records);
   // Newmark at 1024 steps a period leaves a dispersion error ≈ (ωh)²/12 ≈ 3e-6 in the
   // response; the bar for model I is 0.05 %.
@@ -132,9 +149,11 @@ TEST_F(FitTest, PaperModelIFromTimeIntegrationFrequencySweep) {
 }
 
 TEST_F(FitTest, CoulombFrictionFromTimeIntegrationAmplitudeSweep) {
-  const std::vector<joints::Joint> truth{make_joint("tip", 7, 0, {Term::k, Term::c, Term::fc, Term::k3}, {4800, 20, 3.0, 1.6e8})};
+  const std::vector<joints::Joint> truth{
+      make_joint("tip", 7, 0, {Term::k, Term::c, Term::fc, Term::k3}, {4800, 20, 3.0, 1.6e8})};
   std::vector<identify::Record> records;
-  for (int i = 1; i <= 10; ++i) records.push_back(time_record(truth, 7, 3.0, 10.0 * i, 2048));
+  for (int i = 1; i <= 10; ++i)
+    records.push_back(time_record(truth, 7, 3.0, 10.0 * i, 2048));
   const identify::FitResult r = identify::fit(H, system.dofs, truth, records);
   expect_values(r, truth, 1e-2); // the bar for model II
 }
@@ -147,8 +166,10 @@ TEST_F(FitTest, TwoJointsForceOffTheJointsHarmonicBalance) {
       make_joint("mid", 3, 4, {Term::k, Term::c2}, {2.0e5, 300.0})};
   std::vector<identify::Record> records;
   for (double f : {2.0, 3.5, 5.0, 12.0, 17.0, 19.0, 25.0})
-    for (double a : {40.0, 120.0}) records.push_back(hb_record(truth, 5, f, a));
-  const identify::FitResult r = identify::fit(H, system.dofs, truth, records, {.harmonics = {1, 3}});
+    for (double a : {40.0, 120.0})
+      records.push_back(hb_record(truth, 5, f, a));
+  const identify::FitResult r =
+      identify::fit(H, system.dofs, truth, records, {.harmonics = {1, 3}});
   // Harmonic balance and identification share only H; truncation at 15 harmonics and
   // sampling leave errors far below 1e-5.
   expect_values(r, truth, 1e-5);
@@ -157,9 +178,11 @@ TEST_F(FitTest, TwoJointsForceOffTheJointsHarmonicBalance) {
 }
 
 TEST_F(FitTest, FixedTermsAreHeldAndMovedToTheRightHandSide) {
-  std::vector<joints::Joint> truth{make_joint("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800, 20, 1.6e8})};
+  std::vector<joints::Joint> truth{
+      make_joint("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800, 20, 1.6e8})};
   std::vector<identify::Record> records;
-  for (double f : {2.0, 3.0, 4.0}) records.push_back(hb_record(truth, 7, f, 80.0));
+  for (double f : {2.0, 3.0, 4.0})
+    records.push_back(hb_record(truth, 7, f, 80.0));
   std::vector<joints::Joint> start = truth;
   start[0].fixed = {true, false, false};
   start[0].values = {4800, 1.0, 1.0}; // wrong starting values for the free terms
@@ -174,13 +197,15 @@ TEST_F(FitTest, FixedTermsAreHeldAndMovedToTheRightHandSide) {
 }
 
 TEST_F(FitTest, TooFewEquationsIsAClearError) {
-  const std::vector<joints::Joint> truth{make_joint("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800, 20, 1.6e8})};
+  const std::vector<joints::Joint> truth{
+      make_joint("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800, 20, 1.6e8})};
   const std::vector<identify::Record> records{hb_record(truth, 7, 3.0, 80.0)};
   try {
     identify::fit(H, system.dofs, truth, records);
     FAIL() << "2 equations for 3 unknowns accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("2 equations for 3 unknowns"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("2 equations for 3 unknowns"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -213,19 +238,23 @@ TEST_F(FitTest, InseparableTermsAreAClearError) {
 }
 
 TEST_F(FitTest, WarnsAboutUnsteadyAndClippedRecordsAndDerivedVelocity) {
-  const std::vector<joints::Joint> truth{make_joint("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800, 20, 1.6e8})};
+  const std::vector<joints::Joint> truth{
+      make_joint("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800, 20, 1.6e8})};
   std::vector<identify::Record> records;
-  for (double f : {2.0, 3.0, 4.0}) records.push_back(hb_record(truth, 7, f, 80.0));
+  for (double f : {2.0, 3.0, 4.0})
+    records.push_back(hb_record(truth, 7, f, 80.0));
   identify::Record growing = records[0];
   Eigen::VectorXd& x = growing.channels[1].samples;
-  for (int i = 0; i < x.size(); ++i) x(i) *= 1.0 + 0.02 * i / x.size(); // 2 % growth
+  for (int i = 0; i < x.size(); ++i)
+    x(i) *= 1.0 + 0.02 * i / x.size(); // 2 % growth
   identify::Record clipped = records[1];
   Eigen::VectorXd& xc = clipped.channels[1].samples;
   const double limit = 0.8 * xc.cwiseAbs().maxCoeff();
   xc = xc.cwiseMax(-limit).cwiseMin(limit);
   identify::Record no_velocity = records[2];
   no_velocity.channels.pop_back();
-  const identify::FitResult r = identify::fit(H, system.dofs, truth, {growing, clipped, no_velocity});
+  const identify::FitResult r =
+      identify::fit(H, system.dofs, truth, {growing, clipped, no_velocity});
   auto warned = [&](const std::string& source, const std::string& what) {
     for (const auto& w : r.warnings)
       if (w.find(source) != std::string::npos && w.find(what) != std::string::npos) return true;
@@ -238,7 +267,8 @@ TEST_F(FitTest, WarnsAboutUnsteadyAndClippedRecordsAndDerivedVelocity) {
 }
 
 TEST_F(FitTest, DerivedVelocityStillIdentifies) {
-  const std::vector<joints::Joint> truth{make_joint("tip", 7, 0, {Term::k, Term::c, Term::c2, Term::k3}, {4800, 20, 500, 1.6e8})};
+  const std::vector<joints::Joint> truth{
+      make_joint("tip", 7, 0, {Term::k, Term::c, Term::c2, Term::k3}, {4800, 20, 500, 1.6e8})};
   std::vector<identify::Record> records;
   for (double f : {1.5, 2.5, 3.5, 4.5}) {
     records.push_back(hb_record(truth, 7, f, 80.0));

@@ -14,11 +14,13 @@ constexpr double pi = std::numbers::pi;
 // x(t) = 0.3 + Re(X1 e^{iωt}) + Re(X3 e^{3iωt}) with known complex amplitudes.
 const cd X1 = std::polar(2.0, 0.4), X3 = std::polar(0.5, -1.0);
 double signal(double t, double omega) {
-  return 0.3 + (X1 * std::polar(1.0, omega * t)).real() + (X3 * std::polar(1.0, 3 * omega * t)).real();
+  return 0.3 + (X1 * std::polar(1.0, omega * t)).real() +
+         (X3 * std::polar(1.0, 3 * omega * t)).real();
 }
 Eigen::VectorXd times(int n, double dt, double t0) {
   Eigen::VectorXd t(n);
-  for (int i = 0; i < n; ++i) t(i) = t0 + i * dt;
+  for (int i = 0; i < n; ++i)
+    t(i) = t0 + i * dt;
   return t;
 }
 } // namespace
@@ -27,7 +29,8 @@ TEST(FitHarmonics, RecoversKnownAmplitudesOnWholePeriods) {
   const double f = 3.0, omega = 2 * pi * f;
   const Eigen::VectorXd t = times(400, 1.0 / (f * 100), 0.0); // 4 periods, 100 samples each
   Eigen::VectorXd x(t.size());
-  for (int i = 0; i < t.size(); ++i) x(i) = signal(t(i), omega);
+  for (int i = 0; i < t.size(); ++i)
+    x(i) = signal(t(i), omega);
   const Eigen::VectorXcd X = fit_harmonics(t, x, omega, 3);
   // Exact model: only rounding remains.
   EXPECT_NEAR(X(0).real(), 0.3, 1e-12);
@@ -40,7 +43,8 @@ TEST(FitHarmonics, RecoversKnownAmplitudesWithoutWholePeriodsAndShiftedTime) {
   const double f = 7.3, omega = 2 * pi * f;
   const Eigen::VectorXd t = times(537, 1.0 / 211.0, 12.345); // 2.53 periods, not aligned
   Eigen::VectorXd x(t.size());
-  for (int i = 0; i < t.size(); ++i) x(i) = signal(t(i), omega);
+  for (int i = 0; i < t.size(); ++i)
+    x(i) = signal(t(i), omega);
   const Eigen::VectorXcd X = fit_harmonics(t, x, omega, 3);
   EXPECT_NEAR(std::abs(X(1) - X1), 0.0, 1e-10);
   EXPECT_NEAR(std::abs(X(3) - X3), 0.0, 1e-10);
@@ -74,7 +78,8 @@ TEST(EstimateFrequency, FindsANonBinFrequency) {
   const double f = 13.37;
   const Eigen::VectorXd t = times(3000, 1e-3, 0.5);
   Eigen::VectorXd x(t.size());
-  for (int i = 0; i < t.size(); ++i) x(i) = 5.0 * std::sin(2 * pi * f * t(i) + 1.0) + 0.2;
+  for (int i = 0; i < t.size(); ++i)
+    x(i) = 5.0 * std::sin(2 * pi * f * t(i) + 1.0) + 0.2;
   // The DFT resolution is 1/3 s⁻¹; the refined fit must reach far below it.
   EXPECT_NEAR(estimate_frequency(t, x), f, 1e-6 * f);
 }

@@ -8,9 +8,10 @@ using namespace jointid::identify;
 
 TEST(Statistics, IncompleteBetaClosedForms) {
   for (double x : {0.1, 0.37, 0.9}) {
-    EXPECT_NEAR(incomplete_beta(1.0, 1.0, x), x, 1e-14);                      // uniform
-    EXPECT_NEAR(incomplete_beta(2.5, 1.0, x), std::pow(x, 2.5), 1e-13);        // I_x(a,1) = x^a
-    EXPECT_NEAR(incomplete_beta(3.0, 4.5, x), 1.0 - incomplete_beta(4.5, 3.0, 1.0 - x), 1e-13); // symmetry
+    EXPECT_NEAR(incomplete_beta(1.0, 1.0, x), x, 1e-14);                // uniform
+    EXPECT_NEAR(incomplete_beta(2.5, 1.0, x), std::pow(x, 2.5), 1e-13); // I_x(a,1) = x^a
+    EXPECT_NEAR(incomplete_beta(3.0, 4.5, x), 1.0 - incomplete_beta(4.5, 3.0, 1.0 - x),
+                1e-13); // symmetry
   }
 }
 

@@ -129,9 +129,13 @@ std::string replace(std::string text, const std::string& from, const std::string
 
 } // namespace
 
-TEST(Gmsh, ReadsFormat22) { expect_l_frame(io::read_gmsh(write_temp("l22.msh", msh22))); }
+TEST(Gmsh, ReadsFormat22) {
+  expect_l_frame(io::read_gmsh(write_temp("l22.msh", msh22)));
+}
 
-TEST(Gmsh, ReadsFormat41WithEntityPhysicalGroups) { expect_l_frame(io::read_gmsh(write_temp("l41.msh", msh41))); }
+TEST(Gmsh, ReadsFormat41WithEntityPhysicalGroups) {
+  expect_l_frame(io::read_gmsh(write_temp("l41.msh", msh41)));
+}
 
 TEST(Gmsh, UnknownGroupIsAnError) {
   const io::GmshMesh m = io::read_gmsh(write_temp("l22.msh", msh22));

@@ -276,7 +276,8 @@ TEST_F(ModelFileTest, GmshFileAndInlineMeshAreExclusive) {
 }
 
 TEST_F(ModelFileTest, GroupNamesNeedAGmshMesh) {
-  const std::string text = test::replaced(cantilever_toml(), "elements = \"all\"", "elements = \"columns\"");
+  const std::string text =
+      test::replaced(cantilever_toml(), "elements = \"all\"", "elements = \"columns\"");
   expect_error(text, test::line_of(text, "\"columns\""), {"key 'elements'", "Gmsh mesh"});
 }
 
@@ -336,12 +337,14 @@ protected:
       FAIL() << "expected io::Error";
     } catch (const Error& e) {
       const std::string message = e.what();
-      EXPECT_NE(message.find("portal.toml:" + std::to_string(line) + ":"), std::string::npos) << message;
+      EXPECT_NE(message.find("portal.toml:" + std::to_string(line) + ":"), std::string::npos)
+          << message;
       for (const auto& p : parts)
         EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' not in: " << message;
     }
   }
-  const std::filesystem::path source = std::filesystem::path(JOINTID_SOURCE_DIR) / "examples/portal_frame";
+  const std::filesystem::path source =
+      std::filesystem::path(JOINTID_SOURCE_DIR) / "examples/portal_frame";
   test::TempDir dir;
 };
 
@@ -351,7 +354,8 @@ TEST_F(GmshModelTest, ReadsThePortalFrame) {
   // portal.geo: 3 m columns and a 4 m beam meshed at 0.25 m: 12 + 16 + 12 elements.
   EXPECT_EQ(m.elements.size(), 40u);
   EXPECT_EQ(m.nodes.size(), 41u);
-  for (const auto& e : m.elements) EXPECT_EQ(e.type, fem::ElementType::frame2d);
+  for (const auto& e : m.elements)
+    EXPECT_EQ(e.type, fem::ElementType::frame2d);
   ASSERT_EQ(m.supports.size(), 2u); // "base": both feet, nodes 1 and 4 of the mesh
   EXPECT_EQ(m.supports[0].node, 1);
   EXPECT_EQ(m.supports[1].node, 4);
@@ -384,11 +388,13 @@ TEST_F(GmshModelTest, AGroupWithoutElementSetIsNamed) {
 }
 
 TEST_F(GmshModelTest, UnknownGroupsAndAmbiguousNodesAreErrors) {
-  const std::string roof = test::replaced(portal_toml(), "elements = \"beam\"", "elements = \"roof\"");
+  const std::string roof =
+      test::replaced(portal_toml(), "elements = \"beam\"", "elements = \"roof\"");
   expect_error(roof, test::line_of(roof, "\"roof\""), {"key 'elements'", "'roof'"});
   const std::string two = test::replaced(portal_toml(), "node = \"corner\"", "node = \"base\"");
   expect_error(two, test::line_of(two, "node = \"base\""), {"key 'node'", "holds 2 nodes"});
-  const std::string missing = test::replaced(portal_toml(), "file = \"portal.msh\"", "file = \"nowhere.msh\"");
+  const std::string missing =
+      test::replaced(portal_toml(), "file = \"portal.msh\"", "file = \"nowhere.msh\"");
   try {
     read_model(write(missing));
     FAIL();
