@@ -19,9 +19,13 @@ struct Setup {
   fem::Modes modes = fem::modal_analysis(system, {.num_modes = 0});
   fem::SparseMatrix C = fem::damping_matrix(system, model.damping, &modes);
   int tip = system.dofs.equation({7, fem::Dof::uy});
-  joints::Joint joint{"tip", 7, 0, fem::Dof::uy,
+  joints::Joint joint{"tip",
+                      7,
+                      0,
+                      fem::Dof::uy,
                       {joints::Term::k, joints::Term::c, joints::Term::c2, joints::Term::k3},
-                      {4800.0, 20.0, 500.0, 1.6e8}, {false, false, false, false}};
+                      {4800.0, 20.0, 500.0, 1.6e8},
+                      {false, false, false, false}};
 };
 
 const Setup& setup() {
@@ -45,12 +49,14 @@ identify::Record record(const Setup& s, double f) {
 
 void BM_Assembly(benchmark::State& state) {
   const fem::Model m = test::paper_cantilever();
-  for (auto _ : state) benchmark::DoNotOptimize(fem::assemble(m));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(fem::assemble(m));
 }
 
 void BM_ModalAnalysisAllModes(benchmark::State& state) {
   const Setup& s = setup();
-  for (auto _ : state) benchmark::DoNotOptimize(fem::modal_analysis(s.system, {.num_modes = 0}));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(fem::modal_analysis(s.system, {.num_modes = 0}));
 }
 
 void BM_FrfBlocksTenFrequencies(benchmark::State& state) {
@@ -58,24 +64,28 @@ void BM_FrfBlocksTenFrequencies(benchmark::State& state) {
   const frf::Partition p{{s.system.dofs.equation({4, fem::Dof::uy})}, {s.tip}};
   for (auto _ : state) {
     const frf::ModalSynthesis H(s.system, s.modes, s.model.damping, {p.set1[0], p.set2[0]});
-    for (int i = 0; i < 10; ++i) benchmark::DoNotOptimize(H.blocks(2.0 * M_PI * (1.0 + 0.4 * i), p));
+    for (int i = 0; i < 10; ++i)
+      benchmark::DoNotOptimize(H.blocks(2.0 * M_PI * (1.0 + 0.4 * i), p));
   }
 }
 
 void BM_SteadyStateOneTest(benchmark::State& state) {
   const Setup& s = setup();
-  for (auto _ : state) benchmark::DoNotOptimize(record(s, 3.0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(record(s, 3.0));
 }
 
 void BM_IdentifyCaseI(benchmark::State& state) {
   const Setup& s = setup();
   std::vector<identify::Record> records;
-  for (int i = 0; i < 10; ++i) records.push_back(record(s, 1.0 + 0.4 * i));
+  for (int i = 0; i < 10; ++i)
+    records.push_back(record(s, 1.0 + 0.4 * i));
   const frf::ModalSynthesis H(s.system, s.modes, s.model.damping, {s.tip});
   const identify::ReceptanceFn Hf = [&](double w, std::span<const int> r, std::span<const int> c) {
     return H.receptance(w, r, c);
   };
-  for (auto _ : state) benchmark::DoNotOptimize(identify::fit(Hf, s.system.dofs, {s.joint}, records));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(identify::fit(Hf, s.system.dofs, {s.joint}, records));
 }
 
 } // namespace
