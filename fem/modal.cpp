@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -60,7 +61,20 @@ public:
   Eigen::Index rows() const { return K_.rows(); }
   Eigen::Index cols() const { return K_.cols(); }
   void set_shift(double sigma) {
-    llt_.compute(K_ - sigma * M_);
+    const SparseMatrix A = K_ - sigma * M_;
+    llt_.analyzePattern(A);
+    // Eigen's CHOLMOD wrapper uses 32-bit indices: a factor with more nonzeros than that
+    // cannot be formed (CHOLMOD would overflow and crash). Its symbolic analysis predicts the
+    // size, so say so instead.
+    const double factor_nonzeros = llt_.cholmod().lnz;
+    if (factor_nonzeros > 0.9 * std::numeric_limits<int>::max())
+      throw std::invalid_argument(
+          "sparse modal analysis: the Cholesky factor of K - sigma*M would have " +
+          std::to_string(static_cast<long long>(factor_nonzeros)) + " nonzeros (about " +
+          std::to_string(static_cast<long long>(factor_nonzeros * 8.0 / (1 << 30))) +
+          " GiB), beyond the 32-bit indices of the CHOLMOD interface; the model is too large for "
+          "this engine");
+    llt_.factorize(A);
     if (llt_.info() != Eigen::Success)
       throw std::invalid_argument(
           "shift-invert: K - sigma*M is not positive definite for sigma = " +
