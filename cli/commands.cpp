@@ -156,10 +156,11 @@ void simulate(const SimulateOptions& o) {
   fem::NodeDof force_at;
   int force_equation = -1;
   try {
-    force_at = fem::parse_node_dof(o.force);
+    force_at = io::resolve_node_dof(file, o.force);
     force_equation = system.dofs.equation(force_at);
   } catch (const std::invalid_argument& e) {
-    throw io::Error(fmt::format("--force {}: {} (expected NODE:DOF of a free DOF of {}, e.g. 7:uy)",
+    throw io::Error(fmt::format("--force {}: {} (expected NODE:DOF of a free DOF of {}, e.g. "
+                                "7:uy, or a one-node Gmsh group such as tip:uy)",
                                 o.force, e.what(), o.model.string()));
   }
   // Outputs: every joint DOF, then the force DOF.

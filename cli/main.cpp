@@ -58,7 +58,10 @@ int main(int argc, char** argv) {
       "simulate", "Simulate sine tests of the model with its joints at their values; "
                   "one record (CSV) per frequency x amplitude");
   simulate->add_option("MODEL", sim.model, "Model file (TOML)")->required();
-  simulate->add_option("--force", sim.force, "NODE:DOF of the sine force, e.g. 7:uy")->required();
+  simulate
+      ->add_option("--force", sim.force,
+                   "NODE:DOF of the sine force, e.g. 7:uy; NODE may be a one-node Gmsh group")
+      ->required();
   simulate->add_option("--freq", sim.frequencies, "Excitation frequencies, Hz (comma-separated)")
       ->required()
       ->delimiter(',')

@@ -73,4 +73,11 @@ std::array<int, 6> DofMap::node_equations(int node_id) const {
   return out;
 }
 
+std::vector<int> DofMap::equation_nodes() const {
+  std::vector<int> out(by_equation_.size());
+  for (std::size_t e = 0; e < by_equation_.size(); ++e)
+    out[e] = index_of(by_equation_[e].node);
+  return out;
+}
+
 } // namespace jointid::fem

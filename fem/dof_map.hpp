@@ -26,6 +26,9 @@ public:
   /// Node ids in model order, and every node's equation numbers (-1 where absent or fixed).
   const std::vector<int>& node_ids() const { return node_ids_; }
   std::array<int, 6> node_equations(int node_id) const;
+  /// For every equation, the position in node_ids() of its node (groups the DOFs of a node,
+  /// e.g. for a node-wise fill-reducing ordering).
+  std::vector<int> equation_nodes() const;
 
 private:
   int index_of(int node_id) const;

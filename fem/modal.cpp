@@ -1,16 +1,18 @@
 #include "fem/modal.hpp"
 
 #include <Eigen/Cholesky>
-#include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace jointid::fem {
 
@@ -21,6 +23,10 @@ double Modes::frequency_hz(int r) const {
 namespace {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 double to_omega(double lambda) {
   return std::sqrt(std::max(lambda, 0.0));
@@ -53,60 +59,69 @@ Modes dense_modes(const Assembled& s, const ModalOptions& o) {
   return out;
 }
 
-// y = (K − σM)⁻¹ x by a supernodal CHOLMOD factorisation (K − σM is SPD for σ < λ_min).
-class CholmodShiftInvert {
+// y = (K − σM)⁻¹ x by a supernodal CHOLMOD factorisation with 64-bit indices (K − σM is SPD
+// for σ < λ_min).
+class ShiftInvert {
 public:
   using Scalar = double;
-  CholmodShiftInvert(const SparseMatrix& K, const SparseMatrix& M) : K_(K), M_(M) {}
+  // groups: the node of every equation; the fill-reducing ordering is computed on the nodes.
+  ShiftInvert(const SparseMatrix& K, const SparseMatrix& M, std::vector<int> groups,
+              const CholeskyOptions& options, SparseModalStats& stats)
+      : K_(K), M_(M), groups_(std::move(groups)), llt_(options), stats_(stats) {}
   Eigen::Index rows() const { return K_.rows(); }
   Eigen::Index cols() const { return K_.cols(); }
   void set_shift(double sigma) {
     const SparseMatrix A = K_ - sigma * M_;
-    llt_.analyzePattern(A);
-    // Eigen's CHOLMOD wrapper uses 32-bit indices: a factor with more nonzeros than that
-    // cannot be formed (CHOLMOD would overflow and crash). Its symbolic analysis predicts the
-    // size, so say so instead.
-    const double factor_nonzeros = llt_.cholmod().lnz;
-    if (factor_nonzeros > 0.9 * std::numeric_limits<int>::max())
-      throw std::invalid_argument(
-          "sparse modal analysis: the Cholesky factor of K - sigma*M would have " +
-          std::to_string(static_cast<long long>(factor_nonzeros)) + " nonzeros (about " +
-          std::to_string(static_cast<long long>(factor_nonzeros * 8.0 / (1 << 30))) +
-          " GiB), beyond the 32-bit indices of the CHOLMOD interface; the model is too large for "
-          "this engine");
-    llt_.factorize(A);
-    if (llt_.info() != Eigen::Success)
+    auto start = std::chrono::steady_clock::now();
+    stats_.factor = llt_.analyze(A, groups_);
+    stats_.analyze_s = seconds_since(start);
+    start = std::chrono::steady_clock::now();
+    try {
+      llt_.factorize(A);
+    } catch (const std::domain_error&) {
       throw std::invalid_argument(
           "shift-invert: K - sigma*M is not positive definite for sigma = " +
           std::to_string(sigma) +
-          " (the shift must lie below the lowest eigenvalue "
-          "and M must be positive definite)");
+          " (the shift must lie below the lowest eigenvalue and M must "
+          "be positive definite)");
+    }
+    stats_.factorize_s = seconds_since(start);
+    stats_.cholesky_peak_bytes = llt_.peak_memory_bytes();
   }
   void perform_op(const double* x_in, double* y_out) const {
-    Eigen::Map<const Eigen::VectorXd> x(x_in, rows());
-    Eigen::Map<Eigen::VectorXd> y(y_out, rows());
-    y = llt_.solve(x);
+    const auto start = std::chrono::steady_clock::now();
+    llt_.solve(x_in, y_out);
+    ++stats_.solves;
+    stats_.solve_s += seconds_since(start);
   }
 
 private:
   const SparseMatrix& K_;
   const SparseMatrix& M_;
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt_;
+  std::vector<int> groups_;
+  SparseCholesky llt_;
+  SparseModalStats& stats_;
 };
 
 Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, int nev) {
   const int n = s.dofs.num_equations();
   const double sigma = -std::pow(two_pi * o.shift_hz, 2);
-  CholmodShiftInvert op(s.K, s.M);
+  Modes out;
+  out.sparse = SparseModalStats{};
+  SparseModalStats& stats = *out.sparse;
+  ShiftInvert op(s.K, s.M, s.dofs.equation_nodes(), o.cholesky, stats);
   Spectra::SparseSymMatProd<double> bop(s.M);
   const int ncv = std::min(n, std::max(2 * nev + 1, nev + 20));
-  Spectra::SymGEigsShiftSolver<CholmodShiftInvert, Spectra::SparseSymMatProd<double>,
+  stats.ncv = ncv;
+  Spectra::SymGEigsShiftSolver<ShiftInvert, Spectra::SparseSymMatProd<double>,
                                Spectra::GEigsMode::ShiftInvert>
       solver(op, bop, nev, ncv, sigma);
+  const auto start = std::chrono::steady_clock::now();
   solver.init();
   solver.compute(Spectra::SortRule::LargestMagn, o.max_iterations, o.tolerance,
                  Spectra::SortRule::SmallestAlge);
-  Modes out;
+  stats.lanczos_s = seconds_since(start);
+  stats.restarts = static_cast<int>(solver.num_iterations());
   if (solver.info() != Spectra::CompInfo::Successful) {
     out.status = ModalStatus::not_converging;
     return out;

@@ -270,6 +270,7 @@ public:
     read_options(root);
     read_joints(root);
     check();
+    out_.mesh = std::move(mesh_);
     return std::move(out_);
   }
 
@@ -818,6 +819,36 @@ ModelFile read_model(const std::filesystem::path& path) {
   ModelFile out = ModelReader(path, root).read();
   out.path = path;
   return out;
+}
+
+fem::NodeDof resolve_node_dof(const ModelFile& file, std::string_view text) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string_view::npos || colon == 0)
+    throw std::invalid_argument("'" + std::string(text) +
+                                "' is not NODE:DOF (expected e.g. 7:uy, or a one-node group "
+                                "name such as tip:uy)");
+  const std::string node(text.substr(0, colon));
+  if (node.find_first_not_of("0123456789+-") == std::string::npos) return fem::parse_node_dof(text);
+  fem::NodeDof nd;
+  nd.dof = fem::parse_dof(text.substr(colon + 1));
+  if (!file.mesh)
+    throw std::invalid_argument("'" + node + "' is not a node id, and " + file.path.string() +
+                                " has no Gmsh mesh whose groups could name a node");
+  std::vector<int> ids;
+  try {
+    ids = file.mesh->nodes_in(node);
+  } catch (const Error& e) {
+    std::vector<std::string> names;
+    for (const auto& [key, name] : file.mesh->names)
+      names.push_back("\"" + name + "\"");
+    throw std::invalid_argument(std::string(e.what()) + " (groups: " + joined(names) + ")");
+  }
+  if (ids.size() != 1)
+    throw std::invalid_argument("the group '" + node + "' of " + file.mesh->path.string() +
+                                " holds " + std::to_string(ids.size()) +
+                                " nodes; a force or response point needs a group of one node");
+  nd.node = ids.front();
+  return nd;
 }
 
 } // namespace jointid::io

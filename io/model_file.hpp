@@ -1,9 +1,13 @@
 #pragma once
 /// The model file (TOML, DESIGN.md's contract): the linear substructure and its joints.
+#include "fem/dof.hpp"
 #include "fem/model.hpp"
+#include "io/gmsh.hpp"
 #include "joints/joint.hpp"
 
 #include <filesystem>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 namespace jointid::io {
@@ -11,7 +15,8 @@ namespace jointid::io {
 struct ModelFile {
   fem::Model model;
   std::vector<joints::Joint> joints;
-  std::filesystem::path path; ///< the file it was read from, for messages
+  std::filesystem::path path;   ///< the file it was read from, for messages
+  std::optional<GmshMesh> mesh; ///< the mesh it references, if any (its named groups)
 };
 
 /// Reads and checks a model file: every key known and of the right type, every reference
@@ -20,5 +25,11 @@ struct ModelFile {
 /// `fixed = ["k"]` lists terms whose `values` are known and held during identification.
 /// Throws io::Error naming the file, line, key and what was expected.
 ModelFile read_model(const std::filesystem::path& path);
+
+/// "NODE:DOF" of the model, e.g. "7:uy", where NODE is a node id or, with a Gmsh mesh, the
+/// name of a physical group holding exactly one node ("tip:uy"). The DOF is not checked
+/// against the model (fem::DofMap::equation does that). Throws std::invalid_argument saying
+/// what is wrong (no colon, unknown group and the groups there are, a group of several nodes).
+fem::NodeDof resolve_node_dof(const ModelFile& file, std::string_view text);
 
 } // namespace jointid::io

@@ -3,7 +3,7 @@
 scripts/bench_modal_scale.sh (one JSON object a line). Only the text between
 <!-- BEGIN GENERATED --> and <!-- END GENERATED --> is replaced; a missing file is created.
 
-  benchmarks_modal_table.py RUNS.jsonl OUT.md [--limits TEXT] [--quiet-load L]
+  benchmarks_modal_table.py RUNS.jsonl OUT.md [--limits TEXT] [--quiet-load L] [--note TEXT]
 """
 import argparse
 import datetime
@@ -54,9 +54,10 @@ def outcome(rec):
     if rec["rc"] == 0:
         return "ok"
     if rec["rc"] == 124:
-        return f"timed out after {rec['wall_s']:.0f} s"
-    tail = " ".join(rec.get("stderr_tail", []))[-160:]
-    return f"failed (exit {rec['rc']}) after {rec['wall_s']:.0f} s: {tail}"
+        return (f"timed out after {rec['wall_s']:.0f} s (peak RSS until then "
+                f"{rec['time_maxrss_mib']:.0f} MiB)")
+    tail = " / ".join(rec.get("output_tail", []))
+    return f"failed (exit {rec['rc']}) after {rec['wall_s']:.0f} s: `{tail}`"
 
 
 def main():
@@ -65,13 +66,15 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--limits", default="")
     ap.add_argument("--quiet-load", default="")
+    ap.add_argument("--note", default="", help="a line to add under the date, e.g. how runs were merged")
     args = ap.parse_args()
     recs = [json.loads(line) for line in open(args.runs) if line.strip()]
     by = {(r["size"], r["tool"]): r for r in recs}
     sizes = list(dict.fromkeys(r["size"] for r in recs))
 
     lines = [BEGIN, "",
-             f"Measured {datetime.date.today().isoformat()} by `scripts/bench_modal_scale.sh`.", ""]
+             f"Measured {datetime.date.today().isoformat()} by `scripts/bench_modal_scale.sh`."
+             + (f" {args.note}" if args.note else ""), ""]
     lines += machine()
     lines += [f"- limits: {args.limits}",
               f"- each run started when the 1-minute load average was below {args.quiet_load} "
@@ -84,12 +87,12 @@ def main():
               "‖KΦ−MΦΛ‖/‖KΦ‖ | max abs(ΦᵀMΦ−I) | load before→after |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     scipy_rows = []
+    stage_rows = []
     notes = []
     for size in sizes:
-        j, a = by.get((size, "jointid")), by.get((size, "analysis"))
+        j = by.get((size, "jointid"))
         jr = j.get("result") if j else None
-        ar = a.get("result") if a else None
-        geo = jr or ar or {}
+        geo = jr or (j.get("partial") if j else None) or {}
         row = [size, "×".join(str(g) for g in geo.get("grid", [])), fmt(geo.get("nodes")),
                fmt(geo.get("elements")), fmt(geo.get("dofs")), fmt(geo.get("nnz_K"))]
         if jr and j["rc"] == 0:
@@ -97,18 +100,20 @@ def main():
                     f"{jr['peak_rss_to_assembly_mib']:.0f} / {jr['peak_rss_modal_mib']:.0f}",
                     f"{jr['residual']:.1e}", f"{jr['orthonormality']:.1e}"]
         else:
-            row += ["–"] * 5
+            part = j.get("partial", {}) if j else {}
+            row += [fmt(part.get("assembly_s")), "–",
+                    f"{part['peak_rss_to_assembly_mib']:.0f} / –" if part else "–", "–", "–"]
             notes.append(f"- {size} jointid (fem::assemble + fem::modal_analysis): {outcome(j)}")
         row.append(f"{j['load_before']:.2f}→{j['load_after']:.2f}" if j else "–")
         lines.append("| " + " | ".join(row) + " |")
-        if ar:
-            p = ar.get("proto", {})
-            notes.append(
-                f"- {size}: CHOLMOD analysis of K − σM (bench proto engine, 64-bit indices, "
-                f"{p.get('ordering_used')} ordering): nnz(L) = {p.get('lnz', 0):.3g} "
-                f"({p.get('lnz', 0) * 8 / 2**30:.1f} GiB of values), factorisation "
-                f"{p.get('factor_flops', 0):.3g} flops; indexed assembly "
-                f"{ar.get('indexed_assembly_s', 0):.1f} s, analysis {p.get('analyze_s', 0):.0f} s")
+        sp = jr.get("sparse") if jr else None
+        if sp:
+            stage_rows.append("| " + " | ".join([
+                size, sp["ordering_used"], f"{sp['lnz']:.3g}", f"{sp['factor_entries']:.3g}",
+                f"{sp['factor_gib']:.2f}", f"{sp['factor_flops']:.3g}", fmt(sp["analyze_s"]),
+                fmt(sp["factorize_s"]), f"{sp['factor_flops'] / sp['factorize_s'] / 1e9:.0f}",
+                f"{fmt(sp['lanczos_s'])} ({sp['solves']} solves, {fmt(sp['solve_s'])} s)",
+                str(sp["restarts"])]) + " |")
         for tool, label in (("scipy", "eigsh default (splu, COLAMD)"),
                             ("scipy_sym", "eigsh + OPinv = splu symmetric mode (MMD_AT_PLUS_A)")):
             s = by.get((size, tool))
@@ -129,6 +134,11 @@ def main():
                 srow += [outcome(s), "–", "–", "–", "–"]
             srow.append(f"{s['load_before']:.2f}→{s['load_after']:.2f}")
             scipy_rows.append("| " + " | ".join(srow) + " |")
+    lines += ["", "jointid's sparse engine stage by stage (`Modes::sparse`; CHOLMOD supernodal, 64-bit "
+              "indices; the ordering is the candidate with the smallest predicted factor):", "",
+              "| size | ordering | nnz(L) | stored values | predicted factor + workspace GiB | "
+              "flops | analysis s | factorisation s | GFlop/s | Lanczos s (solves) | restarts |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"] + stage_rows
     lines += ["", "scipy on the same K and M (MatrixMarket files written by the bench; reading "
               "excluded from the time):", "",
               "| size | scipy call | eigsh s | peak RSS MiB (after reading / eigsh stage) | "

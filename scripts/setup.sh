@@ -3,7 +3,10 @@
 set -euo pipefail
 packages=(build-essential cmake pkg-config libeigen3-dev libspectra-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev libgmock-dev
-  libbenchmark-dev libvtk9-dev xvfb xauth)
+  libbenchmark-dev libvtk9-dev xvfb xauth
+  # OpenBLAS takes over libblas.so.3 (Debian's alternatives) from the reference BLAS, which
+  # CHOLMOD's supernodal factorisation otherwise runs on: 8x faster on a 10^5-DOF frame.
+  libopenblas0-pthread)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

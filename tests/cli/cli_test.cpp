@@ -317,6 +317,31 @@ TEST_F(CliTest, SimulateChecksEverythingBeforeWriting) {
   EXPECT_FALSE(fs::exists(dir() / "never"));
 }
 
+TEST_F(CliTest, ForceAtAOneNodeGmshGroup) {
+  // examples/portal_frame: Physical Point("corner") is mesh node 2, "base" holds both feet.
+  const fs::path portal = fs::path(JOINTID_SOURCE_DIR) / "examples/portal_frame/portal.toml";
+  const fs::path out = dir() / "portal_out";
+  const Outcome run = jointid({"simulate", portal.string(), "--force", "corner:ux", "--freq", "2",
+                               "--amplitude", "100", "--method", "hb", "--steps-per-period", "64",
+                               "--periods", "1", "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const identify::Record r = io::read_record(out / "sine_f2Hz_F100N.csv");
+  bool has_force = false;
+  for (const auto& c : r.channels)
+    has_force |= c.name() == "f@2:ux";
+  EXPECT_TRUE(has_force);
+  expect_one_line_error(jointid({"simulate", portal.string(), "--force", "base:ux", "--freq", "2",
+                                 "--amplitude", "100", "-o", (dir() / "never").string()},
+                                dir()),
+                        "holds 2 nodes");
+  expect_one_line_error(jointid({"simulate", portal.string(), "--force", "roof:ux", "--freq", "2",
+                                 "--amplitude", "100", "-o", (dir() / "never").string()},
+                                dir()),
+                        "\"corner\"");
+  EXPECT_FALSE(fs::exists(dir() / "never"));
+}
+
 TEST_F(CliTest, ModesWithABadModelKeepsTheOldFile) {
   const fs::path out = dir() / "modes_old";
   fs::create_directories(out);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 
 using namespace jointid;
 using fem::ModalEngine;
@@ -138,6 +139,15 @@ TEST(Modal, SparseEngineEqualsDenseEngine) {
     EXPECT_LE((dense.phi.col(r) - sign * sparse.phi.col(r)).norm(), 1e-7 * dense.phi.col(r).norm())
         << "mode " << r;
   }
+  // The sparse engine reports what it did; the dense one does not.
+  EXPECT_FALSE(dense.sparse.has_value());
+  ASSERT_TRUE(sparse.sparse.has_value());
+  const fem::SparseModalStats& st = *sparse.sparse;
+  EXPECT_EQ(st.factor.rows, s.dofs.num_equations());
+  EXPECT_GE(st.factor.factor_nonzeros, s.dofs.num_equations()); // at least the diagonal
+  EXPECT_NE(st.factor.ordering.find("on groups"), std::string::npos) << st.factor.ordering;
+  EXPECT_GE(st.solves, 6);
+  EXPECT_GE(st.ncv, 13);
 }
 
 TEST(Modal, SimplySupportedBeamFrequencies) {

@@ -368,6 +368,35 @@ TEST_F(GmshModelTest, ReadsThePortalFrame) {
   EXPECT_NEAR(length, 10.0, 1e-9);
 }
 
+TEST_F(GmshModelTest, NodeDofTextAcceptsIdsAndOneNodeGroups) {
+  const ModelFile file = read_model(source / "portal.toml");
+  EXPECT_EQ(resolve_node_dof(file, "corner:uy").node, 2); // Physical Point("corner") = node 2
+  EXPECT_EQ(resolve_node_dof(file, "corner:uy").dof, Dof::uy);
+  EXPECT_EQ(resolve_node_dof(file, "7:rz").node, 7);
+  auto error = [&](std::string_view text) {
+    try {
+      resolve_node_dof(file, text);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("base:ux").find("holds 2 nodes"), std::string::npos) << error("base:ux");
+  EXPECT_NE(error("roof:ux").find("\"corner\""), std::string::npos) << error("roof:ux");
+  EXPECT_NE(error("corner:uz3").find("uz3"), std::string::npos) << error("corner:uz3");
+  EXPECT_NE(error("corner").find("NODE:DOF"), std::string::npos) << error("corner");
+  // Without a mesh a name cannot be resolved.
+  ModelFile no_mesh = file;
+  no_mesh.mesh.reset();
+  EXPECT_EQ(resolve_node_dof(no_mesh, "7:ux").node, 7); // ids still work
+  try {
+    resolve_node_dof(no_mesh, "corner:ux");
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no Gmsh mesh"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(GmshModelTest, ReadsTheTableFrame) {
   const ModelFile file = read_model(source.parent_path() / "table_frame/table.toml");
   int legs = 0;
