@@ -60,33 +60,38 @@ Modes dense_modes(const Assembled& s, const ModalOptions& o) {
 }
 
 // y = (K − σM)⁻¹ x by a supernodal CHOLMOD factorisation with 64-bit indices (K − σM is SPD
-// for σ < λ_min).
+// for σ < λ_min). Factorises once per shift: Spectra calls set_shift in every solver's
+// constructor, and a frequency band may need several solvers with the same shift.
 class ShiftInvert {
 public:
   using Scalar = double;
-  // groups: the node of every equation; the fill-reducing ordering is computed on the nodes.
-  ShiftInvert(const SparseMatrix& K, const SparseMatrix& M, std::vector<int> groups,
-              const CholeskyOptions& options, SparseModalStats& stats)
-      : K_(K), M_(M), groups_(std::move(groups)), llt_(options), stats_(stats) {}
-  Eigen::Index rows() const { return K_.rows(); }
-  Eigen::Index cols() const { return K_.cols(); }
+  ShiftInvert(const Assembled& s, const ModalOptions& o, SparseModalStats& stats)
+      : system_(s), options_(o), llt_(o.cholesky), stats_(stats) {}
+  Eigen::Index rows() const { return system_.K.rows(); }
+  Eigen::Index cols() const { return system_.K.cols(); }
   void set_shift(double sigma) {
-    const SparseMatrix A = K_ - sigma * M_;
+    if (factorized_ && sigma == sigma_) return;
+    factorized_ = false;
+    const SparseMatrix A = system_.K - sigma * system_.M;
     auto start = std::chrono::steady_clock::now();
-    stats_.factor = llt_.analyze(A, groups_);
+    // The ordering is computed on the nodes: a node's DOFs share one adjacency.
+    stats_.factor = llt_.analyze(A, system_.dofs.equation_nodes());
     stats_.analyze_s = seconds_since(start);
     start = std::chrono::steady_clock::now();
     try {
       llt_.factorize(A);
-    } catch (const std::domain_error&) {
+    } catch (const NotPositiveDefinite& e) {
+      const NodeDof at = system_.dofs.node_dof(static_cast<int>(e.equation()));
       throw std::invalid_argument(
-          "shift-invert: K - sigma*M is not positive definite for sigma = " +
-          std::to_string(sigma) +
-          " (the shift must lie below the lowest eigenvalue and M must "
-          "be positive definite)");
+          "sparse modal analysis: K + (2 pi " + std::to_string(options_.shift_hz) +
+          " Hz)^2 M is not positive definite; the factorisation broke down at " + to_string(at) +
+          ". Look there for a DOF with neither stiffness nor mass (e.g. a rotation no element "
+          "or spring holds), or a negative mass or stiffness");
     }
     stats_.factorize_s = seconds_since(start);
     stats_.cholesky_peak_bytes = llt_.peak_memory_bytes();
+    sigma_ = sigma;
+    factorized_ = true;
   }
   void perform_op(const double* x_in, double* y_out) const {
     const auto start = std::chrono::steady_clock::now();
@@ -96,23 +101,24 @@ public:
   }
 
 private:
-  const SparseMatrix& K_;
-  const SparseMatrix& M_;
-  std::vector<int> groups_;
+  const Assembled& system_;
+  const ModalOptions& options_;
   SparseCholesky llt_;
   SparseModalStats& stats_;
+  double sigma_ = 0.0;
+  bool factorized_ = false;
 };
 
-Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, int nev) {
+// The nev lowest modes with the factorisation held by `op`.
+Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
+                         SparseModalStats& stats, int nev) {
   const int n = s.dofs.num_equations();
   const double sigma = -std::pow(two_pi * o.shift_hz, 2);
-  Modes out;
-  out.sparse = SparseModalStats{};
-  SparseModalStats& stats = *out.sparse;
-  ShiftInvert op(s.K, s.M, s.dofs.equation_nodes(), o.cholesky, stats);
   Spectra::SparseSymMatProd<double> bop(s.M);
   const int ncv = std::min(n, std::max(2 * nev + 1, nev + 20));
   stats.ncv = ncv;
+  stats.solves = 0;
+  stats.solve_s = 0.0;
   Spectra::SymGEigsShiftSolver<ShiftInvert, Spectra::SparseSymMatProd<double>,
                                Spectra::GEigsMode::ShiftInvert>
       solver(op, bop, nev, ncv, sigma);
@@ -122,6 +128,8 @@ Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, int nev) {
                  Spectra::SortRule::SmallestAlge);
   stats.lanczos_s = seconds_since(start);
   stats.restarts = static_cast<int>(solver.num_iterations());
+  Modes out;
+  out.sparse = stats;
   if (solver.info() != Spectra::CompInfo::Successful) {
     out.status = ModalStatus::not_converging;
     return out;
@@ -133,12 +141,15 @@ Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, int nev) {
 
 Modes sparse_modes(const Assembled& s, const ModalOptions& o) {
   const int n = s.dofs.num_equations();
-  if (o.max_frequency_hz <= 0.0) return sparse_modes_count(s, o, o.num_modes);
+  SparseModalStats stats;
+  ShiftInvert op(s, o, stats);
+  if (o.max_frequency_hz <= 0.0) return sparse_modes_count(s, o, op, stats, o.num_modes);
   // Every mode below f_max: grow the count until the highest mode found lies above f_max.
+  // The factorisation is reused; only the Lanczos iteration is repeated.
   int nev = std::max(o.num_modes, 8);
   while (true) {
     nev = std::min(nev, n - 1);
-    Modes m = sparse_modes_count(s, o, nev);
+    Modes m = sparse_modes_count(s, o, op, stats, nev);
     if (m.status != ModalStatus::success) return m;
     const double omega_max = two_pi * o.max_frequency_hz;
     if (m.omega(m.num_modes() - 1) >= omega_max || nev == n - 1) {
@@ -163,8 +174,9 @@ Modes modal_analysis(const Assembled& s, const ModalOptions& o) {
                                 " modes but the model has only " + std::to_string(n) +
                                 " free DOFs");
   ModalEngine engine = o.engine;
-  if (engine == ModalEngine::automatic)
-    engine = n <= o.dense_limit ? ModalEngine::dense : ModalEngine::sparse;
+  // Spectra needs 1 <= nev < n: a model of one or two equations is solved densely.
+  if (engine == ModalEngine::automatic || n <= 2)
+    engine = n <= std::max(o.dense_limit, 2) ? ModalEngine::dense : ModalEngine::sparse;
   if (engine == ModalEngine::sparse) {
     if (o.max_frequency_hz <= 0.0 && (o.num_modes == 0 || o.num_modes >= n))
       throw std::invalid_argument("the sparse engine finds fewer modes than DOFs (" +

@@ -3,9 +3,11 @@
 #include <cholmod.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -52,7 +54,8 @@ int cholmod_ordering(CholeskyOrdering o) {
 
 std::string gib(double bytes) {
   std::ostringstream s;
-  s.precision(3);
+  s.setf(std::ios::fixed);
+  s.precision(bytes < 10.0 * (1 << 30) ? 2 : 1);
   s << bytes / (1024.0 * 1024.0 * 1024.0) << " GiB";
   return s.str();
 }
@@ -77,13 +80,62 @@ std::string status_text(int status) {
 } // namespace
 
 double available_memory_bytes() {
-  std::ifstream in("/proc/meminfo");
-  std::string key;
-  double value = 0.0;
-  std::string unit;
-  while (in >> key >> value >> unit)
-    if (key == "MemAvailable:") return value * 1024.0; // kB
-  return -1.0;
+  double available = -1.0;
+  {
+    std::ifstream in("/proc/meminfo");
+    std::string key, unit;
+    double value = 0.0;
+    while (in >> key >> value >> unit)
+      if (key == "MemAvailable:") {
+        available = value * 1024.0; // kB
+        break;
+      }
+  }
+  // A cgroup (v2) limit, as in containers and batch jobs, can be tighter than the machine.
+  std::ifstream max_in("/sys/fs/cgroup/memory.max"), current_in("/sys/fs/cgroup/memory.current");
+  std::string max_text;
+  double current = 0.0;
+  if (max_in >> max_text && max_text != "max" && current_in >> current) {
+    const double room = std::max(0.0, std::stod(max_text) - current);
+    available = available < 0.0 ? room : std::min(available, room);
+  }
+  return available;
+}
+
+// Owners of CHOLMOD objects, so that no exception path leaks one.
+struct FreeSparse {
+  cholmod_common* common;
+  void operator()(cholmod_sparse* p) const { cholmod_l_free_sparse(&p, common); }
+};
+struct FreeFactor {
+  cholmod_common* common;
+  void operator()(cholmod_factor* p) const { cholmod_l_free_factor(&p, common); }
+};
+using SparsePtr = std::unique_ptr<cholmod_sparse, FreeSparse>;
+using FactorPtr = std::unique_ptr<cholmod_factor, FreeFactor>;
+
+// The pattern of a lower triangle: its size and a hash (FNV-1a) of its column pointers and
+// row indices, to check that factorize gets the pattern that was analysed.
+struct Pattern {
+  Long nonzeros = -1;
+  std::uint64_t hash = 0;
+  bool operator==(const Pattern&) const = default;
+};
+
+Pattern pattern_of(const cholmod_sparse& L) {
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](Long v) {
+    h ^= static_cast<std::uint64_t>(v);
+    h *= 1099511628211ull;
+  };
+  const auto* p = static_cast<const Long*>(L.p);
+  const auto* i = static_cast<const Long*>(L.i);
+  const Long n = static_cast<Long>(L.ncol);
+  for (Long j = 0; j <= n; ++j)
+    mix(p[j]);
+  for (Long k = 0; k < p[n]; ++k)
+    mix(i[k]);
+  return {p[n], h};
 }
 
 struct SparseCholesky::Impl {
@@ -91,6 +143,7 @@ struct SparseCholesky::Impl {
   CholeskyAnalysis analysis;
   mutable cholmod_common common{};
   cholmod_factor* factor = nullptr;
+  Pattern pattern; // of the analysed matrix's lower triangle
   bool factorized = false;
   // Workspace reused by every solve (cholmod_l_solve2).
   mutable cholmod_dense* x = nullptr;
@@ -110,6 +163,7 @@ struct SparseCholesky::Impl {
     }
   }
   ~Impl() {
+    // Everything CHOLMOD allocated goes back before cholmod_l_finish.
     cholmod_l_free_dense(&x, &common);
     cholmod_l_free_dense(&y, &common);
     cholmod_l_free_dense(&e, &common);
@@ -134,34 +188,43 @@ struct SparseCholesky::Impl {
     if (static_cast<Long>(groups.size()) != n)
       throw std::invalid_argument("sparse Cholesky: " + std::to_string(groups.size()) +
                                   " group numbers for " + std::to_string(n) + " equations");
-    const int num_groups = *std::max_element(groups.begin(), groups.end()) + 1;
+    if (n == 0) return {};
     if (*std::min_element(groups.begin(), groups.end()) < 0)
       throw std::invalid_argument("sparse Cholesky: negative group number");
+    const Long num_groups = Long{*std::max_element(groups.begin(), groups.end())} + 1;
+    if (num_groups > n)
+      throw std::invalid_argument("sparse Cholesky: group numbers up to " +
+                                  std::to_string(num_groups - 1) + " for " + std::to_string(n) +
+                                  " equations (expected 0 .. n-1)");
+    // Both directions of every coupling: A may hold only one triangle, and group numbers
+    // need not grow with the equation numbers.
     std::vector<Eigen::Triplet<double, int>> edges;
-    edges.reserve(static_cast<std::size_t>(A.nonZeros()));
+    edges.reserve(2 * static_cast<std::size_t>(A.nonZeros()));
     for (Long j = 0; j < n; ++j)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
         edges.emplace_back(groups[it.row()], groups[j], 1.0);
+        edges.emplace_back(groups[j], groups[it.row()], 1.0);
+      }
     Eigen::SparseMatrix<double> G(num_groups, num_groups);
     G.setFromTriplets(edges.begin(), edges.end());
     edges = {};
-    cholmod_sparse* graph = lower_triangle(G);
+    SparsePtr graph(lower_triangle(G), FreeSparse{&common});
     G = {};
     std::vector<Long> order(num_groups);
     if (ordering == CHOLMOD_NESDIS) {
       std::vector<Long> parent(num_groups), member(num_groups);
-      cholmod_l_nested_dissection(graph, nullptr, 0, order.data(), parent.data(), member.data(),
-                                  &common);
+      cholmod_l_nested_dissection(graph.get(), nullptr, 0, order.data(), parent.data(),
+                                  member.data(), &common);
     } else if (ordering == CHOLMOD_AMD) {
-      cholmod_l_amd(graph, nullptr, 0, order.data(), &common);
+      cholmod_l_amd(graph.get(), nullptr, 0, order.data(), &common);
     } else {
-      cholmod_l_metis(graph, nullptr, 0, 1, order.data(), &common);
+      cholmod_l_metis(graph.get(), nullptr, 0, 1, order.data(), &common);
     }
-    cholmod_l_free_sparse(&graph, &common);
+    graph.reset();
     check("ordering");
     std::vector<Long> start(num_groups + 1, 0);
     for (int g : groups)
-      ++start[g + 1];
+      ++start[static_cast<std::size_t>(g) + 1];
     std::vector<Long> first(num_groups + 1, 0); // first position of each group in the ordering
     for (Long k = 0; k < num_groups; ++k)
       first[k + 1] = first[k] + start[order[k] + 1];
@@ -228,6 +291,7 @@ struct SparseCholesky::Impl {
         if (it.row() >= j) ++count;
     cholmod_sparse* L = cholmod_l_allocate_sparse(n, n, count, 1, 1, -1, CHOLMOD_REAL, &common);
     check("matrix copy");
+    if (L == nullptr) throw std::runtime_error("sparse Cholesky: could not copy the matrix");
     auto* p = static_cast<Long*>(L->p);
     auto* i = static_cast<Long*>(L->i);
     auto* x = static_cast<double*>(L->x);
@@ -246,6 +310,13 @@ struct SparseCholesky::Impl {
   }
 };
 
+NotPositiveDefinite::NotPositiveDefinite(std::int64_t equation, std::int64_t rows)
+    : std::domain_error("sparse Cholesky: the matrix is not positive definite (the "
+                        "factorisation broke down at equation " +
+                        std::to_string(equation) + ", counted from 0, of " + std::to_string(rows) +
+                        ")"),
+      equation_(equation) {}
+
 SparseCholesky::SparseCholesky(CholeskyOptions options) : impl_(std::make_unique<Impl>(options)) {}
 
 SparseCholesky::~SparseCholesky() = default;
@@ -255,43 +326,51 @@ const CholeskyAnalysis& SparseCholesky::analyze(const Eigen::SparseMatrix<double
   Impl& m = *impl_;
   cholmod_l_free_factor(&m.factor, &m.common);
   m.factorized = false;
-  cholmod_sparse* lower = m.lower_triangle(A);
-  try {
-    // Candidates: CHOLMOD's own choice on the equations, or orderings of the group graph
-    // (0 = CHOLMOD on the equations). `automatic` with groups tries METIS and NESDIS on the
-    // groups and CHOLMOD's default on the equations, and keeps the factor that needs least
-    // memory: the analyses are cheap next to the factorisation, and which one wins depends
-    // on the mesh (node-wise won by 23 % on a 10⁵-DOF frame lattice, lost on a small cube).
-    std::vector<int> candidates{0};
-    if (!groups.empty())
-      candidates = m.options.ordering == CholeskyOrdering::automatic
-                       ? std::vector<int>{CHOLMOD_METIS, CHOLMOD_NESDIS, 0}
-                       : std::vector<int>{cholmod_ordering(m.options.ordering)};
-    for (int ordering : candidates) {
-      cholmod_factor* candidate = nullptr;
+  const SparsePtr lower(m.lower_triangle(A), FreeSparse{&m.common});
+  if (!groups.empty() && static_cast<Long>(groups.size()) != static_cast<Long>(A.cols()))
+    throw std::invalid_argument("sparse Cholesky: " + std::to_string(groups.size()) +
+                                " group numbers for " + std::to_string(A.cols()) + " equations");
+  // Candidates: CHOLMOD's own choice on the equations (0), or orderings of the group graph.
+  // `automatic` with groups tries METIS and NESDIS on the groups and CHOLMOD's default on the
+  // equations, and keeps the factor that needs least memory: the analyses are cheap next to
+  // the factorisation, and which wins depends on the mesh (node-wise won by 23 % on a
+  // 10⁵-DOF frame lattice and lost on a small random cube). A candidate that fails (e.g. out
+  // of memory in the partitioner) is skipped while another succeeds.
+  std::vector<int> candidates{0};
+  if (!groups.empty())
+    candidates = m.options.ordering == CholeskyOrdering::automatic
+                     ? std::vector<int>{CHOLMOD_METIS, CHOLMOD_NESDIS, 0}
+                     : std::vector<int>{cholmod_ordering(m.options.ordering)};
+  FactorPtr best(nullptr, FreeFactor{&m.common});
+  CholeskyAnalysis best_analysis;
+  std::string errors;
+  for (int ordering : candidates) {
+    try {
+      FactorPtr candidate(nullptr, FreeFactor{&m.common});
       std::string name;
       if (ordering == 0) {
-        candidate = m.symbolic(lower, nullptr);
+        candidate.reset(m.symbolic(lower.get(), nullptr));
         name = ordering_name(candidate->ordering);
       } else {
         std::vector<Long> perm = m.group_ordering(A, groups, ordering);
-        candidate = m.symbolic(lower, perm.data());
+        candidate.reset(m.symbolic(lower.get(), perm.data()));
         name = ordering_name(ordering) + " on groups";
       }
-      const CholeskyAnalysis a = m.describe(*candidate, name);
-      if (m.factor == nullptr || a.factor_bytes < m.analysis.factor_bytes) {
-        cholmod_l_free_factor(&m.factor, &m.common);
-        m.factor = candidate;
-        m.analysis = a;
-      } else {
-        cholmod_l_free_factor(&candidate, &m.common);
+      CholeskyAnalysis a = m.describe(*candidate, std::move(name));
+      if (!best || a.factor_bytes < best_analysis.factor_bytes) {
+        best = std::move(candidate);
+        best_analysis = std::move(a);
       }
+    } catch (const std::invalid_argument&) {
+      throw; // bad input: no ordering will do better
+    } catch (const std::exception& e) {
+      errors += std::string(errors.empty() ? "" : "; ") + e.what();
     }
-  } catch (...) {
-    cholmod_l_free_sparse(&lower, &m.common);
-    throw;
   }
-  cholmod_l_free_sparse(&lower, &m.common);
+  if (!best) throw std::runtime_error(errors);
+  m.factor = best.release();
+  m.analysis = std::move(best_analysis);
+  m.pattern = pattern_of(*lower);
   return m.analysis;
 }
 
@@ -302,26 +381,36 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
     throw std::invalid_argument("sparse Cholesky: factorize got a " + std::to_string(A.rows()) +
                                 " x " + std::to_string(A.cols()) + " matrix, analysed " +
                                 std::to_string(m.analysis.rows));
+  m.factorized = false;
+  const SparsePtr lower(m.lower_triangle(A), FreeSparse{&m.common});
+  if (!(pattern_of(*lower) == m.pattern))
+    throw std::invalid_argument("sparse Cholesky: factorize got a matrix whose nonzero pattern "
+                                "differs from the analysed one; analyse it again");
   if (m.options.max_memory_fraction > 0.0) {
+    // The factor's values (unless a previous factorisation allocated them) and workspace, and
+    // CHOLMOD's permuted copy of the lower triangle (values and indices, like ours).
+    const cholmod_factor& L = *m.factor;
+    const double values_held = L.is_super && L.x != nullptr ? 8.0 * L.xsize : 0.0;
+    const double copy = 16.0 * static_cast<double>(lower->nzmax) + 8.0 * (L.n + 1);
+    const double need = m.analysis.factor_bytes - values_held + copy;
     const double available = available_memory_bytes();
-    if (available > 0.0 && m.analysis.factor_bytes > m.options.max_memory_fraction * available)
+    if (available > 0.0 && need > m.options.max_memory_fraction * available)
       throw std::runtime_error("sparse Cholesky: the factor of the " +
                                std::to_string(m.analysis.rows) + "-equation matrix needs about " +
-                               gib(m.analysis.factor_bytes) + " (" +
+                               gib(need) + " (" +
                                std::to_string(static_cast<long long>(m.analysis.factor_entries)) +
-                               " stored values, " + m.analysis.ordering + " ordering), but only " +
+                               " values stored, " + m.analysis.ordering + " ordering), but only " +
                                gib(available) + " of memory is available");
   }
-  cholmod_sparse* lower = m.lower_triangle(A);
-  m.factorized = false;
-  cholmod_l_factorize(lower, m.factor, &m.common);
-  cholmod_l_free_sparse(&lower, &m.common);
+  cholmod_l_factorize(lower.get(), m.factor, &m.common);
   m.check("factorisation");
-  if (m.common.status == CHOLMOD_NOT_POSDEF || m.factor->minor < m.factor->n)
-    throw std::domain_error("sparse Cholesky: the matrix is not positive definite (the "
-                            "factorisation broke down at column " +
-                            std::to_string(m.factor->minor) + " of " + std::to_string(m.factor->n) +
-                            ")");
+  const cholmod_factor& L = *m.factor;
+  if (m.common.status == CHOLMOD_NOT_POSDEF || L.minor < L.n) {
+    // L.minor counts columns of the permuted matrix; name the caller's equation.
+    const auto column = static_cast<Long>(L.minor);
+    const Long equation = L.Perm != nullptr ? static_cast<const Long*>(L.Perm)[column] : column;
+    throw NotPositiveDefinite(equation, static_cast<std::int64_t>(L.n));
+  }
   m.factorized = true;
 }
 

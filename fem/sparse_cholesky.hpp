@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,17 @@ struct CholeskyAnalysis {
   std::string ordering;         ///< ordering used: "metis", "nesdis on groups", …
 };
 
+/// Thrown by SparseCholesky::factorize when the matrix is not positive definite; names the
+/// equation (0-based, the caller's numbering) at which the factorisation broke down.
+class NotPositiveDefinite : public std::domain_error {
+public:
+  NotPositiveDefinite(std::int64_t equation, std::int64_t rows);
+  std::int64_t equation() const { return equation_; }
+
+private:
+  std::int64_t equation_;
+};
+
 class SparseCholesky {
 public:
   explicit SparseCholesky(CholeskyOptions options = {});
@@ -62,9 +74,10 @@ public:
   const CholeskyAnalysis& analyze(const Eigen::SparseMatrix<double>& A,
                                   const std::vector<int>& groups = {});
 
-  /// Numeric factorisation of `A`, which must have the pattern given to `analyze`.
-  /// Throws std::runtime_error when the factor would not fit in memory or CHOLMOD runs out of
-  /// it, std::domain_error (naming the column) when A is not positive definite.
+  /// Numeric factorisation of `A`, which must have the pattern given to `analyze`
+  /// (std::invalid_argument otherwise). Throws std::runtime_error when the factor would not
+  /// fit in the memory available (/proc/meminfo, cgroup limit) or CHOLMOD runs out of it,
+  /// NotPositiveDefinite when A is not positive definite.
   void factorize(const Eigen::SparseMatrix<double>& A);
 
   /// x = A⁻¹ b for vectors of length rows(); b and x may not overlap.
@@ -80,8 +93,8 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
-/// Bytes the system reports available to a new allocation (Linux: MemAvailable); < 0 when
-/// unknown.
+/// Bytes the system reports available to a new allocation (Linux: MemAvailable, and the room
+/// under a cgroup v2 memory limit if tighter); < 0 when unknown.
 double available_memory_bytes();
 
 } // namespace jointid::fem

@@ -828,7 +828,10 @@ fem::NodeDof resolve_node_dof(const ModelFile& file, std::string_view text) {
                                 "' is not NODE:DOF (expected e.g. 7:uy, or a one-node group "
                                 "name such as tip:uy)");
   const std::string node(text.substr(0, colon));
-  if (node.find_first_not_of("0123456789+-") == std::string::npos) return fem::parse_node_dof(text);
+  const bool is_id =
+      node.find_first_not_of("0123456789", node[0] == '-' ? 1 : 0) == std::string::npos &&
+      node != "-";
+  if (is_id) return fem::parse_node_dof(text); // negative ids are rejected by the model
   fem::NodeDof nd;
   nd.dof = fem::parse_dof(text.substr(colon + 1));
   if (!file.mesh)
@@ -840,7 +843,7 @@ fem::NodeDof resolve_node_dof(const ModelFile& file, std::string_view text) {
   } catch (const Error& e) {
     std::vector<std::string> names;
     for (const auto& [key, name] : file.mesh->names)
-      names.push_back("\"" + name + "\"");
+      if (key.first <= 1) names.push_back("\"" + name + "\""); // groups of points or lines
     throw std::invalid_argument(std::string(e.what()) + " (groups: " + joined(names) + ")");
   }
   if (ids.size() != 1)

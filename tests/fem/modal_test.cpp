@@ -280,6 +280,47 @@ TEST(Modal, BadOptionsThrowAndMasslessDofIsANumericalIssue) {
             fem::ModalStatus::numerical_issue);
 }
 
+TEST(Modal, SparseEngineNamesTheDofThatIsNeitherStiffNorHeavy) {
+  // A spring of zero stiffness to a massless node: K − σM has a zero row at 99:uy.
+  fem::Model m = test::cantilever(10, {});
+  m.nodes.push_back({99, Eigen::Vector3d(5.0, 5.0, 0.0)});
+  m.springs.push_back({99, 0, fem::Dof::uy, 0.0});
+  fem::ModalOptions o;
+  o.num_modes = 3;
+  o.engine = ModalEngine::sparse;
+  try {
+    fem::modal_analysis(fem::assemble(m), o);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("99:uy"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Modal, BandNeedingASecondPassFindsEveryMode) {
+  // A band that needs more than the first guess of 8 modes: the count is doubled and the
+  // Lanczos run again (on the factor of the first pass). Reference: the same engine asked
+  // for 12 modes (the dense solver is only eps·λ_max/λ_1 ≈ 1e-7 accurate at mode 1 with 40
+  // elements; it serves to place the band edge between modes 12 and 13).
+  const fem::Assembled s = fem::assemble(test::cantilever(40, {}));
+  fem::ModalOptions o;
+  o.engine = ModalEngine::dense;
+  o.num_modes = 0;
+  const fem::Modes dense = fem::modal_analysis(s, o);
+  o.engine = ModalEngine::sparse;
+  o.num_modes = 12;
+  const fem::Modes all = fem::modal_analysis(s, o);
+  o.num_modes = 0;
+  o.max_frequency_hz = 0.5 * (dense.frequency_hz(11) + dense.frequency_hz(12));
+  const fem::Modes band = fem::modal_analysis(s, o);
+  ASSERT_EQ(band.status, fem::ModalStatus::success);
+  ASSERT_EQ(band.num_modes(), 12);
+  for (int r = 0; r < 12; ++r)
+    EXPECT_NEAR(band.omega(r), all.omega(r), 1e-9 * all.omega(r));
+  ASSERT_TRUE(band.sparse.has_value());
+  EXPECT_GE(band.sparse->ncv, 2 * 16 + 1); // the second pass, 16 modes
+}
+
 TEST(Modal, OscillatorFrequency) {
   // Single DOF: ω = sqrt(k/m) to rounding.
   const fem::Modes m = modes_of(test::oscillator(2.5, 1000.0), 1);
