@@ -185,25 +185,26 @@ struct SparseCholesky::Impl {
   std::vector<Long> group_ordering(const Eigen::SparseMatrix<double>& A,
                                    const std::vector<int>& groups, int ordering) {
     const Long n = A.cols();
-    if (static_cast<Long>(groups.size()) != n)
-      throw std::invalid_argument("sparse Cholesky: " + std::to_string(groups.size()) +
-                                  " group numbers for " + std::to_string(n) + " equations");
     if (n == 0) return {};
-    if (*std::min_element(groups.begin(), groups.end()) < 0)
-      throw std::invalid_argument("sparse Cholesky: negative group number");
-    const Long num_groups = Long{*std::max_element(groups.begin(), groups.end())} + 1;
-    if (num_groups > n)
-      throw std::invalid_argument("sparse Cholesky: group numbers up to " +
-                                  std::to_string(num_groups - 1) + " for " + std::to_string(n) +
-                                  " equations (expected 0 .. n-1)");
+    // Group numbers are labels: number the groups that occur 0 .. num_groups-1 (fixed nodes
+    // leave gaps in fem::DofMap's node positions).
+    std::vector<int> labels(groups);
+    std::sort(labels.begin(), labels.end());
+    labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+    const auto num_groups = static_cast<Long>(labels.size());
+    std::vector<int> group(n);
+    for (Long i = 0; i < n; ++i)
+      group[i] = static_cast<int>(std::lower_bound(labels.begin(), labels.end(), groups[i]) -
+                                  labels.begin());
+    labels = {};
     // Both directions of every coupling: A may hold only one triangle, and group numbers
     // need not grow with the equation numbers.
     std::vector<Eigen::Triplet<double, int>> edges;
     edges.reserve(2 * static_cast<std::size_t>(A.nonZeros()));
     for (Long j = 0; j < n; ++j)
       for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
-        edges.emplace_back(groups[it.row()], groups[j], 1.0);
-        edges.emplace_back(groups[j], groups[it.row()], 1.0);
+        edges.emplace_back(group[it.row()], group[j], 1.0);
+        edges.emplace_back(group[j], group[it.row()], 1.0);
       }
     Eigen::SparseMatrix<double> G(num_groups, num_groups);
     G.setFromTriplets(edges.begin(), edges.end());
@@ -223,7 +224,7 @@ struct SparseCholesky::Impl {
     graph.reset();
     check("ordering");
     std::vector<Long> start(num_groups + 1, 0);
-    for (int g : groups)
+    for (int g : group)
       ++start[static_cast<std::size_t>(g) + 1];
     std::vector<Long> first(num_groups + 1, 0); // first position of each group in the ordering
     for (Long k = 0; k < num_groups; ++k)
@@ -233,7 +234,7 @@ struct SparseCholesky::Impl {
       slot[order[k]] = first[k];
     std::vector<Long> perm(n);
     for (Long i = 0; i < n; ++i)
-      perm[slot[groups[i]]++] = i;
+      perm[slot[group[i]]++] = i;
     return perm;
   }
 

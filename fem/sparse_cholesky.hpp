@@ -66,11 +66,11 @@ public:
   SparseCholesky& operator=(const SparseCholesky&) = delete;
 
   /// Orders the lower triangle of `A` (the upper triangle is not read) and predicts the
-  /// factor. `groups`, if given, numbers the group of every equation (0-based; e.g. the node a
-  /// DOF belongs to): the ordering is then computed on the much smaller graph of the groups
-  /// and each group's equations are kept together. Throws std::invalid_argument for a
-  /// non-square matrix or bad groups, std::runtime_error when CHOLMOD fails (e.g. out of
-  /// memory).
+  /// factor. `groups`, if given, labels the group of every equation (any integers; e.g. the
+  /// node a DOF belongs to): the ordering is then computed on the much smaller graph of the
+  /// groups and each group's equations are kept together. Throws std::invalid_argument for a
+  /// non-square matrix or a wrong number of group labels, std::runtime_error when CHOLMOD fails
+  /// (e.g. out of memory).
   const CholeskyAnalysis& analyze(const Eigen::SparseMatrix<double>& A,
                                   const std::vector<int>& groups = {});
 
