@@ -1,7 +1,8 @@
 # Tests of jointid_io_vtk (included by tests/io/CMakeLists.txt). The tests read the files back
 # with VTK's readers, so they link VTK themselves.
 find_package(VTK REQUIRED COMPONENTS CommonCore CommonDataModel IOXML IOImage)
-add_executable(io_vtk_tests ${CMAKE_CURRENT_LIST_DIR}/vtk_output_test.cpp)
+add_executable(io_vtk_tests ${CMAKE_CURRENT_LIST_DIR}/vtk_output_test.cpp
+                            ${CMAKE_CURRENT_LIST_DIR}/chart_test.cpp)
 target_link_libraries(io_vtk_tests PRIVATE jointid_io_vtk GTest::gtest_main ${VTK_LIBRARIES})
 target_include_directories(io_vtk_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 gtest_discover_tests(io_vtk_tests DISCOVERY_TIMEOUT 60)
