@@ -40,6 +40,26 @@ DofMap::DofMap(const Model& model) {
       }
 }
 
+DofMap DofMap::from_dofs(const std::vector<NodeDof>& dofs) {
+  DofMap map;
+  map.listed_ = true;
+  for (const NodeDof& nd : dofs) {
+    auto [it, added] = map.index_.emplace(nd.node, static_cast<int>(map.node_ids_.size()));
+    if (added) {
+      map.node_ids_.push_back(nd.node);
+      map.eq_.push_back({absent, absent, absent, absent, absent, absent});
+    }
+    int& slot = map.eq_[it->second][static_cast<int>(nd.dof)];
+    if (slot != absent)
+      throw std::invalid_argument("DOF " + to_string(nd) + " is listed twice (as equations " +
+                                  std::to_string(slot) + " and " +
+                                  std::to_string(map.by_equation_.size()) + ")");
+    slot = static_cast<int>(map.by_equation_.size());
+    map.by_equation_.push_back(nd);
+  }
+  return map;
+}
+
 int DofMap::index_of(int node_id) const {
   const auto it = index_.find(node_id);
   return it == index_.end() ? -1 : it->second;
@@ -59,7 +79,8 @@ int DofMap::equation(const NodeDof& nd) const {
   if (e == absent)
     throw std::invalid_argument("node " + std::to_string(nd.node) + " has no DOF " +
                                 std::string(dof_name(nd.dof)) +
-                                " (no element or spring at the node uses it)");
+                                (listed_ ? " (it is not among the substructure's DOFs)"
+                                         : " (no element or spring at the node uses it)"));
   if (e == fixed) throw std::invalid_argument("DOF " + to_string(nd) + " is fixed by a support");
   return e;
 }

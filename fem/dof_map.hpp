@@ -1,7 +1,8 @@
 #pragma once
 /// Map between (node id, DOF) and equation numbers. A node has only the DOFs that an element
 /// or spring at it uses; supported (fixed) DOFs get no equation. Equations are numbered node by
-/// node in the order of Model::nodes, DOFs in the order ux uy uz rx ry rz.
+/// node in the order of Model::nodes, DOFs in the order ux uy uz rx ry rz (from_dofs: in the
+/// order of a given list, for a substructure known only at a few DOFs).
 #include "fem/model.hpp"
 
 #include <array>
@@ -16,6 +17,10 @@ public:
 
   DofMap() = default;
   explicit DofMap(const Model& model);
+  /// The DOFs of a substructure known only at these DOFs (e.g. given by its modes): equation e
+  /// is dofs[e]; node_ids() in order of first appearance; every other DOF of those nodes is
+  /// absent. Throws std::invalid_argument naming a DOF listed twice.
+  static DofMap from_dofs(const std::vector<NodeDof>& dofs);
 
   int num_equations() const { return static_cast<int>(by_equation_.size()); }
   State state(const NodeDof& nd) const;
@@ -36,6 +41,7 @@ private:
   std::unordered_map<int, int> index_; // node id → position in node_ids_
   std::vector<std::array<int, 6>> eq_; // -2 absent, -1 fixed, >= 0 equation
   std::vector<NodeDof> by_equation_;
+  bool listed_ = false; // from_dofs: an absent DOF is one the list lacks
 };
 
 } // namespace jointid::fem

@@ -3,6 +3,8 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace jointid::frf {
@@ -47,6 +49,38 @@ ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& m
       has_residual_ = true;
     }
   }
+}
+
+ModalSynthesis::ModalSynthesis(const ModalModel& modal, std::vector<int> dofs)
+    : dofs_(std::move(dofs)) {
+  modal.validate();
+  const int n = modal.num_dofs(), m = modal.num_modes(), d = static_cast<int>(dofs_.size());
+  for (int e : dofs_)
+    if (e < 0 || e >= n)
+      throw std::invalid_argument("modal synthesis: equation " + std::to_string(e) +
+                                  " out of range (the modal model has " + std::to_string(n) +
+                                  " DOFs)");
+  phi_.resize(d, m);
+  for (int i = 0; i < d; ++i)
+    phi_.row(i) = modal.shapes.col(dofs_[i]).transpose();
+  omega_ = 2.0 * std::numbers::pi * modal.frequencies_hz;
+  modal_damping_ = 2.0 * modal.damping.cwiseProduct(omega_);
+  residual_ = Eigen::MatrixXd::Zero(d, d);
+  has_residual_ = modal.residual_flexibility.size() > 0;
+  if (has_residual_)
+    for (int i = 0; i < d; ++i)
+      for (int j = 0; j < d; ++j)
+        residual_(i, j) = modal.residual_flexibility(dofs_[i], dofs_[j]);
+}
+
+ModalSynthesis ModalSynthesis::with_damping_scale(double factor) const {
+  if (!(factor > 0.0) || !std::isfinite(factor))
+    throw std::invalid_argument(
+        "modal synthesis: a damping scale factor must be finite and > 0, got " +
+        std::to_string(factor));
+  ModalSynthesis scaled = *this;
+  scaled.modal_damping_ *= factor;
+  return scaled;
 }
 
 int ModalSynthesis::position(int equation) const {

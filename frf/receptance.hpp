@@ -4,6 +4,7 @@
 /// and by a direct sparse solve of (K − ω²M + iωC), the cross-check.
 #include "fem/damping.hpp"
 #include "fem/modal.hpp"
+#include "frf/modal_model.hpp"
 
 #include <Eigen/Core>
 #include <complex>
@@ -35,15 +36,25 @@ struct ModalSynthesisOptions {
 };
 
 /// H(ω)_ij = Σ_r φ_ir φ_jr / (ω_r² − ω² + 2iζ_r ω_r ω) [+ R_ij], for DOFs among `dofs`.
-/// ζ_r comes from the model's damping (modal ratio, or Rayleigh's α/2ω_r + βω_r/2).
+/// ζ_r comes from the model's damping (modal ratio, or Rayleigh's α/2ω_r + βω_r/2), or from a
+/// modal model's ratios.
 class ModalSynthesis {
 public:
   ModalSynthesis(const fem::Assembled& system, const fem::Modes& modes, const fem::Damping& damping,
                  std::vector<int> dofs, const ModalSynthesisOptions& options = {});
+  /// From a substructure given by its modes: equation e is modal.dofs[e] (the numbering of
+  /// fem::DofMap::from_dofs), `dofs` the equations served; ω_r = 2π f_r, 2ζ_rω_r from the given
+  /// ratios, and the residual flexibility (if given) restricted to `dofs`. Validates `modal`;
+  /// throws std::invalid_argument for it or for an equation out of range.
+  ModalSynthesis(const ModalModel& modal, std::vector<int> dofs);
+  /// A copy with every mode's damping 2ζ_rω_r multiplied by `factor` (> 0; else
+  /// std::invalid_argument): "the substructure's damping is off by a factor".
+  ModalSynthesis with_damping_scale(double factor) const;
   /// Rows and columns are equation numbers, each one of `dofs`.
   CMatrix receptance(double omega, std::span<const int> rows, std::span<const int> cols) const;
   Blocks blocks(double omega, const Partition& partition) const;
   bool has_residual() const { return has_residual_; }
+  int num_modes() const { return static_cast<int>(omega_.size()); }
   const std::vector<int>& dofs() const { return dofs_; }
 
 private:

@@ -257,7 +257,8 @@ public:
   ModelFile read() {
     Table root(file_, root_, "",
                {"model", "materials", "sections", "mesh", "element_sets", "supports", "masses",
-                "springs", "damping", "options", "joints"});
+                "springs", "damping", "options", "joints", "modal"});
+    if (root.has("modal")) return read_modal_file(root);
     read_model_table(root);
     read_materials(root);
     read_sections(root);
@@ -290,7 +291,9 @@ private:
     const int id = t.to_integer(n, label);
     if (zero_is_ground && id == 0) return 0;
     if (!node_lines_.count(id))
-      t.fail_at(n, label, fmt::format("node {} does not exist in [mesh] nodes", id));
+      t.fail_at(n, label,
+                modal_ ? fmt::format("node {} is not among the [modal] dofs", id)
+                       : fmt::format("node {} does not exist in [mesh] nodes", id));
     return id;
   }
   int node_key(const Table& t, std::string_view key) {
@@ -299,6 +302,11 @@ private:
   // The nodes of a named Gmsh physical group (points, or every node of a group of lines).
   std::vector<int> group_nodes(const Table& t, const toml::node& n, const std::string& label) {
     const std::string name = t.to_string(n, label);
+    if (modal_)
+      t.fail_at(n, label,
+                "expected a node id; a substructure given by its modes ([modal]) has no groups "
+                "such as " +
+                    shown(n));
     if (!mesh_)
       t.fail_at(n, label,
                 "expected a node id; group names such as " + shown(n) +
@@ -308,6 +316,156 @@ private:
     } catch (const Error& e) {
       t.fail_at(n, label, e.what());
     }
+  }
+
+  // A substructure given by its modes: [modal], an optional [model] and the joints; the finite
+  // element tables are errors.
+  ModelFile read_modal_file(const Table& root) {
+    reject_finite_element_keys(root);
+    if (root.has("model")) read_model_table(root);
+    read_modal(root);
+    read_joints(root);
+    check_modal();
+    return std::move(out_);
+  }
+
+  void reject_finite_element_keys(const Table& root) {
+    const toml::node* first = nullptr;
+    std::string_view first_key;
+    for (std::string_view key : {"mesh", "element_sets", "materials", "sections", "supports",
+                                 "masses", "springs", "damping", "options"}) {
+      const toml::node* n = root.get(key);
+      if (!n) continue;
+      // An array of tables ([[supports]]) is reported at its first table.
+      if (const auto* a = n->as_array(); a && !a->empty() && line_of((*a)[0]) > 0) n = &(*a)[0];
+      if (!first || line_of(*n) < line_of(*first)) first = n, first_key = key;
+    }
+    if (first)
+      root.fail_at(*first, Table::key_label(first_key),
+                   "not used with [modal]: the substructure is given by its modes");
+  }
+
+  // [modal]: dofs, frequencies_hz, damping, shapes and the optional residual_flexibility.
+  void read_modal(const Table& root) {
+    Table t(file_, *table(root, "modal"), "[modal]",
+            {"dofs", "frequencies_hz", "damping", "shapes", "residual_flexibility"});
+    modal_line_ = t.line();
+    frf::ModalModel& modal = modal_.emplace();
+
+    const toml::node& dofs_node =
+        t.need("dofs", "a list of \"<node>:<dof>\" such as [\"1:uy\", \"4:uy\"]");
+    const toml::array& dofs =
+        t.to_array(dofs_node, "key 'dofs'", "\"<node>:<dof>\" strings such as \"4:uy\"");
+    if (dofs.empty()) t.fail_at(dofs_node, "key 'dofs'", "expected at least one DOF");
+    const bool planar = root.has("model") && model().dimension == 2;
+    for (std::size_t i = 0; i < dofs.size(); ++i) {
+      const std::string label = fmt::format("key 'dofs', entry {}", i + 1);
+      const std::string text = t.to_string(dofs[i], label);
+      fem::NodeDof nd;
+      try {
+        nd = fem::parse_node_dof(text);
+      } catch (const std::invalid_argument&) {
+        t.fail_at(dofs[i], label,
+                  "expected \"<node>:<dof>\" with a node id and one of ux, uy, uz, rx, ry, rz "
+                  "(e.g. \"4:uy\"), got " +
+                      shown(dofs[i]));
+      }
+      if (nd.node <= 0)
+        t.fail_at(dofs[i], label,
+                  fmt::format("node ids must be > 0 (0 means ground), got {}", shown(dofs[i])));
+      for (std::size_t k = 0; k < i; ++k)
+        if (modal.dofs[k] == nd)
+          t.fail_at(dofs[i], label, fmt::format("{} is already entry {}", shown(dofs[i]), k + 1));
+      if (planar && nd.dof != fem::Dof::ux && nd.dof != fem::Dof::uy && nd.dof != fem::Dof::rz)
+        t.fail_at(dofs[i], label,
+                  "a planar model (dimension = 2) has only ux, uy and rz, got " + shown(dofs[i]));
+      modal.dofs.push_back(nd);
+      node_lines_.emplace(nd.node, line_of(dofs[i]) > 0 ? line_of(dofs[i]) : t.line());
+    }
+    const std::size_t n = modal.dofs.size();
+
+    const toml::node& f_node = t.need("frequencies_hz", "a list of natural frequencies in Hz");
+    const toml::array& f = t.to_array(f_node, "key 'frequencies_hz'", "frequencies in Hz");
+    if (f.empty()) t.fail_at(f_node, "key 'frequencies_hz'", "expected at least one mode");
+    const std::size_t m = f.size();
+    modal.frequencies_hz.resize(static_cast<Eigen::Index>(m));
+    for (std::size_t r = 0; r < m; ++r) {
+      const std::string label = fmt::format("key 'frequencies_hz', entry {}", r + 1);
+      const double value = t.to_number(f[r], label);
+      if (!(value >= 0.0))
+        t.fail_at(f[r], label, fmt::format("expected a frequency >= 0 Hz, got {}", value));
+      modal.frequencies_hz(static_cast<Eigen::Index>(r)) = value;
+    }
+
+    const toml::node& d_node = t.need("damping", "a list of modal damping ratios, one per mode");
+    const toml::array& d = t.to_array(d_node, "key 'damping'", "damping ratios");
+    if (d.size() != m)
+      t.fail_at(d_node, "key 'damping'",
+                fmt::format("expected {} damping ratio{} (one per entry of frequencies_hz), got {}",
+                            m, m > 1 ? "s" : "", d.size()));
+    modal.damping.resize(static_cast<Eigen::Index>(m));
+    for (std::size_t r = 0; r < m; ++r) {
+      const std::string label = fmt::format("key 'damping', entry {}", r + 1);
+      const double value = t.to_number(d[r], label);
+      if (!(value >= 0.0))
+        t.fail_at(d[r], label, fmt::format("expected a damping ratio >= 0, got {}", value));
+      modal.damping(static_cast<Eigen::Index>(r)) = value;
+    }
+
+    modal.shapes = matrix(t, "shapes", m, n, "one row per mode (as frequencies_hz)",
+                          "one column per entry of dofs");
+    if (t.has("residual_flexibility")) {
+      const Eigen::MatrixXd R = matrix(t, "residual_flexibility", n, n, "one row per entry of dofs",
+                                       "one column per entry of dofs");
+      const double tolerance = 1e-9 * R.cwiseAbs().maxCoeff();
+      const toml::array& rows = *t.get("residual_flexibility")->as_array();
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j) {
+          const auto a = static_cast<Eigen::Index>(i), b = static_cast<Eigen::Index>(j);
+          if (std::abs(R(a, b) - R(b, a)) > tolerance)
+            t.fail_at((*rows[j].as_array())[i],
+                      fmt::format("key 'residual_flexibility', row {}", j + 1),
+                      fmt::format("expected a symmetric matrix (m/N): entry {} of row {} is {}, "
+                                  "entry {} of row {} is {}",
+                                  i + 1, j + 1, R(b, a), j + 1, i + 1, R(a, b)));
+        }
+      modal.residual_flexibility = R;
+    }
+  }
+
+  // A rows × cols matrix written as a list of rows of numbers.
+  Eigen::MatrixXd matrix(const Table& t, std::string_view key, std::size_t rows, std::size_t cols,
+                         std::string_view row_meaning, std::string_view col_meaning) {
+    const std::string label = Table::key_label(key);
+    const std::string expected =
+        fmt::format("{} rows of {} numbers ({}, {})", rows, cols, row_meaning, col_meaning);
+    const toml::node& node = t.need(key, expected);
+    const toml::array& list = t.to_array(node, label, "rows of numbers");
+    if (list.size() != rows)
+      t.fail_at(node, label, fmt::format("expected {}, got {} rows", expected, list.size()));
+    Eigen::MatrixXd out(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
+    for (std::size_t i = 0; i < rows; ++i) {
+      const std::string row_label = fmt::format("key '{}', row {}", key, i + 1);
+      const auto* row = list[i].as_array();
+      if (!row || row->size() != cols)
+        t.fail_at(list[i], row_label,
+                  fmt::format("expected {} numbers ({}), got {}", cols, col_meaning,
+                              row ? fmt::format("{} numbers", row->size()) : shown(list[i])));
+      for (std::size_t j = 0; j < cols; ++j)
+        out(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+            t.to_number((*row)[j], row_label);
+    }
+    return out;
+  }
+
+  void check_modal() {
+    try {
+      modal_->validate();
+    } catch (const std::invalid_argument& e) {
+      file_.fail(modal_line_, std::string("[modal]: ") + e.what());
+    }
+    check_joints(fem::DofMap::from_dofs(modal_->dofs));
+    out_.modal = std::move(modal_);
   }
 
   void read_model_table(const Table& root) {
@@ -779,6 +937,11 @@ private:
     } catch (const std::exception& e) {
       file_.fail(0, e.what());
     }
+    check_joints(dofs);
+  }
+
+  // Joints on free DOFs, each reported at its line; then the checks across joints.
+  void check_joints(const fem::DofMap& dofs) {
     for (std::size_t i = 0; i < out_.joints.size(); ++i) {
       try {
         joints::validate_joints({out_.joints[i]}, dofs);
@@ -803,6 +966,8 @@ private:
   int elements_line_ = 0;
   std::map<std::string, int> material_index_, section_index_;
   std::vector<int> joint_lines_;
+  std::optional<frf::ModalModel> modal_; // [modal], while it is read
+  int modal_line_ = 0;
 };
 
 } // namespace
@@ -819,6 +984,10 @@ ModelFile read_model(const std::filesystem::path& path) {
   ModelFile out = ModelReader(path, root).read();
   out.path = path;
   return out;
+}
+
+frf::Substructure ModelFile::substructure() const {
+  return modal ? frf::Substructure(*modal) : frf::Substructure(model);
 }
 
 fem::NodeDof resolve_node_dof(const ModelFile& file, std::string_view text) {

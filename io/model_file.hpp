@@ -2,6 +2,8 @@
 /// The model file (TOML, DESIGN.md's contract): the linear substructure and its joints.
 #include "fem/dof.hpp"
 #include "fem/model.hpp"
+#include "frf/modal_model.hpp"
+#include "frf/substructure.hpp"
 #include "io/gmsh.hpp"
 #include "joints/joint.hpp"
 
@@ -13,16 +15,24 @@
 namespace jointid::io {
 
 struct ModelFile {
-  fem::Model model;
+  fem::Model model; ///< the finite element model (left empty with [modal])
   std::vector<joints::Joint> joints;
-  std::filesystem::path path;   ///< the file it was read from, for messages
-  std::optional<GmshMesh> mesh; ///< the mesh it references, if any (its named groups)
+  std::filesystem::path path;           ///< the file it was read from, for messages
+  std::optional<GmshMesh> mesh;         ///< the mesh it references, if any (its named groups)
+  std::optional<frf::ModalModel> modal; ///< the substructure given by its modes ([modal])
+
+  /// The linear substructure: the modal model if given, else the finite element model
+  /// (validated and assembled on each call).
+  frf::Substructure substructure() const;
 };
 
 /// Reads and checks a model file: every key known and of the right type, every reference
 /// resolved, every element in exactly one element set, the model valid (fem::Model::validate)
 /// and the joints on free DOFs (joints::validate_joints). Extension to the contract: a joint's
 /// `fixed = ["k"]` lists terms whose `values` are known and held during identification.
+/// With [modal] (a substructure given by its modes, DESIGN.md) the finite element tables are
+/// errors, [model] is optional (dimension = 2 allows only ux, uy, rz) and the joints must be on
+/// the listed DOFs (fem::DofMap::from_dofs).
 /// Throws io::Error naming the file, line, key and what was expected.
 ModelFile read_model(const std::filesystem::path& path);
 

@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <set>
 #include <string>
+#include <vector>
 
 using namespace jointid;
 using fem::Dof;
@@ -125,4 +127,44 @@ TEST(DofMap, SingleOscillatorWithoutElements) {
   const fem::Assembled s = fem::assemble(m);
   EXPECT_EQ(Eigen::MatrixXd(s.K)(0, 0), 800.0);
   EXPECT_EQ(Eigen::MatrixXd(s.M)(0, 0), 2.0);
+}
+
+TEST(DofMap, FromDofsNumbersInListOrder) {
+  // A substructure known only at these DOFs (e.g. by its modes): equation e is the e-th entry,
+  // nodes in order of first appearance, whatever the node ids and DOF kinds.
+  const std::vector<fem::NodeDof> list{{4, Dof::uy}, {1, Dof::rz}, {4, Dof::ux}, {9, Dof::uz}};
+  const fem::DofMap dofs = fem::DofMap::from_dofs(list);
+  ASSERT_EQ(dofs.num_equations(), 4);
+  for (int e = 0; e < 4; ++e) {
+    EXPECT_EQ(dofs.equation(list[e]), e);
+    EXPECT_EQ(dofs.node_dof(e), list[e]);
+    EXPECT_EQ(dofs.state(list[e]), State::free);
+  }
+  EXPECT_EQ(dofs.node_ids(), (std::vector<int>{4, 1, 9}));
+  EXPECT_EQ(dofs.node_equations(4), (std::array<int, 6>{2, 0, -1, -1, -1, -1}));
+  EXPECT_EQ(dofs.node_equations(1), (std::array<int, 6>{-1, -1, -1, -1, -1, 1}));
+  EXPECT_EQ(dofs.equation_nodes(), (std::vector<int>{0, 1, 0, 2}));
+  // Every other DOF of a listed node is absent, never fixed.
+  for (Dof d : {Dof::uz, Dof::rx, Dof::ry, Dof::rz})
+    EXPECT_EQ(dofs.state({4, d}), State::absent) << fem::dof_name(d);
+  EXPECT_EQ(dofs.state({1, Dof::uy}), State::absent);
+  EXPECT_EQ(dofs.state({2, Dof::uy}), State::absent); // not a node of the list
+  EXPECT_EQ(fem::DofMap::from_dofs({}).num_equations(), 0);
+}
+
+TEST(DofMap, FromDofsErrors) {
+  const fem::DofMap dofs = fem::DofMap::from_dofs({{4, Dof::uy}, {7, Dof::uy}});
+  const std::string absent = equation_error(dofs, {4, Dof::rz});
+  EXPECT_TRUE(contains(absent, "node 4") && contains(absent, "rz") &&
+              contains(absent, "not among the substructure's DOFs"))
+      << absent;
+  const std::string missing = equation_error(dofs, {5, Dof::uy});
+  EXPECT_TRUE(contains(missing, "node 5") && contains(missing, "does not exist")) << missing;
+  EXPECT_THROW(dofs.node_equations(5), std::invalid_argument);
+  try {
+    fem::DofMap::from_dofs({{4, Dof::uy}, {7, Dof::uy}, {4, Dof::uy}});
+    FAIL() << "a DOF listed twice was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_TRUE(contains(e.what(), "4:uy") && contains(e.what(), "twice")) << e.what();
+  }
 }

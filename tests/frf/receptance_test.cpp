@@ -3,12 +3,15 @@
 #include "frf/receptance.hpp"
 
 #include "support/beam_models.hpp"
+#include "support/cantilever.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <vector>
 
 using namespace jointid;
@@ -213,4 +216,152 @@ TEST(Receptance, BadInputThrows) {
   fem::Modes failed = modes;
   failed.status = fem::ModalStatus::not_converging;
   EXPECT_THROW(frf::ModalSynthesis(c.system, failed, d, c.dofs), std::invalid_argument);
+}
+
+// A substructure given by its modes (frf::ModalModel): the paper cantilever's FE modes at two
+// DOFs, 4:uy (mid-span) and 7:uy (tip), as a modal test would give them.
+namespace {
+
+struct PaperModes {
+  PaperModes() : model(test::paper_cantilever()), system(fem::assemble(model)) {
+    modes = all_modes(system);
+    equations = {system.dofs.equation({4, Dof::uy}), system.dofs.equation({7, Dof::uy})};
+  }
+  // The first `count` modes as a ModalModel on 4:uy, 7:uy with the model's 1 % damping.
+  frf::ModalModel modal(int count) const {
+    frf::ModalModel m;
+    m.dofs = {{4, Dof::uy}, {7, Dof::uy}};
+    m.frequencies_hz = modes.omega.head(count) / two_pi;
+    m.damping = Eigen::VectorXd::Constant(count, model.damping.modal_ratio);
+    m.shapes.resize(count, 2);
+    for (int i = 0; i < 2; ++i)
+      m.shapes.col(i) = modes.phi.row(equations[i]).head(count).transpose();
+    return m;
+  }
+  fem::Modes first(int count) const {
+    fem::Modes m = modes;
+    m.omega = modes.omega.head(count).eval();
+    m.phi = modes.phi.leftCols(count).eval();
+    return m;
+  }
+  fem::Model model;
+  fem::Assembled system;
+  fem::Modes modes;
+  std::vector<int> equations; // FE equations of 4:uy, 7:uy
+};
+
+} // namespace
+
+TEST(ReceptanceOfAModalModel, EqualsTheFESynthesisOfTheSameModes) {
+  // The same 5 modes, no residual, through the FE constructor and through a ModalModel (whose
+  // equations 0, 1 are 4:uy, 7:uy): only f = ω/2π and back differ, ≈ 1e-16 relative.
+  const PaperModes p;
+  const std::vector<int> served{0, 1};
+  const frf::ModalSynthesis fe(p.system, p.first(5), p.model.damping, p.equations,
+                               {.residual_flexibility = false});
+  const frf::ModalSynthesis modal(p.modal(5), served);
+  EXPECT_FALSE(modal.has_residual());
+  EXPECT_EQ(modal.num_modes(), 5);
+  for (double w : {0.0, 0.5 * p.modes.omega(0), p.modes.omega(0), p.modes.omega(1),
+                   0.5 * (p.modes.omega(2) + p.modes.omega(3)), 2.0 * p.modes.omega(4)}) {
+    const frf::CMatrix expected = fe.receptance(w, p.equations, p.equations);
+    EXPECT_LE(relative_difference(modal.receptance(w, served, served), expected), 1e-12)
+        << "ω = " << w;
+  }
+}
+
+TEST(ReceptanceOfAModalModel, AllModesEqualTheDirectSolve) {
+  // All 12 modes of the 6-element model, no residual: an exact rewriting of
+  // (K − ω²M + iωC)⁻¹ with the modal C; the direct sparse LU is the independent reference
+  // (agreement ≈ cond·eps, 1e-9 as in AllModesEqualTheDirectSolve above).
+  const PaperModes p;
+  const int n = p.system.dofs.num_equations();
+  ASSERT_EQ(n, 12);
+  const frf::ModalSynthesis modal(p.modal(n), {0, 1});
+  const fem::SparseMatrix C = fem::damping_matrix(p.system, p.model.damping, &p.modes);
+  const std::vector<int> served{0, 1};
+  for (double w : {0.0, two_pi * 1.0, p.modes.omega(0), two_pi * 10.0, p.modes.omega(1),
+                   1.7 * p.modes.omega(5)}) {
+    const frf::CMatrix direct = frf::direct_receptance(p.system, C, w, p.equations, p.equations);
+    EXPECT_LE(relative_difference(modal.receptance(w, served, served), direct), 1e-9)
+        << "ω = " << w;
+  }
+}
+
+TEST(ReceptanceOfAModalModel, TruncatedModesWithTheExactResidualHaveTheStaticFlexibility) {
+  // 2 modes plus R = K⁻¹ − Σ_kept φφᵀ/ω_r² on 4:uy, 7:uy: at ω = 0 the synthesis is K⁻¹, whose
+  // entries for a tip load are those of Euler–Bernoulli statics (cubic elements are exact at
+  // the nodes): δ_tip = L³/3EI, δ_mid = 5L³/48EI per unit tip load, and L³/24EI at mid-span
+  // for a mid-span load. K⁻¹ from a dense LU; tolerance cond(K)·eps ≈ 1e-10 relative.
+  const PaperModes p;
+  const Eigen::MatrixXd flex = test::dense_flexibility(p.system);
+  frf::ModalModel m = p.modal(2);
+  Eigen::Matrix2d R;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      R(i, j) = flex(p.equations[i], p.equations[j]);
+  for (int r = 0; r < 2; ++r)
+    R -= m.shapes.row(r).transpose() * m.shapes.row(r) / std::pow(p.modes.omega(r), 2);
+  m.residual_flexibility = 0.5 * (R + R.transpose());
+  const frf::ModalSynthesis H(m, {0, 1});
+  EXPECT_TRUE(H.has_residual());
+  const std::vector<int> served{0, 1};
+  const frf::CMatrix H0 = H.receptance(0.0, served, served);
+
+  const double L = 2.0, E = 210e9, b = 0.25, t = 0.0143622750907616, I = b * t * t * t / 12.0;
+  Eigen::Matrix2d statics;
+  statics << std::pow(L, 3) / (24 * E * I), 5 * std::pow(L, 3) / (48 * E * I),
+      5 * std::pow(L, 3) / (48 * E * I), std::pow(L, 3) / (3 * E * I);
+  EXPECT_LE((H0.real() - statics).norm(), 1e-9 * statics.norm()) << H0.real();
+  EXPECT_LE(H0.imag().norm(), 1e-15 * statics.norm());
+  // The residual matters: without it the static tip flexibility is short by what modes 3–12
+  // carry (a few per mille, far above the tolerance).
+  frf::ModalModel bare = m;
+  bare.residual_flexibility.resize(0, 0);
+  const frf::CMatrix H0_bare = frf::ModalSynthesis(bare, {0, 1}).receptance(0.0, served, served);
+  EXPECT_GT((H0_bare.real() - statics).norm(), 1e-4 * statics.norm());
+  // Serving one equation restricts the residual to it.
+  const std::vector<int> tip{1};
+  const frf::ModalSynthesis tip_only(m, tip);
+  EXPECT_NEAR(tip_only.receptance(0.0, tip, tip)(0, 0).real(), statics(1, 1), 1e-9 * statics(1, 1));
+}
+
+TEST(ReceptanceOfAModalModel, DampingScaleDoublesTheDampingOfASingleMode) {
+  // One mode f = 12 Hz, ζ = 0.02, φ = 0.4/sqrt(kg) at one DOF: 1/H = (ω_r² − ω² + 2iζω_rω)/φ².
+  // Scaling the damping by 2 doubles Im(1/H) = 2ζω_rω/φ² and leaves Re(1/H) as it is.
+  frf::ModalModel m;
+  m.dofs = {{3, Dof::ux}};
+  m.frequencies_hz = Eigen::VectorXd::Constant(1, 12.0);
+  m.damping = Eigen::VectorXd::Constant(1, 0.02);
+  m.shapes = Eigen::MatrixXd::Constant(1, 1, 0.4);
+  const std::vector<int> e{0};
+  const frf::ModalSynthesis H(m, e);
+  const frf::ModalSynthesis doubled = H.with_damping_scale(2.0);
+  const double wr = two_pi * 12.0, phi2 = 0.16;
+  for (double w : {wr, 0.8 * wr}) {
+    const frf::Complex inv = 1.0 / H.receptance(w, e, e)(0, 0);
+    const frf::Complex inv2 = 1.0 / doubled.receptance(w, e, e)(0, 0);
+    const double im = 2 * 0.02 * wr * w / phi2, re = (wr * wr - w * w) / phi2;
+    EXPECT_NEAR(inv.imag(), im, 1e-12 * im) << "ω = " << w;
+    EXPECT_NEAR(inv2.imag(), 2 * im, 1e-12 * im) << "ω = " << w;
+    EXPECT_NEAR(inv.real(), re, 1e-12 * std::abs(im)) << "ω = " << w;
+    EXPECT_NEAR(inv2.real(), re, 1e-12 * std::abs(im)) << "ω = " << w;
+  }
+  // The original is untouched; bad factors are refused.
+  EXPECT_NEAR((1.0 / H.receptance(wr, e, e)(0, 0)).imag(), 2 * 0.02 * wr * wr / phi2, 1e-6);
+  for (double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity()})
+    EXPECT_THROW(H.with_damping_scale(bad), std::invalid_argument) << bad;
+}
+
+TEST(ReceptanceOfAModalModel, BadInputThrows) {
+  const PaperModes p;
+  EXPECT_THROW(frf::ModalSynthesis(p.modal(3), {0, 2}), std::invalid_argument); // 2 DOFs only
+  EXPECT_THROW(frf::ModalSynthesis(p.modal(3), {-1}), std::invalid_argument);
+  frf::ModalModel bad = p.modal(3);
+  bad.damping(1) = -0.01;
+  EXPECT_THROW(frf::ModalSynthesis(bad, {0}), std::invalid_argument); // validated
+  const frf::ModalSynthesis H(p.modal(3), {1});
+  const std::vector<int> other{0};
+  EXPECT_THROW(H.receptance(1.0, other, other), std::invalid_argument);
 }

@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace jointid::io {
 namespace {
@@ -317,6 +320,193 @@ TEST_F(ModelFileTest, MissingFileIsNamed) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("nothing.toml"), std::string::npos) << e.what();
   }
+}
+
+// A substructure given by its modes ([modal], DESIGN.md): two modes at three DOFs, a residual
+// flexibility and a joint to ground at 4:uy.
+std::string modal_toml() {
+  return "# a substructure given by its modes\n"
+         "[model]\n"
+         "dimension = 2\n"
+         "\n"
+         "[modal]\n"
+         "dofs = [\"1:uy\", \"4:uy\", \"4:rz\"]\n"
+         "frequencies_hz = [80.3, 212.0]\n"
+         "damping = [0.0012, 0.002]\n"
+         "shapes = [[0.91, -0.40, 0.5],\n"
+         "          [0.35, 0.88, -1.5]]\n"
+         "residual_flexibility = [[1e-7, 0.0, 2e-9],\n"
+         "                        [0.0, 2e-7, 0.0],\n"
+         "                        [2e-9, 0.0, 3e-7]]\n"
+         "\n"
+         "[[joints]]\n"
+         "name = \"tip\"\n"
+         "node = 4\n"
+         "dof = \"uy\"\n"
+         "terms = [\"k\", \"c\"]\n"
+         "values = { k = 4800.0, c = 20.0 }\n";
+}
+
+TEST_F(ModelFileTest, ReadsAModalSubstructure) {
+  const ModelFile file = read_model(write(modal_toml()));
+  ASSERT_TRUE(file.modal.has_value());
+  const frf::ModalModel& m = *file.modal;
+  EXPECT_EQ(m.dofs, (std::vector<fem::NodeDof>{{1, Dof::uy}, {4, Dof::uy}, {4, Dof::rz}}));
+  ASSERT_EQ(m.frequencies_hz.size(), 2);
+  EXPECT_EQ(m.frequencies_hz(0), 80.3);
+  EXPECT_EQ(m.frequencies_hz(1), 212.0);
+  ASSERT_EQ(m.damping.size(), 2);
+  EXPECT_EQ(m.damping(0), 0.0012);
+  EXPECT_EQ(m.damping(1), 0.002);
+  ASSERT_EQ(m.shapes.rows(), 2); // one row per mode
+  ASSERT_EQ(m.shapes.cols(), 3); // one column per DOF
+  EXPECT_EQ(m.shapes(0, 1), -0.40);
+  EXPECT_EQ(m.shapes(1, 2), -1.5);
+  ASSERT_EQ(m.residual_flexibility.rows(), 3);
+  ASSERT_EQ(m.residual_flexibility.cols(), 3);
+  EXPECT_EQ(m.residual_flexibility(0, 2), 2e-9);
+  EXPECT_EQ(m.residual_flexibility(2, 2), 3e-7);
+  EXPECT_TRUE(file.model.nodes.empty()); // no finite element model
+  EXPECT_FALSE(file.mesh.has_value());
+  ASSERT_EQ(file.joints.size(), 1u);
+  EXPECT_EQ(file.joints[0].node, 4);
+  EXPECT_EQ(file.joints[0].dof, Dof::uy);
+  EXPECT_EQ(file.joints[0].values, (std::vector<double>{4800.0, 20.0}));
+
+  // The substructure is the modal one, its equations numbered as `dofs`.
+  const frf::Substructure sub = file.substructure();
+  ASSERT_NE(sub.modal(), nullptr);
+  EXPECT_EQ(sub.system(), nullptr);
+  EXPECT_EQ(sub.dofs().equation({4, Dof::rz}), 2);
+  EXPECT_EQ(resolve_node_dof(file, "4:uy").node, 4);
+}
+
+TEST_F(ModelFileTest, ModalWithoutModelTableOrResidual) {
+  // [model] is optional with [modal], and then any of the six DOFs may be listed.
+  std::string text = test::replaced(modal_toml(), "[model]\ndimension = 2\n", "");
+  text = test::replaced(text, "\"4:rz\"]", "\"4:uz\"]");
+  const auto begin = text.find("residual_flexibility");
+  text.erase(begin, text.find("\n\n[[joints]]") - begin);
+  const ModelFile file = read_model(write(text));
+  ASSERT_TRUE(file.modal.has_value());
+  EXPECT_EQ(file.modal->dofs[2], (fem::NodeDof{4, Dof::uz}));
+  EXPECT_EQ(file.modal->residual_flexibility.size(), 0);
+  EXPECT_FALSE(file.substructure().synthesis({0, 1}, 0.0).has_residual());
+}
+
+TEST_F(ModelFileTest, FiniteElementModelFileHasNoModal) {
+  const ModelFile file = read_model(write(cantilever_toml()));
+  EXPECT_FALSE(file.modal.has_value());
+  const frf::Substructure sub = file.substructure();
+  ASSERT_NE(sub.system(), nullptr);
+  EXPECT_EQ(sub.dofs().num_equations(), 12);
+}
+
+TEST_F(ModelFileTest, FiniteElementTablesAreErrorsWithModal) {
+  const std::string why = "not used with [modal]: the substructure is given by its modes";
+  const std::pair<std::string, std::string> tables[] = {
+      {"[mesh]", "[mesh]\nnodes = [[1, 0.0, 0.0]]\n"},
+      {"[[element_sets]]", "[[element_sets]]\nelements = \"all\"\n"},
+      {"[[materials]]", "[[materials]]\nname = \"steel\"\n"},
+      {"[[sections]]", "[[sections]]\nname = \"bar\"\n"},
+      {"[[supports]]", "[[supports]]\nnode = 1\nfix = [\"uy\"]\n"},
+      {"[[masses]]", "[[masses]]\nnode = 4\nmass = 1.0\n"},
+      {"[[springs]]", "[[springs]]\nnode = 4\ndof = \"uy\"\nstiffness = 1.0\n"},
+      {"[damping]", "[damping]\nmodal = 0.01\n"},
+      {"[options]", "[options]\nlumped_mass = true\n"},
+  };
+  for (const auto& [header, table] : tables) {
+    SCOPED_TRACE(header);
+    const std::string key = header.substr(header.find_first_not_of('['),
+                                          header.find(']') - header.find_first_not_of('['));
+    // After the joints, and (a second time) before [modal].
+    const std::string after = modal_toml() + "\n" + table;
+    expect_error(after, test::line_of(after, header), {"key '" + key + "'", why});
+    const std::string before = test::replaced(modal_toml(), "[modal]\n", table + "\n[modal]\n");
+    expect_error(before, test::line_of(before, header), {"key '" + key + "'", why});
+  }
+}
+
+TEST_F(ModelFileTest, ModalDofErrorsNameTheEntry) {
+  const std::string dofs = "dofs = [\"1:uy\", \"4:uy\", \"4:rz\"]";
+  auto with_dofs = [&](const std::string& replacement) {
+    return test::replaced(modal_toml(), dofs, replacement);
+  };
+  std::string text = with_dofs("dofs = [\"1:uy\", \"4:uy\", \"4:uz\"]");
+  expect_error(text, test::line_of(text, "dofs ="),
+               {"[modal]", "key 'dofs', entry 3",
+                "a planar model (dimension = 2) has only ux, uy and rz", "\"4:uz\""});
+  text = with_dofs("dofs = [\"1:uy\", \"4:uw\", \"4:rz\"]");
+  expect_error(text, test::line_of(text, "dofs ="),
+               {"[modal]", "key 'dofs', entry 2", "expected \"<node>:<dof>\"", "\"4:uw\""});
+  text = with_dofs("dofs = [\"1:uy\", \"0:uy\", \"4:rz\"]");
+  expect_error(text, test::line_of(text, "dofs ="), {"key 'dofs', entry 2", "must be > 0"});
+  text = with_dofs("dofs = [\"1:uy\", \"4:uy\", \"1:uy\"]");
+  expect_error(text, test::line_of(text, "dofs ="),
+               {"key 'dofs', entry 3", "\"1:uy\" is already entry 1"});
+  text = with_dofs("dofs = [1, 4]");
+  expect_error(text, test::line_of(text, "dofs ="), {"key 'dofs', entry 1", "expected a string"});
+  text = with_dofs("dofs = []");
+  expect_error(text, test::line_of(text, "dofs ="), {"key 'dofs'", "at least one DOF"});
+  text = with_dofs("");
+  expect_error(text, test::line_of(text, "[modal]"), {"[modal]", "missing key 'dofs'"});
+  text = with_dofs(dofs + "\nfrequencies = [1.0]");
+  expect_error(text, test::line_of(text, "frequencies = "),
+               {"[modal]", "unknown key 'frequencies'", "frequencies_hz"});
+}
+
+TEST_F(ModelFileTest, ModalValueErrorsNameKeyAndLine) {
+  std::string text =
+      test::replaced(modal_toml(), "frequencies_hz = [80.3, 212.0]", "frequencies_hz = [80.3, -2]");
+  expect_error(
+      text, test::line_of(text, "frequencies_hz"),
+      {"[modal]", "key 'frequencies_hz', entry 2", "expected a frequency >= 0 Hz, got -2"});
+  text = test::replaced(modal_toml(), "frequencies_hz = [80.3, 212.0]", "frequencies_hz = []");
+  expect_error(text, test::line_of(text, "frequencies_hz"),
+               {"key 'frequencies_hz'", "at least one mode"});
+  text = test::replaced(modal_toml(), "damping = [0.0012, 0.002]", "damping = [0.0012]");
+  expect_error(text, test::line_of(text, "damping ="),
+               {"[modal]", "key 'damping'", "expected 2 damping ratios", "got 1"});
+  text = test::replaced(modal_toml(), "damping = [0.0012, 0.002]", "damping = [-0.1, 0.002]");
+  expect_error(text, test::line_of(text, "damping ="),
+               {"key 'damping', entry 1", "expected a damping ratio >= 0, got -0.1"});
+  text = test::replaced(modal_toml(), "damping = [0.0012, 0.002]", "damping = [0.0012, \"1%\"]");
+  expect_error(text, test::line_of(text, "damping ="),
+               {"key 'damping', entry 2", "expected a number", "\"1%\""});
+  text = test::replaced(modal_toml(), "[0.35, 0.88, -1.5]]", "[0.35, 0.88]]");
+  expect_error(text, test::line_of(text, "[0.35, 0.88]]"),
+               {"[modal]", "key 'shapes', row 2", "expected 3 numbers",
+                "one column per entry of dofs", "got 2 numbers"});
+  text = test::replaced(modal_toml(), ",\n          [0.35, 0.88, -1.5]]", "]");
+  expect_error(text, test::line_of(text, "shapes ="),
+               {"key 'shapes'", "expected 2 rows of 3 numbers", "got 1 rows"});
+  text = test::replaced(modal_toml(), "[0.35, 0.88, -1.5]]", "[0.35, 0.88, inf]]");
+  expect_error(text, test::line_of(text, "inf]]"), {"key 'shapes', row 2", "finite number"});
+  text = test::replaced(modal_toml(), "[2e-9, 0.0, 3e-7]]", "[3e-9, 0.0, 3e-7]]");
+  expect_error(text, test::line_of(text, "[3e-9"),
+               {"[modal]", "key 'residual_flexibility', row 3", "expected a symmetric matrix",
+                "entry 1 of row 3 is 3e-09, entry 3 of row 1 is 2e-09"});
+  text = test::replaced(modal_toml(), ",\n                        [2e-9, 0.0, 3e-7]]", "]");
+  expect_error(text, test::line_of(text, "residual_flexibility"),
+               {"key 'residual_flexibility'", "expected 3 rows of 3 numbers", "got 2 rows"});
+}
+
+TEST_F(ModelFileTest, ModalJointsMustBeOnListedDofs) {
+  std::string text = test::replaced(modal_toml(), "node = 4\n", "node = 7\n");
+  expect_error(text, test::line_of(text, "node = 7"),
+               {"[[joints]] 'tip'", "key 'node'", "node 7 is not among the [modal] dofs"});
+  text = test::replaced(modal_toml(), "dof = \"uy\"", "dof = \"ux\"");
+  expect_error(text, test::line_of(text, "[[joints]]"),
+               {"joint 'tip'", "node 4 has no DOF ux", "not among the substructure's DOFs"});
+  text = test::replaced(modal_toml(), "node = 4\n", "node = 4\nnode_b = 9\n");
+  expect_error(text, test::line_of(text, "node_b = 9"),
+               {"key 'node_b'", "node 9 is not among the [modal] dofs"});
+  text = test::replaced(modal_toml(), "node = 4\n", "node = \"tip\"\n");
+  expect_error(text, test::line_of(text, "node = \"tip\""),
+               {"key 'node'", "expected a node id", "[modal]"});
+  // A joint between two listed DOFs is fine.
+  text = test::replaced(modal_toml(), "node = 4\n", "node = 4\nnode_b = 1\n");
+  EXPECT_EQ(read_model(write(text)).joints[0].node_b, 1);
 }
 
 // Gmsh meshes: the shipped portal-frame example, and errors on a copy of it.

@@ -1,0 +1,106 @@
+#include "frf/substructure.hpp"
+
+#include "fem/damping.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+namespace jointid::frf {
+
+namespace {
+
+/// Up to this many equations every mode is computed by the dense eigensolver (fem's automatic
+/// engine choice).
+int dense_limit() {
+  return fem::ModalOptions{}.dense_limit;
+}
+
+// The shortest text that reads back as `value`.
+std::string number(double value) {
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
+  return std::string(buffer, end);
+}
+
+fem::Modes checked(fem::Modes modes) {
+  if (modes.status == fem::ModalStatus::not_converging)
+    throw std::runtime_error("modal analysis: the eigensolver did not converge");
+  if (modes.status != fem::ModalStatus::success)
+    throw std::runtime_error(
+        "modal analysis: numerical issue (is the mass matrix positive definite?)");
+  return modes;
+}
+
+} // namespace
+
+Substructure::Substructure(fem::Model model)
+    : model_(std::move(model)), system_(fem::assemble(*model_)) {}
+
+Substructure::Substructure(ModalModel modal) {
+  modal.validate();
+  modal_dofs_ = fem::DofMap::from_dofs(modal.dofs);
+  modal_ = std::move(modal);
+}
+
+const fem::DofMap& Substructure::dofs() const {
+  return system_ ? system_->dofs : modal_dofs_;
+}
+
+const fem::Modes& Substructure::all_modes() const {
+  if (!all_modes_) {
+    fem::ModalOptions options;
+    options.num_modes = 0;
+    options.engine = fem::ModalEngine::dense;
+    all_modes_ = checked(fem::modal_analysis(*system_, options));
+  }
+  return *all_modes_;
+}
+
+ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
+                                       std::vector<std::string>* notes) const {
+  if (modal_) return ModalSynthesis(*modal_, std::move(dofs));
+  const int n = system_->dofs.num_equations();
+  for (int e : dofs)
+    if (e < 0 || e >= n)
+      throw std::invalid_argument("receptance: equation " + std::to_string(e) +
+                                  " is outside the model (" + std::to_string(n) + " equations)");
+  std::optional<fem::Modes> band;
+  if (n > dense_limit()) {
+    if (!(f_max_hz > 0.0) || !std::isfinite(f_max_hz))
+      throw std::invalid_argument(
+          "receptance: a model of " + std::to_string(n) + " equations (more than " +
+          std::to_string(dense_limit()) +
+          ") uses the modes below the highest frequency of interest, which must be > 0 Hz, got " +
+          number(f_max_hz));
+    fem::ModalOptions options;
+    options.max_frequency_hz = f_max_hz;
+    options.engine = fem::ModalEngine::sparse;
+    band = checked(fem::modal_analysis(*system_, options));
+  }
+  const fem::Modes& modes = band ? *band : all_modes();
+  ModalSynthesis synthesis(*system_, modes, model_->damping, std::move(dofs));
+  if (notes && modes.num_modes() < n && !synthesis.has_residual())
+    notes->push_back("receptance from " + std::to_string(modes.num_modes()) + " of " +
+                     std::to_string(n) +
+                     " modes without residual flexibility (the model has rigid-body modes): the "
+                     "modes left out are ignored");
+  return synthesis;
+}
+
+fem::SparseMatrix Substructure::damping_matrix() const {
+  if (!system_)
+    throw std::logic_error("time integration needs a finite element model; this substructure "
+                           "is given by its modes ([modal])");
+  const fem::Damping& damping = model_->damping;
+  if (damping.kind != fem::Damping::Kind::modal) return fem::damping_matrix(*system_, damping);
+  const int n = system_->dofs.num_equations();
+  if (n > dense_limit())
+    throw std::invalid_argument(
+        "modal damping in a time simulation needs every mode, and the model has " +
+        std::to_string(n) + " equations (more than " + std::to_string(dense_limit()) +
+        "); use [damping] rayleigh = [alpha, beta]");
+  return fem::damping_matrix(*system_, damping, &all_modes());
+}
+
+} // namespace jointid::frf

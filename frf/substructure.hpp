@@ -1,0 +1,58 @@
+#pragma once
+/// The linear substructure as the analyses see it: a finite element model (assembled K, M and
+/// its damping) or a modal model given by its modes at a few DOFs. SI units; frequencies in Hz.
+#include "fem/assembly.hpp"
+#include "fem/modal.hpp"
+#include "fem/model.hpp"
+#include "frf/modal_model.hpp"
+#include "frf/receptance.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace jointid::frf {
+
+class Substructure {
+public:
+  /// Validates and assembles (throws std::invalid_argument for an invalid model).
+  explicit Substructure(fem::Model model);
+  /// Validates (throws std::invalid_argument); equations are numbered as modal.dofs.
+  explicit Substructure(ModalModel modal);
+
+  /// The equations: the FE model's free DOFs, or fem::DofMap::from_dofs(modal.dofs).
+  const fem::DofMap& dofs() const;
+  const fem::Model* model() const { return model_ ? &*model_ : nullptr; }        ///< nullptr: modal
+  const fem::Assembled* system() const { return system_ ? &*system_ : nullptr; } ///< ditto
+  const ModalModel* modal() const { return modal_ ? &*modal_ : nullptr; }        ///< nullptr: FE
+
+  /// Receptance over `dofs` (equation numbers) for excitation frequencies up to f_max_hz:
+  /// an FE model with at most fem::ModalOptions{}.dense_limit equations uses every mode (exact;
+  /// the dense engine, f_max_hz unused); a larger one the modes below f_max_hz (> 0; sparse
+  /// engine, frequency band) with residual flexibility. A modal model uses its given modes and
+  /// residual. `notes` (if not null) receives what the user should know, e.g. "receptance from
+  /// 12 of 3000 modes without residual flexibility (the model has rigid-body modes): the modes
+  /// left out are ignored". Throws std::runtime_error when the modal analysis fails, saying why
+  /// (not converging; mass matrix not positive definite), std::invalid_argument for an
+  /// equation outside the model or f_max_hz <= 0 where it is needed.
+  ModalSynthesis synthesis(std::vector<int> dofs, double f_max_hz,
+                           std::vector<std::string>* notes = nullptr) const;
+
+  /// Viscous damping matrix for time integration (FE only; N·s/m): Rayleigh directly (none: an
+  /// empty matrix); modal damping needs every mode, so a model above the dense limit is refused
+  /// (std::invalid_argument saying to use [damping] rayleigh = [alpha, beta]). Throws
+  /// std::logic_error for a modal model ("time integration needs a finite element model").
+  fem::SparseMatrix damping_matrix() const;
+
+private:
+  /// Every mode of the FE model (dense engine), computed once and kept.
+  const fem::Modes& all_modes() const;
+
+  std::optional<fem::Model> model_;
+  std::optional<fem::Assembled> system_;
+  std::optional<ModalModel> modal_;
+  fem::DofMap modal_dofs_;
+  mutable std::optional<fem::Modes> all_modes_; // a cache: not safe for concurrent first use
+};
+
+} // namespace jointid::frf

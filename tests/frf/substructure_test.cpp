@@ -1,0 +1,231 @@
+// The linear substructure as the analyses see it: FE (dense or band of modes) or given by its
+// modes; receptance and the damping matrix for time integration.
+#include "frf/substructure.hpp"
+
+#include "fem/damping.hpp"
+#include "support/beam_models.hpp"
+#include "support/cantilever.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace jointid;
+using fem::Dof;
+
+namespace {
+
+constexpr double two_pi = 2.0 * std::numbers::pi;
+
+double relative_difference(const frf::CMatrix& a, const frf::CMatrix& b) {
+  return (a - b).norm() / b.norm();
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+fem::Modes all_modes(const fem::Assembled& s) {
+  fem::ModalOptions o;
+  o.num_modes = 0;
+  o.engine = fem::ModalEngine::dense;
+  return fem::modal_analysis(s, o);
+}
+
+// A cantilever of 800 beam elements: 1600 equations, above the dense limit (1500).
+fem::Model long_cantilever() {
+  fem::Model m = test::cantilever(800);
+  m.damping.kind = fem::Damping::Kind::modal;
+  m.damping.modal_ratio = 0.01;
+  return m;
+}
+
+} // namespace
+
+TEST(Substructure, SmallFEModelUsesEveryMode) {
+  // The paper cantilever (12 equations): every mode, as a ModalSynthesis built by hand from
+  // the dense eigensolver with the model's damping.
+  const fem::Model model = test::paper_cantilever();
+  const frf::Substructure sub(model);
+  ASSERT_NE(sub.model(), nullptr);
+  ASSERT_NE(sub.system(), nullptr);
+  EXPECT_EQ(sub.modal(), nullptr);
+  EXPECT_EQ(sub.dofs().num_equations(), 12);
+  const std::vector<int> dofs{sub.dofs().equation({4, Dof::uy}), sub.dofs().equation({7, Dof::uy})};
+  std::vector<std::string> notes;
+  const frf::ModalSynthesis H = sub.synthesis(dofs, 0.0, &notes);
+  EXPECT_TRUE(notes.empty());
+  EXPECT_EQ(H.num_modes(), 12);
+
+  const fem::Assembled system = fem::assemble(model);
+  const frf::ModalSynthesis by_hand(system, all_modes(system), model.damping, dofs);
+  for (double f : {0.0, 1.0, 3.0, 18.8, 40.0}) {
+    const double w = two_pi * f;
+    EXPECT_LE(relative_difference(H.receptance(w, dofs, dofs), by_hand.receptance(w, dofs, dofs)),
+              1e-12)
+        << f << " Hz";
+  }
+  // The exact receptance: the direct solve with the modal damping matrix.
+  const fem::SparseMatrix C = sub.damping_matrix();
+  for (double f : {1.0, 3.0, 18.8}) {
+    const double w = two_pi * f;
+    EXPECT_LE(relative_difference(H.receptance(w, dofs, dofs),
+                                  frf::direct_receptance(system, C, w, dofs, dofs)),
+              1e-9)
+        << f << " Hz";
+  }
+}
+
+TEST(Substructure, LargeFEModelUsesTheModesBelowFmaxWithResidual) {
+  // 1600 equations: the sparse engine's modes below 30 Hz (the cantilever's first three,
+  // 3.0, 18.8 and 52.7 Hz for 2 m: two of them) plus residual flexibility.
+  const fem::Model model = long_cantilever();
+  const frf::Substructure sub(model);
+  ASSERT_EQ(sub.dofs().num_equations(), 1600);
+  const std::vector<int> dofs{sub.dofs().equation({401, Dof::uy}),
+                              sub.dofs().equation({801, Dof::uy})};
+  std::vector<std::string> notes;
+  const frf::ModalSynthesis H = sub.synthesis(dofs, 30.0, &notes);
+  EXPECT_TRUE(notes.empty());
+  EXPECT_EQ(H.num_modes(), 2);
+  EXPECT_TRUE(H.has_residual());
+
+  fem::ModalOptions o;
+  o.max_frequency_hz = 30.0;
+  o.engine = fem::ModalEngine::sparse;
+  const frf::ModalSynthesis by_hand(*sub.system(), fem::modal_analysis(*sub.system(), o),
+                                    model.damping, dofs);
+  for (double f : {0.0, 2.0, 3.0, 10.0, 25.0}) {
+    const double w = two_pi * f;
+    EXPECT_LE(relative_difference(H.receptance(w, dofs, dofs), by_hand.receptance(w, dofs, dofs)),
+              1e-9)
+        << f << " Hz";
+  }
+  // The static limit is the flexibility: the tip's L³/3EI (2 m, paper section). The residual
+  // comes from a Cholesky solve with K, whose condition number grows as (800 elements)⁴: about
+  // 2e-6 relative is rounding here, while the modes left out without the residual would be
+  // missing 0.46 % (modes 3 and up of a cantilever: 1 − 0.9707 − 0.0247).
+  const test::BeamProperties p;
+  const std::vector<int> tip{dofs[1]};
+  const double tip_flexibility = std::pow(p.length, 3) / (3 * p.E * p.I());
+  EXPECT_NEAR(H.receptance(0.0, tip, tip)(0, 0).real(), tip_flexibility, 1e-5 * tip_flexibility);
+  // The band needs an upper frequency.
+  EXPECT_THROW(sub.synthesis(dofs, 0.0), std::invalid_argument);
+}
+
+TEST(Substructure, LargeFreeModelNotesTheModesLeftOut) {
+  // A free beam has rigid-body modes: K is singular, no residual flexibility; the note says so.
+  fem::Model model = test::uniform_beam(800);
+  const frf::Substructure sub(model);
+  const std::vector<int> dofs{sub.dofs().equation({801, Dof::uy})};
+  std::vector<std::string> notes;
+  const frf::ModalSynthesis H = sub.synthesis(dofs, 30.0, &notes);
+  EXPECT_FALSE(H.has_residual());
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_TRUE(contains(notes[0], "receptance from " + std::to_string(H.num_modes()) +
+                                     " of 1602 modes without residual flexibility"))
+      << notes[0];
+  EXPECT_TRUE(contains(notes[0], "rigid-body modes")) << notes[0];
+}
+
+TEST(Substructure, EquationsOutsideTheModelAreRefused) {
+  const frf::Substructure sub(test::paper_cantilever());
+  EXPECT_THROW(sub.synthesis({12}, 10.0), std::invalid_argument);
+  EXPECT_THROW(sub.synthesis({-1}, 10.0), std::invalid_argument);
+  fem::Model broken = test::paper_cantilever();
+  broken.materials[0].E = -1.0;
+  EXPECT_THROW(frf::Substructure{broken}, std::invalid_argument);
+}
+
+TEST(Substructure, RayleighDampingMatrixIsAlphaMPlusBetaK) {
+  fem::Model model = test::paper_cantilever();
+  model.damping.kind = fem::Damping::Kind::rayleigh;
+  model.damping.alpha = 0.4;
+  model.damping.beta = 2e-5;
+  const frf::Substructure sub(model);
+  const Eigen::MatrixXd C(sub.damping_matrix());
+  const fem::Assembled s = fem::assemble(model);
+  const Eigen::MatrixXd expected = 0.4 * Eigen::MatrixXd(s.M) + 2e-5 * Eigen::MatrixXd(s.K);
+  EXPECT_LE((C - expected).norm(), 1e-14 * expected.norm());
+  // No damping: a zero matrix of the right size.
+  model.damping = {};
+  const fem::SparseMatrix none = frf::Substructure(model).damping_matrix();
+  EXPECT_EQ(none.rows(), 12);
+  EXPECT_EQ(none.cols(), 12);
+  EXPECT_EQ(none.nonZeros(), 0);
+}
+
+TEST(Substructure, ModalDampingMatrixIsDiagonalisedByTheModes) {
+  // Φᵀ C Φ = diag(2ζω_r) with ζ = 1 %, every mode (Φ mass-normalised from an independent
+  // dense solve).
+  const frf::Substructure sub(test::paper_cantilever());
+  const Eigen::MatrixXd C(sub.damping_matrix());
+  const fem::Modes modes = all_modes(*sub.system());
+  const Eigen::MatrixXd modal = modes.phi.transpose() * C * modes.phi;
+  const Eigen::MatrixXd expected = (2.0 * 0.01 * modes.omega).asDiagonal();
+  EXPECT_LE((modal - expected).norm(), 1e-9 * expected.norm());
+}
+
+TEST(Substructure, ModalDampingAboveTheDenseLimitIsRefused) {
+  const frf::Substructure sub(long_cantilever());
+  try {
+    sub.damping_matrix();
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    const std::string message = e.what();
+    EXPECT_TRUE(contains(message, "needs every mode")) << message;
+    EXPECT_TRUE(contains(message, "1600 equations (more than 1500)")) << message;
+    EXPECT_TRUE(contains(message, "rayleigh = [alpha, beta]")) << message;
+  }
+  // Rayleigh damping is fine at any size.
+  fem::Model model = long_cantilever();
+  model.damping.kind = fem::Damping::Kind::rayleigh;
+  model.damping.beta = 1e-5;
+  EXPECT_EQ(frf::Substructure(model).damping_matrix().rows(), 1600);
+}
+
+TEST(Substructure, ModalModelUsesItsModes) {
+  frf::ModalModel modal;
+  modal.dofs = {{7, Dof::uy}, {4, Dof::uy}};
+  modal.frequencies_hz = Eigen::Vector2d(3.0, 18.8);
+  modal.damping = Eigen::Vector2d(0.01, 0.02);
+  modal.shapes.resize(2, 2);
+  modal.shapes << 0.5, 0.2, -0.4, 0.3;
+  modal.residual_flexibility = Eigen::Matrix2d::Identity() * 1e-8;
+  const frf::Substructure sub(modal);
+  EXPECT_EQ(sub.model(), nullptr);
+  EXPECT_EQ(sub.system(), nullptr);
+  ASSERT_NE(sub.modal(), nullptr);
+  EXPECT_EQ(sub.dofs().num_equations(), 2);
+  EXPECT_EQ(sub.dofs().equation({4, Dof::uy}), 1);
+  std::vector<std::string> notes;
+  const std::vector<int> dofs{1, 0};
+  const frf::ModalSynthesis H = sub.synthesis(dofs, 0.0, &notes);
+  EXPECT_TRUE(notes.empty());
+  EXPECT_TRUE(H.has_residual());
+  // H_{7:uy, 4:uy} at 10 Hz by hand: Σ φ_7 φ_4 / (ω_r² − ω² + 2iζ_rω_rω) + 0.
+  const double w = two_pi * 10.0;
+  frf::Complex expected = 0.0;
+  for (int r = 0; r < 2; ++r) {
+    const double wr = two_pi * modal.frequencies_hz(r);
+    expected += modal.shapes(r, 0) * modal.shapes(r, 1) /
+                frf::Complex(wr * wr - w * w, 2 * modal.damping(r) * wr * w);
+  }
+  const std::vector<int> row{0}, col{1};
+  EXPECT_LE(std::abs(H.receptance(w, row, col)(0, 0) - expected), 1e-14 * std::abs(expected));
+  EXPECT_THROW(sub.synthesis({2}, 10.0), std::invalid_argument);
+  // No time integration without K and M.
+  try {
+    sub.damping_matrix();
+    FAIL() << "expected std::logic_error";
+  } catch (const std::logic_error& e) {
+    EXPECT_TRUE(contains(e.what(), "time integration needs a finite element model")) << e.what();
+  }
+  modal.damping(0) = -1.0;
+  EXPECT_THROW(frf::Substructure{modal}, std::invalid_argument);
+}
