@@ -25,7 +25,8 @@ struct Setup {
                       fem::Dof::uy,
                       {joints::Term::k, joints::Term::c, joints::Term::c2, joints::Term::k3},
                       {4800.0, 20.0, 500.0, 1.6e8},
-                      {false, false, false, false}};
+                      {false, false, false, false},
+                      {}};
 };
 
 const Setup& setup() {

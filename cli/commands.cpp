@@ -1,14 +1,13 @@
 #include "cli/commands.hpp"
 
-#include "fem/assembly.hpp"
-#include "fem/damping.hpp"
+#include "discover/discover.hpp"
 #include "fem/modal.hpp"
-#include "fem/time_integration.hpp"
 #include "fem/zero_modes.hpp"
-#include "frf/harmonic_balance.hpp"
-#include "frf/receptance.hpp"
+#include "frf/substructure.hpp"
 #include "identify/fit.hpp"
-#include "identify/harmonics.hpp"
+#include "identify/measurement.hpp"
+#include "identify/sine_tests.hpp"
+#include "io/discovery_report.hpp"
 #include "io/files.hpp"
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
@@ -22,7 +21,6 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
-#include <optional>
 #include <set>
 #include <span>
 #include <stdexcept>
@@ -33,21 +31,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Up to this many equations every mode is computed by the dense eigensolver (as fem's
-/// automatic engine choice); above it modal damping cannot be used in the time domain.
-constexpr int dense_limit = 1500;
-
 void warn(const std::string& what) {
   std::cerr << "jointid: warning: " << what << "\n";
-}
-
-// Numbers in file names and comments: the shortest form that reads back exactly (3.4, 80).
-std::string compact(double value) {
-  return fmt::format("{}", value);
-}
-
-void add_unique(std::vector<int>& list, int value) {
-  if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
 }
 
 void check_output_dir(const fs::path& dir) {
@@ -74,48 +59,62 @@ void check_output_file(const fs::path& file) {
         fmt::format("-o {}: the directory {} does not exist", file.string(), parent.string()));
 }
 
-// Modes for modal synthesis (and modal damping): every mode when the dense solver can find
-// them (the synthesis is then exact), else the modes below f_max_hz, the residual flexibility
-// standing in for the others.
-fem::Modes synthesis_modes(const fem::Assembled& system, double f_max_hz) {
-  const bool all = system.dofs.num_equations() <= dense_limit;
-  fem::ModalOptions options;
-  if (all) {
-    options.num_modes = 0;
-    options.engine = fem::ModalEngine::dense;
-  } else {
-    options.max_frequency_hz = f_max_hz;
-    options.engine = fem::ModalEngine::sparse;
+void check_harmonics(const std::vector<int>& harmonics, int lowest) {
+  if (harmonics.empty())
+    throw io::Error("--harmonics: expected at least one harmonic, e.g. 1,2,3");
+  std::set<int> seen;
+  for (int k : harmonics) {
+    if (k < lowest || k > 50)
+      throw io::Error(
+          fmt::format("--harmonics: expected harmonics from {} to 50, got {}", lowest, k));
+    if (!seen.insert(k).second)
+      throw io::Error(fmt::format("--harmonics: harmonic {} is listed twice", k));
   }
-  fem::Modes modes = fem::modal_analysis(system, options);
-  if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error(
-        modes.status == fem::ModalStatus::not_converging
-            ? "modal analysis: the eigensolver did not converge"
-            : "modal analysis: numerical issue (is the mass matrix positive definite?)");
-  return modes;
 }
 
-std::string describe(const joints::Joint& j) {
-  std::string text =
-      fmt::format("joint '{}': {}:{} {}", j.name, j.node, fem::dof_name(j.dof),
-                  j.to_ground() ? std::string("to ground") : fmt::format("to node {}", j.node_b));
-  for (std::size_t t = 0; t < j.terms.size(); ++t)
-    text += fmt::format("{} {} = {}", t == 0 ? ";" : ",", joints::term_name(j.terms[t]),
-                        compact(j.values[t]));
-  return text;
+fem::NodeDof resolve(const io::ModelFile& file, const frf::Substructure& sub,
+                     const std::string& option, const std::string& text) {
+  try {
+    const fem::NodeDof at = io::resolve_node_dof(file, text);
+    sub.dofs().equation(at);
+    return at;
+  } catch (const std::invalid_argument& e) {
+    throw io::Error(fmt::format("{} {}: {} (expected NODE:DOF of a free DOF of {}, e.g. 7:uy, or "
+                                "a one-node Gmsh group such as tip:uy)",
+                                option, text, e.what(), file.path.string()));
+  }
 }
 
-struct Output {
-  fs::path path;
-  identify::Record record;
-  std::vector<std::string> comments;
-};
+identify::Quantity parse_quantity(const std::string& text) {
+  if (text == "x") return identify::Quantity::displacement;
+  if (text == "v") return identify::Quantity::velocity;
+  if (text == "a") return identify::Quantity::acceleration;
+  throw io::Error(fmt::format("--channels: expected x, v or a, got \"{}\"", text));
+}
+
+// The receptance of the substructure over the joints' DOFs and the tests' force (and other)
+// DOFs, valid up to `f_max_hz`. DOFs the model lacks are left out here: the library names them
+// with the test they come from.
+frf::ModalSynthesis synthesis_for(const frf::Substructure& sub,
+                                  const std::vector<joints::Joint>& joints,
+                                  const std::vector<identify::Measurement>& tests,
+                                  double f_max_hz, std::vector<std::string>& notes) {
+  std::vector<int> dofs = joints::joint_dof_set(joints, sub.dofs());
+  auto add = [&](const fem::NodeDof& at) {
+    if (sub.dofs().state(at) != fem::DofMap::State::free) return;
+    const int e = sub.dofs().equation(at);
+    if (std::find(dofs.begin(), dofs.end(), e) == dofs.end()) dofs.push_back(e);
+  };
+  for (const auto& m : tests)
+    for (const auto& at : m.force_at)
+      add(at);
+  return sub.synthesis(dofs, f_max_hz, &notes);
+}
 
 } // namespace
 
 void simulate(const SimulateOptions& o) {
-  // 1. Everything that can be checked before computing.
+  // 1. The options, before anything is read or computed.
   if (o.frequencies.empty()) throw io::Error("--freq: expected at least one frequency (Hz)");
   if (o.amplitudes.empty()) throw io::Error("--amplitude: expected at least one amplitude (N)");
   for (double f : o.frequencies)
@@ -132,224 +131,145 @@ void simulate(const SimulateOptions& o) {
   if (o.steps_per_period < 8)
     throw io::Error(
         fmt::format("--steps-per-period: expected at least 8, got {}", o.steps_per_period));
+  if (o.samples_per_period != 0 &&
+      (o.samples_per_period < 8 || o.steps_per_period % o.samples_per_period != 0))
+    throw io::Error(fmt::format("--samples-per-period: expected at least 8 and a divisor of "
+                                "--steps-per-period ({}), got {}",
+                                o.steps_per_period, o.samples_per_period));
   if (o.harmonics < 1)
     throw io::Error(fmt::format("--harmonics: expected at least 1, got {}", o.harmonics));
+  if (!(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise < 1.0))
+    throw io::Error(fmt::format(
+        "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", o.noise));
+  identify::SimulationOptions options;
+  options.quantities.clear();
+  for (const auto& c : o.channels) {
+    const identify::Quantity q = parse_quantity(c);
+    if (std::find(options.quantities.begin(), options.quantities.end(), q) !=
+        options.quantities.end())
+      throw io::Error(fmt::format("--channels: {} is listed twice", c));
+    options.quantities.push_back(q);
+  }
+  if (options.quantities.empty()) throw io::Error("--channels: expected x, v and/or a");
   check_output_dir(o.output_dir);
-  struct Test {
-    double frequency_hz, amplitude;
-    std::string file;
-  };
-  std::vector<Test> tests;
+
+  // 2. The model and the tests.
+  const io::ModelFile file = io::read_model(o.model);
+  const frf::Substructure sub = file.substructure();
+  const fem::NodeDof force_at = resolve(file, sub, "--force", o.force);
+  for (const auto& text : o.outputs)
+    options.extra_outputs.push_back(resolve(file, sub, "--outputs", text));
+  std::vector<identify::SineTestPlan> plans;
   std::set<std::string> names;
   for (double f : o.frequencies)
     for (double a : o.amplitudes) {
-      std::string file = fmt::format("sine_f{}Hz_F{}N.csv", compact(f), compact(a));
-      if (!names.insert(file).second)
+      plans.push_back({f, a});
+      if (!names.insert(identify::sine_test_name(plans.back())).second)
         throw io::Error(fmt::format("--freq, --amplitude: the test at {} Hz, {} N is listed twice",
-                                    compact(f), compact(a)));
-      tests.push_back({f, a, std::move(file)});
+                                    f, a));
     }
-
-  const io::ModelFile file = io::read_model(o.model);
-  const fem::Model& model = file.model;
-  const fem::Assembled system = fem::assemble(model);
-  fem::NodeDof force_at;
-  int force_equation = -1;
-  try {
-    force_at = io::resolve_node_dof(file, o.force);
-    force_equation = system.dofs.equation(force_at);
-  } catch (const std::invalid_argument& e) {
-    throw io::Error(fmt::format("--force {}: {} (expected NODE:DOF of a free DOF of {}, e.g. "
-                                "7:uy, or a one-node Gmsh group such as tip:uy)",
-                                o.force, e.what(), o.model.string()));
-  }
-  // Outputs: every joint DOF, then the force DOF.
-  std::vector<int> outputs;
-  for (const auto& j : file.joints) {
-    add_unique(outputs, system.dofs.equation({j.node, j.dof}));
-    if (!j.to_ground()) add_unique(outputs, system.dofs.equation({j.node_b, j.dof}));
-  }
-  add_unique(outputs, force_equation);
-
-  // 2. The substructure's modes where needed: modal damping in the time domain, and the
-  // harmonic balance's modal synthesis.
-  const int n = system.dofs.num_equations();
-  const bool time_domain = o.method == "time";
-  const double f_max = *std::max_element(o.frequencies.begin(), o.frequencies.end());
-  std::optional<fem::Modes> modes;
-  if (time_domain && model.damping.kind == fem::Damping::Kind::modal) {
-    if (n > dense_limit)
-      throw io::Error(fmt::format(
-          "{}: modal damping in a time simulation needs every mode, and the model has {} "
-          "equations (more than {}); use [damping] rayleigh = [alpha, beta]",
-          o.model.string(), n, dense_limit));
-    modes = synthesis_modes(system, 0.0);
-  }
-  if (!time_domain) modes = synthesis_modes(system, 4.0 * o.harmonics * f_max);
+  options.method = o.method == "time" ? identify::SimulationMethod::time_integration
+                                      : identify::SimulationMethod::harmonic_balance;
+  options.periods = o.periods;
+  options.steps_per_period = o.steps_per_period;
+  options.samples_per_period = o.samples_per_period;
+  options.balance.harmonics = o.harmonics;
 
   // 3. Simulate every test, keeping the records in memory: nothing is written unless all succeed.
-  const std::vector<std::string> common{"jointid simulate", "model: " + o.model.string()};
-  std::vector<Output> outs;
-  auto make_record = [&](const Test& test, const Eigen::VectorXd& t, const Eigen::VectorXd& force,
-                         const Eigen::MatrixXd& u, const Eigen::MatrixXd& v) {
-    identify::Record r;
-    r.source = test.file;
-    r.t = t;
-    r.excitation_hz = test.frequency_hz;
-    r.channels.push_back({identify::Quantity::force, force_at, force});
-    for (std::size_t j = 0; j < outputs.size(); ++j) {
-      const fem::NodeDof at = system.dofs.node_dof(outputs[j]);
-      r.channels.push_back(
-          {identify::Quantity::displacement, at, u.col(static_cast<Eigen::Index>(j))});
-      r.channels.push_back({identify::Quantity::velocity, at, v.col(static_cast<Eigen::Index>(j))});
+  std::vector<identify::SimulatedTest> tests;
+  try {
+    tests = identify::simulate_sine_tests(sub, file.joints, force_at, plans, options);
+  } catch (const std::invalid_argument& e) {
+    throw io::Error(o.model.string() + ": " + e.what());
+  }
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    auto& t = tests[i];
+    t.comments.insert(t.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
+    if (o.noise > 0.0) {
+      identify::add_noise(t.record, o.noise, o.seed + i);
+      t.comments.push_back(fmt::format(
+          "noise: white Gaussian, RMS {} of each channel's RMS, on every channel (seed {})",
+          o.noise, o.seed + i));
     }
-    std::vector<std::string> comments = common;
-    comments.push_back(fmt::format("sine force {} N (peak) at {} Hz on {}", compact(test.amplitude),
-                                   compact(test.frequency_hz), fem::to_string(force_at)));
-    for (const auto& j : file.joints)
-      comments.push_back(describe(j));
-    return Output{o.output_dir / test.file, std::move(r), std::move(comments)};
-  };
-
-  if (time_domain) {
-    const fem::SparseMatrix C =
-        fem::damping_matrix(system, model.damping, modes ? &*modes : nullptr);
-    const joints::JointForces forces(file.joints, system.dofs);
-    fem::SteadyStateOptions options;
-    options.steps_per_period = o.steps_per_period;
-    options.output_periods = o.periods;
-    options.max_periods = std::max(options.max_periods, o.periods + 2);
-    for (const Test& test : tests) {
-      const fem::SteadyState s =
-          fem::steady_state(system, C, &forces, {force_equation, test.amplitude, test.frequency_hz},
-                            outputs, options);
-      if (s.status == fem::SteadyStateStatus::newton_failed)
-        throw std::runtime_error(
-            fmt::format("time integration at {} Hz, {} N: the joints' Newton iteration failed in "
-                        "period {}",
-                        compact(test.frequency_hz), compact(test.amplitude), s.periods_run));
-      Output out = make_record(test, s.t, s.force, s.u, s.v);
-      out.comments.push_back(fmt::format(
-          "method: time (Newmark, average acceleration, {} steps per period)", o.steps_per_period));
-      const bool converged = s.status == fem::SteadyStateStatus::converged;
-      out.comments.push_back(fmt::format(
-          "periods run: {} from rest ({}; last period-to-period change {:.3g}); the record "
-          "holds the last {}",
-          s.periods_run, converged ? "steady state reached" : "NOT periodic", s.period_change,
-          o.periods));
-      if (!converged) {
-        const std::string what =
-            fmt::format("{}: not a periodic steady state after {} periods (last period-to-period "
-                        "change {:.3g})",
-                        test.file, s.periods_run, s.period_change);
-        out.comments.push_back("WARNING: " + what);
-        warn(what);
-      }
-      outs.push_back(std::move(out));
-    }
-  } else {
-    const frf::ModalSynthesis synthesis(system, *modes, model.damping, outputs);
-    frf::HarmonicBalanceOptions options;
-    options.harmonics = o.harmonics;
-    for (const Test& test : tests) {
-      const frf::HarmonicBalanceResult hb =
-          frf::harmonic_balance(synthesis, file.joints, system.dofs, force_equation, test.amplitude,
-                                test.frequency_hz, outputs, options);
-      const int samples = o.periods * o.steps_per_period;
-      const double h = 1.0 / (test.frequency_hz * o.steps_per_period);
-      const double omega = 2.0 * std::numbers::pi * test.frequency_hz;
-      Eigen::VectorXd t(samples), force(samples);
-      Eigen::MatrixXd u(samples, static_cast<Eigen::Index>(outputs.size())), v(u.rows(), u.cols());
-      for (int i = 0; i < samples; ++i) {
-        t(i) = i * h;
-        force(i) = test.amplitude * std::sin(omega * t(i));
-        for (Eigen::Index j = 0; j < u.cols(); ++j) {
-          u(i, j) = hb.displacement(static_cast<int>(j), t(i));
-          v(i, j) = hb.velocity(static_cast<int>(j), t(i));
-        }
-      }
-      Output out = make_record(test, t, force, u, v);
-      out.comments.push_back(fmt::format(
-          "method: hb (harmonic balance, harmonics 0 to {}; modal synthesis of {} of {} "
-          "modes{})",
-          o.harmonics, modes->num_modes(), n,
-          synthesis.has_residual() ? ", residual flexibility" : ""));
-      out.comments.push_back(fmt::format(
-          "harmonic balance: {} after {} iterations (relative residual {:.3g}); {} "
-          "periods sampled from the harmonics",
-          hb.converged ? "converged" : "NOT converged", hb.iterations, hb.residual, o.periods));
-      if (!hb.converged) {
-        const std::string what =
-            fmt::format("{}: the harmonic balance did not converge (relative residual {:.3g})",
-                        test.file, hb.residual);
-        out.comments.push_back("WARNING: " + what);
-        warn(what);
-      }
-      outs.push_back(std::move(out));
-    }
+    for (const auto& w : t.warnings)
+      warn(w);
   }
 
   // 4. Write.
-  std::vector<std::string> texts;
-  for (const auto& out : outs)
-    texts.push_back(io::record_csv(out.record, out.comments));
+  std::vector<std::pair<fs::path, std::string>> outputs;
+  if (o.table) {
+    io::SteppedSineTable table;
+    std::vector<std::string> comments{"jointid simulate", "model: " + o.model.string(),
+                                      "one sine test a row: fundamentals of the records"};
+    if (!tests.empty())
+      for (std::size_t c = 3; c < tests.front().comments.size(); ++c)
+        if (tests.front().comments[c].rfind("joint ", 0) == 0 ||
+            tests.front().comments[c].rfind("method", 0) == 0 ||
+            tests.front().comments[c].rfind("noise", 0) == 0)
+          comments.push_back(tests.front().comments[c]);
+    table.values.resize(static_cast<Eigen::Index>(tests.size()),
+                        static_cast<Eigen::Index>(tests.front().record.channels.size()));
+    for (const auto& c : tests.front().record.channels)
+      table.channels.push_back(c.name());
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+      const identify::Record& r = tests[i].record;
+      const identify::Measurement m = identify::measure(r, {.harmonics = 1});
+      table.freq_hz.push_back(m.frequency_hz);
+      const double omega = 2.0 * std::numbers::pi * m.frequency_hz;
+      for (std::size_t c = 0; c < r.channels.size(); ++c) {
+        const auto& ch = r.channels[c];
+        std::complex<double> value;
+        if (ch.quantity == identify::Quantity::force) {
+          value = m.F(1, m.force_index(ch.at));
+        } else {
+          const int power = ch.quantity == identify::Quantity::displacement ? 0
+                            : ch.quantity == identify::Quantity::velocity   ? 1
+                                                                            : 2;
+          value = m.X(1, m.response_index(ch.at)) * std::pow(std::complex<double>(0.0, omega), power);
+        }
+        table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = value;
+      }
+    }
+    outputs.push_back({o.output_dir / "stepped_sine.csv", io::stepped_sine_csv(table, comments)});
+  } else {
+    for (const auto& t : tests)
+      outputs.push_back({o.output_dir / t.record.source, io::record_csv(t.record, t.comments)});
+  }
   make_output_dir(o.output_dir);
-  for (std::size_t i = 0; i < outs.size(); ++i) {
-    io::write_file_atomically(outs[i].path, texts[i]);
-    fmt::print("wrote {}\n", outs[i].path.string());
+  for (const auto& [path, text] : outputs) {
+    io::write_file_atomically(path, text);
+    fmt::print("wrote {}\n", path.string());
   }
 }
 
 void identify(const IdentifyOptions& o) {
-  if (o.records.empty()) throw io::Error("expected at least one record (CSV file)");
-  if (o.harmonics.empty())
-    throw io::Error("--harmonics: expected at least one harmonic, e.g. 1,2,3");
-  std::set<int> seen;
-  for (int k : o.harmonics) {
-    if (k < 0 || k > 50)
-      throw io::Error(fmt::format("--harmonics: expected harmonics from 0 to 50, got {}", k));
-    if (!seen.insert(k).second)
-      throw io::Error(fmt::format("--harmonics: harmonic {} is listed twice", k));
-  }
+  if (o.records.empty()) throw io::Error("expected at least one record or table (CSV file)");
+  check_harmonics(o.harmonics, 0);
   check_output_file(o.output);
 
   const io::ModelFile file = io::read_model(o.model);
   if (file.joints.empty()) throw io::Error(o.model.string() + ": no [[joints]] to identify");
-  const std::vector<identify::Record> records = io::read_records(o.records);
-  const fem::Assembled system = fem::assemble(file.model);
-  for (const auto& r : records)
-    io::check_record_channels(r, system.dofs, file.joints);
-
-  // Receptance over the joints' DOFs and the force DOFs.
-  std::vector<int> dofs = identify::joint_dof_set(file.joints, system.dofs);
-  for (const auto& r : records)
-    for (const identify::Channel* f : r.all(identify::Quantity::force))
-      add_unique(dofs, system.dofs.equation(f->at));
-  double f_max = 0.0; // only needed when the modes are truncated
-  if (system.dofs.num_equations() > dense_limit)
-    for (const auto& r : records)
-      f_max =
-          std::max(f_max, r.excitation_hz ? *r.excitation_hz
-                                          : identify::estimate_frequency(
-                                                r.t, r.all(identify::Quantity::force)[0]->samples));
+  const std::vector<identify::SineTest> tests = io::read_tests(o.records);
+  identify::FitOptions options;
+  options.harmonics = o.harmonics;
+  const std::vector<identify::Measurement> measured =
+      identify::measure(tests, identify::measure_options(options));
+  const frf::Substructure sub = file.substructure();
+  double f_max = 0.0;
+  for (const auto& m : measured)
+    f_max = std::max(f_max, m.frequency_hz);
   const int max_harmonic = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
-  const fem::Modes modes = synthesis_modes(system, 4.0 * max_harmonic * f_max);
-  const frf::ModalSynthesis synthesis(system, modes, file.model.damping, dofs);
-  std::vector<std::string> extra;
-  if (modes.num_modes() < system.dofs.num_equations() && !synthesis.has_residual())
-    extra.push_back(fmt::format(
-        "receptance from {} of {} modes without residual flexibility (the model has rigid-body "
-        "modes): the modes left out are ignored",
-        modes.num_modes(), system.dofs.num_equations()));
+  std::vector<std::string> notes;
+  const frf::ModalSynthesis synthesis =
+      synthesis_for(sub, file.joints, measured, 4.0 * max_harmonic * f_max, notes);
   const identify::ReceptanceFn H = [&synthesis](double omega, std::span<const int> rows,
                                                 std::span<const int> cols) {
     return synthesis.receptance(omega, rows, cols);
   };
-  identify::FitOptions options;
-  options.harmonics = o.harmonics;
-  const identify::FitResult result = identify::fit(H, system.dofs, file.joints, records, options);
+  const identify::FitResult result =
+      identify::fit(H, sub.dofs(), file.joints, measured, options);
 
-  io::write_json(o.output, io::identify_result_json(result, extra));
+  io::write_json(o.output, io::identify_result_json(result, notes));
 
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
              "95 % interval");
@@ -366,7 +286,71 @@ void identify(const IdentifyOptions& o) {
   fmt::print("wrote {}\n", o.output.string());
   for (const auto& w : result.warnings)
     warn(w);
-  for (const auto& w : extra)
+  for (const auto& w : notes)
+    warn(w);
+}
+
+void discover(const DiscoverOptions& o) {
+  if (o.records.empty()) throw io::Error("expected at least one record or table (CSV file)");
+  check_harmonics(o.harmonics, 1);
+  const int K = *std::max_element(o.harmonics.begin(), o.harmonics.end());
+  if (o.balance_harmonics < K || o.balance_harmonics > 200)
+    throw io::Error(fmt::format("--hb-harmonics: expected from {} (the largest of --harmonics) to "
+                                "200, got {}",
+                                K, o.balance_harmonics));
+  if (o.max_steps < 1)
+    throw io::Error(fmt::format("--max-steps: expected at least 1, got {}", o.max_steps));
+  discover::Options options;
+  options.harmonics = o.harmonics;
+  options.balance.harmonics = o.balance_harmonics;
+  options.max_steps = o.max_steps;
+  options.substructure_damping = o.substructure_damping;
+  if (!o.terms.empty()) {
+    options.terms.clear();
+    for (const auto& t : o.terms) {
+      try {
+        options.terms.push_back(joints::parse_term(t));
+      } catch (const std::invalid_argument& e) {
+        throw io::Error(std::string("--terms: ") + e.what());
+      }
+    }
+  }
+  check_output_dir(o.output_dir);
+
+  const io::ModelFile file = io::read_model(o.model);
+  if (file.joints.empty())
+    throw io::Error(o.model.string() + ": no [[joints]]: discovery starts from the joints' terms");
+  const std::vector<identify::SineTest> tests = io::read_tests(o.records);
+  const std::vector<identify::Measurement> measured =
+      identify::measure(tests, {.harmonics = K});
+  const frf::Substructure sub = file.substructure();
+  const discover::Result result = discover::discover(sub, file.joints, measured, options);
+
+  make_output_dir(o.output_dir);
+  const fs::path json = o.output_dir / "discovery.json";
+  io::write_json(json, io::discovery_json(result));
+  std::vector<std::string> warnings = result.warnings;
+  io::ReportContext context{o.model.string(), {}, o.plots};
+  for (const auto& p : o.records)
+    context.inputs.push_back(p.string());
+  const std::vector<fs::path> written =
+      io::write_discovery_report(o.output_dir, result, context, warnings);
+
+  for (std::size_t i = 0; i + 1 < result.diagnosis.findings.size(); ++i)
+    fmt::print("{}\n", result.diagnosis.findings[i]);
+  fmt::print("\n{:<5} {:<28} {:<26} {:>12} {:>11} {:>11}\n", "step", "added", "effect", "value",
+             "gap before", "gap after");
+  for (std::size_t i = 0; i < result.steps.size(); ++i) {
+    const auto& s = result.steps[i];
+    fmt::print("{:<5} {:<28} {:<26} {:>12.5g} {:>11.4g} {:>11.4g}\n", i + 1, s.added.name(),
+               s.added.effect(), s.added.value, s.gap_before, s.gap_after);
+  }
+  fmt::print("\n{}\nStopped: {}.\n", result.diagnosis.findings.back(), result.stop_reason);
+  fmt::print("wrote {}", json.string());
+  for (const auto& p : written)
+    fmt::print(", {}", p.filename().string());
+  fmt::print("\n");
+  for (const auto& w : warnings)
     warn(w);
 }
 
@@ -374,7 +358,24 @@ void modes(const ModesOptions& o) {
   if (o.count < 1) throw io::Error(fmt::format("--count: expected at least 1, got {}", o.count));
   check_output_dir(o.output_dir);
   const io::ModelFile file = io::read_model(o.model);
-  const fem::Assembled system = fem::assemble(file.model);
+  if (file.modal) {
+    // A substructure given by its modes: report them; there is no mesh to draw.
+    fem::Modes modes;
+    modes.omega = 2.0 * std::numbers::pi * file.modal->frequencies_hz;
+    const int count = std::min(o.count, modes.num_modes());
+    make_output_dir(o.output_dir);
+    const fs::path out = o.output_dir / "modes.json";
+    io::write_json(out, io::modes_json(modes, count,
+                                       {"the substructure is given by its modes ([modal]): "
+                                        "no mesh, so no VTK files or pictures"}));
+    fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
+    for (int r = 0; r < count; ++r)
+      fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
+    fmt::print("wrote {}\n", out.string());
+    return;
+  }
+  const frf::Substructure sub = file.substructure();
+  const fem::Assembled& system = *sub.system();
   const int count = std::min(o.count, system.dofs.num_equations());
   fem::ModalOptions options;
   options.num_modes = count;

@@ -1,7 +1,7 @@
 #pragma once
-/// The `jointid` commands: each reads its inputs, checks everything it can before computing,
-/// computes, and only then writes its outputs. Errors are exceptions (io::Error for bad input);
-/// warnings go to stderr.
+/// The `jointid` commands: each checks its options, reads its inputs, calls the library, and
+/// only then writes its outputs. Errors are exceptions (io::Error for bad input); warnings go
+/// to stderr.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -15,24 +15,46 @@ struct SimulateOptions {
   std::vector<double> amplitudes;  ///< N or N·m (peak)
   std::string method = "time";     ///< time (Newmark to steady state) or hb (harmonic balance)
   int periods = 8;                 ///< periods in each record
-  int steps_per_period = 2048;     ///< time steps (= samples) per period
+  int steps_per_period = 2048;     ///< time steps per period
+  int samples_per_period = 0;      ///< samples kept per period (0: every step)
   int harmonics = 9;               ///< hb: harmonics 0 … K
+  std::vector<std::string> channels{"x", "v"}; ///< response quantities written: x, v, a
+  std::vector<std::string> outputs;            ///< more response points, NODE:DOF
+  double noise = 0.0;                          ///< noise RMS / channel RMS
+  unsigned long long seed = 1;                 ///< noise generator seed
+  bool table = false; ///< write one stepped-sine table (fundamentals) instead of records
   std::filesystem::path output_dir;
 };
 
-/// One record per frequency × amplitude: DIR/sine_f<freq>Hz_F<amp>N.csv.
+/// One record per frequency × amplitude: DIR/sine_f<freq>Hz_F<amp>N.csv; or, with `table`,
+/// DIR/stepped_sine.csv.
 void simulate(const SimulateOptions& options);
 
 struct IdentifyOptions {
   std::filesystem::path model;
-  std::vector<std::filesystem::path> records;
+  std::vector<std::filesystem::path> records; ///< time records or stepped-sine tables
   std::filesystem::path output;
   std::vector<int> harmonics{1};
 };
 
-/// Identifies the joints' non-fixed terms from the records; writes the JSON result and prints
+/// Identifies the joints' non-fixed terms from the tests; writes the JSON result and prints
 /// a table.
 void identify(const IdentifyOptions& options);
+
+struct DiscoverOptions {
+  std::filesystem::path model;
+  std::vector<std::filesystem::path> records; ///< time records or stepped-sine tables
+  std::filesystem::path output_dir;
+  std::vector<int> harmonics{1, 2, 3};
+  int balance_harmonics = 15;
+  int max_steps = 6;
+  std::vector<std::string> terms; ///< candidate terms; empty: the whole library
+  bool substructure_damping = true;
+  bool plots = true;
+};
+
+/// Model discovery: writes DIR/discovery.json and DIR/report.md with its plots.
+void discover(const DiscoverOptions& options);
 
 struct ModesOptions {
   std::filesystem::path model;

@@ -82,6 +82,31 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   simulate->add_option("--harmonics", sim.harmonics, "Harmonics of the harmonic balance (hb)")
       ->capture_default_str();
+  simulate
+      ->add_option("--samples-per-period", sim.samples_per_period,
+                   "Samples recorded per period (a divisor of --steps-per-period; 0: every step)")
+      ->capture_default_str();
+  simulate
+      ->add_option("--channels", sim.channels,
+                   "Response quantities recorded at every output: x, v, a (comma-separated)")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->capture_default_str();
+  simulate
+      ->add_option("--outputs", sim.outputs,
+                   "More response points beyond the joints and the force, NODE:DOF,...")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  simulate
+      ->add_option("--noise", sim.noise,
+                   "Measurement noise: white Gaussian, RMS as a fraction of each channel's RMS "
+                   "(e.g. 0.01)")
+      ->capture_default_str();
+  simulate->add_option("--seed", sim.seed, "Seed of the noise (record i uses seed + i)")
+      ->capture_default_str();
+  simulate->add_flag("--table", sim.table,
+                     "Write one stepped-sine table (the fundamentals) DIR/stepped_sine.csv "
+                     "instead of time records");
   simulate->add_option("-o,--output", sim.output_dir, "Output directory (created if missing)")
       ->required();
 
@@ -89,13 +114,46 @@ int main(int argc, char** argv) {
   auto* identify = app.add_subcommand(
       "identify", "Identify the joints' terms from measured records; writes JSON");
   identify->add_option("MODEL", ident.model, "Model file (TOML)")->required();
-  identify->add_option("RECORDS", ident.records, "Measurement records (CSV)")->required();
+  identify
+      ->add_option("TESTS", ident.records, "Measurement records or stepped-sine tables (CSV)")
+      ->required();
   identify->add_option("-o,--output", ident.output, "Result file (JSON)")->required();
   identify
       ->add_option("--harmonics", ident.harmonics, "Harmonics whose equations are used, e.g. 1,2,3")
       ->delimiter(',')
       ->allow_extra_args(false)
       ->capture_default_str();
+
+  cli::DiscoverOptions disc;
+  auto* discover = app.add_subcommand(
+      "discover", "Find where the model and the measurement disagree, name the missing joint "
+                  "effect, add it and show the gap shrink; writes DIR/discovery.json and "
+                  "DIR/report.md with plots");
+  discover->add_option("MODEL", disc.model, "Model file (TOML): the starting model")->required();
+  discover
+      ->add_option("TESTS", disc.records, "Measurement records or stepped-sine tables (CSV)")
+      ->required();
+  discover->add_option("-o,--output", disc.output_dir, "Output directory (created if missing)")
+      ->required();
+  discover
+      ->add_option("--harmonics", disc.harmonics,
+                   "Harmonics used in the fits; 0 to the largest are compared")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->capture_default_str();
+  discover
+      ->add_option("--hb-harmonics", disc.balance_harmonics,
+                   "Harmonics of the harmonic-balance re-simulations")
+      ->capture_default_str();
+  discover->add_option("--max-steps", disc.max_steps, "Most terms added")->capture_default_str();
+  discover
+      ->add_option("--terms", disc.terms,
+                   "Candidate terms tried at every joint (default: k, c, k2, k3, c2, c3, fc)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  discover->add_flag("!--no-damping-candidate", disc.substructure_damping,
+                     "Do not try scaling the substructure's damping");
+  discover->add_flag("!--no-plots", disc.plots, "Write the report without plots");
 
   cli::ModesOptions mod;
   auto* modes = app.add_subcommand(
@@ -111,6 +169,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     if (simulate->parsed()) cli::simulate(sim);
     if (identify->parsed()) cli::identify(ident);
+    if (discover->parsed() && disc.plots) rerun_with_display(argv);
+    if (discover->parsed()) cli::discover(disc);
     if (modes->parsed() && mod.pictures > 0) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
     return 0;

@@ -1,10 +1,12 @@
 #pragma once
 /// Harmonic balance: the periodic steady state of the substructure with its joints under a
-/// sine force, in the joint coordinates only. With y = Bᵀx the joints' deformations,
+/// periodic force, in the joint coordinates only. With y = Bᵀx the joints' deformations,
 ///     Y_k = H_yf(kω) F_k − H_yy(kω) G_k(Y),   k = 0 … K,
 /// where G_k are the harmonics of the joint forces g(y(t), ẏ(t)) computed by alternating
-/// frequency and time (AFT). Newton's method with a finite-difference Jacobian, amplitude
-/// continuation when it fails. Dry friction is regularised here: sign(ẏ) ≈ tanh(ẏ/width).
+/// frequency and time (AFT). Newton's method with the analytic Jacobian of the AFT forces
+/// (from ∂g/∂y and ∂g/∂ẏ at the time samples), amplitude continuation when it fails. Dry
+/// friction is regularised here: sign(ẏ) ≈ tanh(ẏ/width). Complex amplitudes are peak values
+/// with x(t) = Re Σ_k X_k e^{ikωt}; units SI.
 #include "frf/receptance.hpp"
 #include "joints/joint.hpp"
 
@@ -24,6 +26,7 @@ struct HarmonicBalanceResult {
   int iterations = 0;
   double residual = 0.0;
   Eigen::MatrixXcd Y; ///< (K+1) × n_joints: harmonics of the joint deformations
+  Eigen::MatrixXcd G; ///< (K+1) × n_joints: harmonics of the joint forces g
   Eigen::MatrixXcd X; ///< (K+1) × n_outputs: harmonics of the output displacements
   double frequency_hz = 0.0;
   /// Displacement and velocity of output j at times t (reconstructed from the harmonics).
@@ -31,7 +34,40 @@ struct HarmonicBalanceResult {
   double velocity(int j, double t) const;
 };
 
-/// `synthesis` must cover the joint DOFs, the force DOF and the outputs.
+/// The harmonics of F0 sin ωt: F_1 = −i F0 (a 2 × 1 matrix, rows 0 and 1).
+Eigen::MatrixXcd sine_force(double amplitude);
+
+/// The harmonic-balance problem at one excitation frequency: the substructure's receptances at
+/// the harmonics are computed once, so that solve() can be called for many joint values and
+/// force levels (discovery re-simulates the same tests with many candidate models).
+class HarmonicBalance {
+public:
+  /// `synthesis` must cover the joints' DOFs, the force equations and the outputs. `joints`
+  /// fixes the layout (nodes and DOFs); their terms and values are given to solve().
+  HarmonicBalance(const ModalSynthesis& synthesis, const std::vector<joints::Joint>& joints,
+                  const fem::DofMap& dofs, std::vector<int> force_equations,
+                  std::vector<int> outputs, double frequency_hz,
+                  const HarmonicBalanceOptions& options = {});
+  /// F: harmonics 0, 1, … of the forces (rows beyond K are ignored, missing ones are 0), one
+  /// column per force equation. `start` (K+1 × n_joints), if given, is the first Newton guess;
+  /// otherwise the linear response with the joints' linear terms (k, c) is.
+  HarmonicBalanceResult solve(const std::vector<joints::Joint>& joints, const Eigen::MatrixXcd& F,
+                              const Eigen::MatrixXcd* start = nullptr) const;
+  const HarmonicBalanceOptions& options() const { return options_; }
+
+private:
+  struct Layout {
+    int node, node_b;
+    fem::Dof dof;
+  };
+  std::vector<Layout> layout_;
+  HarmonicBalanceOptions options_;
+  int K_, nj_, nf_, Nt_;
+  double omega_, frequency_hz_;
+  std::vector<CMatrix> Hyy_, HyF_, HoB_, HoF_; // per harmonic
+};
+
+/// One steady state under F0 sin(2π f t) at `force_equation`.
 HarmonicBalanceResult
 harmonic_balance(const ModalSynthesis& synthesis, const std::vector<joints::Joint>& joints,
                  const fem::DofMap& dofs, int force_equation, double amplitude, double frequency_hz,

@@ -24,133 +24,80 @@ std::string percent(double fraction) {
   return s.str();
 }
 
-// Fraction of samples sitting at the channel's extreme values (a flat top: clipping). A
-// displacement that is flat because the point is at rest (its measured velocity is zero, as
-// in a friction joint's stick phase) is not clipped: pass that velocity to exempt it.
-double clipped_fraction(const Eigen::VectorXd& x, const Eigen::VectorXd* velocity = nullptr) {
-  const double hi = x.maxCoeff(), lo = x.minCoeff(),
-               tol = 1e-9 * std::max(std::abs(hi), std::abs(lo));
-  if (hi - lo <= tol) return 0.0;
-  const double vmax = velocity ? velocity->cwiseAbs().maxCoeff() : 0.0;
-  int at_edge = 0;
-  for (int i = 0; i < x.size(); ++i) {
-    const bool resting = velocity && std::abs((*velocity)(i)) <= 1e-6 * vmax;
-    if ((hi - x(i) <= tol || x(i) - lo <= tol) && !resting) ++at_edge;
-  }
-  return static_cast<double>(at_edge) / x.size();
-}
-
-// Velocity from displacement by differentiating a many-harmonic fit (periodic signals).
-Eigen::VectorXd derive_velocity(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double omega) {
-  const int K = std::min(64, (static_cast<int>(t.size()) - 1) / 2);
-  const Eigen::VectorXcd X = fit_harmonics(t, x, omega, K);
-  Eigen::VectorXd v = Eigen::VectorXd::Zero(t.size());
-  for (int i = 0; i < t.size(); ++i)
-    for (int k = 1; k <= K; ++k)
-      v(i) +=
-          (std::complex<double>(0.0, k * omega) * X(k) * std::polar(1.0, k * omega * t(i))).real();
-  return v;
-}
-
 } // namespace
 
-TestSpectrum extract_spectrum(const Record& r, const fem::DofMap& dofs,
-                              const std::vector<joints::Joint>& joints, int K,
-                              std::vector<std::string>& warnings, const FitOptions& options) {
-  auto fail = [&](const std::string& what) { throw std::invalid_argument(r.source + ": " + what); };
+TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
+                      const std::vector<joints::Joint>& joints,
+                      std::vector<std::string>& warnings) {
+  auto fail = [&](const std::string& what) { throw std::invalid_argument(m.source + ": " + what); };
+  auto channels = [&] {
+    std::string names;
+    for (const auto& at : m.force_at)
+      names += (names.empty() ? "f@" : ", f@") + fem::to_string(at);
+    for (std::size_t i = 0; i < m.response_at.size(); ++i)
+      names += std::string(", ") + quantity_letter(m.measured_as[i]) + "@" +
+               fem::to_string(m.response_at[i]);
+    return names;
+  };
   TestSpectrum s;
-  s.source = r.source;
-  const auto forces = r.all(Quantity::force);
-  if (forces.empty()) fail("no force channel (expected a column such as f@7:uy)");
-  for (const Channel* c : forces) {
+  s.source = m.source;
+  s.frequency_hz = m.frequency_hz;
+  s.fundamental_only = m.fundamental_only;
+  for (const auto& at : m.force_at) {
     try {
-      s.force_equations.push_back(dofs.equation(c->at));
+      s.force_equations.push_back(dofs.equation(at));
     } catch (const std::invalid_argument& e) {
-      fail("force channel " + c->name() + ": " + e.what());
+      fail("force channel f@" + fem::to_string(at) + ": " + e.what() +
+           " (a force must act on a free DOF of the model)");
     }
   }
-  s.frequency_hz =
-      r.excitation_hz ? *r.excitation_hz : estimate_frequency(r.t, forces.front()->samples);
-  if (!(s.frequency_hz > 0.0)) fail("excitation frequency must be > 0 Hz");
-  const double omega = two_pi * s.frequency_hz;
-  const int n = whole_period_samples(r.t, s.frequency_hz);
-  if (n == 0)
-    fail("shorter than one period of the excitation (" + std::to_string(s.frequency_hz) + " Hz)");
-  if (n < 2 * (K + 1) * 4)
-    fail("too few samples per period to resolve harmonic " + std::to_string(K));
-  const Eigen::VectorXd t = r.t.head(n);
-  const double periods = n * r.dt() * s.frequency_hz;
-  if (periods < 2.0 - 1e-9)
-    warnings.push_back(r.source + ": only " + std::to_string(static_cast<int>(periods)) +
-                       " period; steady state cannot be checked (record at least 2)");
-
-  for (const auto& c : r.channels) {
-    const Channel* v =
-        c.quantity == Quantity::displacement ? r.find(Quantity::velocity, c.at) : nullptr;
-    const double clipped = clipped_fraction(c.samples, v ? &v->samples : nullptr);
-    if (clipped > 0.01)
-      warnings.push_back(r.source + ": channel " + c.name() + " looks clipped (" +
-                         percent(clipped) + " of samples at its extremes)");
-  }
+  s.F = m.F;
 
   // Displacement and velocity at every joint DOF.
   const std::vector<int> set2 = joint_dof_set(joints, dofs);
+  const Eigen::Index n = m.t.size();
   Eigen::MatrixXd x2(n, set2.size()), v2(n, set2.size());
+  s.X2.resize(m.X.rows(), static_cast<Eigen::Index>(set2.size()));
   for (std::size_t i = 0; i < set2.size(); ++i) {
     const fem::NodeDof at = dofs.node_dof(set2[i]);
-    const Channel* x = r.find(Quantity::displacement, at);
-    if (!x) fail("no displacement channel x@" + fem::to_string(at) + " for a joint DOF");
-    x2.col(i) = x->samples.head(n);
-    if (const Channel* v = r.find(Quantity::velocity, at)) {
-      v2.col(i) = v->samples.head(n);
-    } else {
-      v2.col(i) = derive_velocity(t, x2.col(i), omega);
-      warnings.push_back(r.source + ": no velocity channel v@" + fem::to_string(at) +
-                         "; velocity derived from displacement");
+    const int r = m.response_index(at);
+    if (r < 0) {
+      std::string joint;
+      for (const auto& j : joints)
+        if ((j.node == at.node || j.node_b == at.node) && j.dof == at.dof) joint = j.name;
+      fail("no channel x@" + fem::to_string(at) + " (nor v@ or a@) for joint '" + joint +
+           "' (identification needs the response at every joint DOF; the channels are " +
+           channels() + ")");
     }
+    x2.col(static_cast<Eigen::Index>(i)) = m.x.col(r);
+    v2.col(static_cast<Eigen::Index>(i)) = m.v.col(r);
+    s.X2.col(static_cast<Eigen::Index>(i)) = m.X.col(r);
   }
-  Eigen::MatrixXd f(n, forces.size());
-  for (std::size_t i = 0; i < forces.size(); ++i)
-    f.col(i) = forces[i]->samples.head(n);
-  s.F = fit_harmonics(t, f, omega, K);
-  s.X2 = fit_harmonics(t, x2, omega, K);
-
-  // Steady state: compare the fundamental over the first and the last half of the record.
-  if (periods >= 2.0 - 1e-9) {
-    const int half = whole_period_samples(t.head(n / 2), s.frequency_hz);
-    if (half > 0) {
-      const Eigen::VectorXcd a =
-          fit_harmonics(t.head(half), Eigen::VectorXd(x2.col(0).head(half)), omega, 1);
-      const Eigen::VectorXcd b =
-          fit_harmonics(t.tail(half), Eigen::VectorXd(x2.col(0).tail(half)), omega, 1);
-      const double change = std::abs(a(1) - b(1)) / std::max(std::abs(b(1)), 1e-300);
-      if (change > options.steady_tolerance)
-        warnings.push_back(r.source + ": not a steady state (first and last half differ by " +
-                           percent(change) + ")");
-    }
-  }
+  const double omega = two_pi * m.frequency_hz;
+  const int K = m.harmonics;
 
   // Basis functions on the measured deformation y = x(node) − x(node_b), i.e. Y = X2 B.
   const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
   const Eigen::MatrixXd Y = x2 * B, Ydot = v2 * B;
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const joints::Joint& j = joints[i];
-    const Eigen::VectorXd y = Y.col(i), ydot = Ydot.col(i);
-    if (j.term_index(joints::Term::fc) >= 0) {
+    const Eigen::VectorXd y = Y.col(static_cast<Eigen::Index>(i)),
+                          ydot = Ydot.col(static_cast<Eigen::Index>(i));
+    if (j.term_index(joints::Term::fc) >= 0 && !m.fundamental_only) {
       // While a dry-friction joint sticks (ẏ = 0) its force lies anywhere in [−fc, fc], but the
       // basis sign(ẏ) says 0: the stuck part of the record is not described by the model.
       const double vmax = ydot.cwiseAbs().maxCoeff();
       const double stuck = (ydot.array().abs() <= 1e-9 * vmax).cast<double>().mean();
       if (stuck > 0.002)
         warnings.push_back(
-            r.source + ": joint '" + j.name + "' sticks for " + percent(stuck) +
+            m.source + ": joint '" + j.name + "' sticks for " + percent(stuck) +
             " of the record; the Coulomb basis sign(ydot) does not describe the force while stuck");
     }
-    Eigen::MatrixXd g(n, j.terms.size());
+    Eigen::MatrixXd g(n, static_cast<Eigen::Index>(j.terms.size()));
     for (std::size_t term = 0; term < j.terms.size(); ++term)
-      for (int i = 0; i < n; ++i)
-        g(i, term) = joints::basis(j.terms[term], y(i), ydot(i));
-    s.G.push_back(fit_harmonics(t, g, omega, K));
+      for (Eigen::Index r = 0; r < n; ++r)
+        g(r, static_cast<Eigen::Index>(term)) = joints::basis(j.terms[term], y(r), ydot(r));
+    s.G.push_back(fit_harmonics(m.t, g, omega, K));
   }
   return s;
 }
@@ -189,6 +136,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   std::vector<double> rhs;
   for (const auto& test : tests) {
     for (int k : o.harmonics) {
+      if (test.fundamental_only && k != 1) continue;
       if (k < 0 || k >= test.F.rows())
         throw std::invalid_argument("identify: harmonic " + std::to_string(k) + " not extracted");
       const double w = two_pi * test.frequency_hz * k;
@@ -300,16 +248,46 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   return out;
 }
 
+MeasureOptions measure_options(const FitOptions& o) {
+  MeasureOptions m;
+  m.harmonics = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
+  m.steady_tolerance = o.steady_tolerance;
+  return m;
+}
+
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
+              const std::vector<joints::Joint>& joints,
+              const std::vector<Measurement>& measurements, const FitOptions& o) {
+  if (measurements.empty()) throw std::invalid_argument("identify: no tests");
+  if (o.harmonics.empty()) throw std::invalid_argument("identify: no harmonics asked");
+  std::vector<std::string> warnings;
+  std::vector<TestSpectrum> tests;
+  int tables = 0;
+  for (const auto& m : measurements) {
+    warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());
+    tests.push_back(spectrum(m, dofs, joints, warnings));
+    tables += m.fundamental_only ? 1 : 0;
+  }
+  if (tables > 0 && (o.harmonics.size() != 1 || o.harmonics[0] != 1))
+    warnings.push_back(std::to_string(tables) +
+                       " test(s) from stepped-sine tables give harmonic 1 only; their other "
+                       "harmonics were not used");
+  return fit(H, dofs, joints, tests, o, std::move(warnings));
+}
+
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
+              const std::vector<joints::Joint>& joints, const std::vector<SineTest>& tests,
+              const FitOptions& o) {
+  if (tests.empty()) throw std::invalid_argument("identify: no tests");
+  if (o.harmonics.empty()) throw std::invalid_argument("identify: no harmonics asked");
+  return fit(H, dofs, joints, measure(tests, measure_options(o)), o);
+}
+
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
               const std::vector<joints::Joint>& joints, const std::vector<Record>& records,
               const FitOptions& o) {
   if (records.empty()) throw std::invalid_argument("identify: no records");
-  const int K = *std::max_element(o.harmonics.begin(), o.harmonics.end());
-  std::vector<std::string> warnings;
-  std::vector<TestSpectrum> tests;
-  for (const auto& r : records)
-    tests.push_back(extract_spectrum(r, dofs, joints, std::max(K, 1), warnings, o));
-  return fit(H, dofs, joints, tests, o, std::move(warnings));
+  return fit(H, dofs, joints, std::vector<SineTest>(records.begin(), records.end()), o);
 }
 
 } // namespace jointid::identify

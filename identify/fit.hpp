@@ -8,6 +8,7 @@
 /// columns of Q scaled to unit norm, and solved by SVD.
 #include "fem/dof_map.hpp"
 #include "frf/receptance.hpp"
+#include "identify/measurement.hpp"
 #include "identify/record.hpp"
 #include "joints/joint.hpp"
 
@@ -59,10 +60,11 @@ struct FitResult {
   std::vector<joints::Joint> identified(const std::vector<joints::Joint>& model_joints) const;
 };
 
-/// One test reduced to harmonics 0 … K at its excitation frequency.
+/// One test reduced, for these joints, to harmonics 0 … K at its excitation frequency.
 struct TestSpectrum {
   std::string source;
   double frequency_hz = 0.0;
+  bool fundamental_only = false;    ///< a stepped-sine row: only harmonic 1 is usable
   std::vector<int> force_equations; ///< equations of the force channels
   Eigen::MatrixXcd F;               ///< (K+1) × n_forces
   Eigen::MatrixXcd X2;              ///< (K+1) × n_set2 displacements at the joints' DOFs
@@ -72,20 +74,35 @@ struct TestSpectrum {
 /// The joints' DOFs (set 2), in the order used by TestSpectrum::X2.
 using joints::joint_dof_set;
 
-/// Extracts a test's harmonics: checks the channels (a force channel, x at every joint DOF;
-/// v derived from x when absent), trims to whole periods, and adds warnings (not periodic,
-/// clipped, short, derived velocity). Throws std::invalid_argument naming the record.
-TestSpectrum extract_spectrum(const Record& record, const fem::DofMap& dofs,
-                              const std::vector<joints::Joint>& joints, int max_harmonic,
-                              std::vector<std::string>& warnings, const FitOptions& options = {});
+/// A measured test as the identification of these joints needs it: the forces on free DOFs of
+/// the model, the displacement at every joint DOF, and the harmonics of every joint term's
+/// basis function evaluated on the measured deformation y = x(node) − x(node_b). Throws
+/// std::invalid_argument naming the test and the missing or misplaced channel. Adds a warning
+/// when a dry-friction joint sticks in the record.
+TestSpectrum spectrum(const Measurement& measurement, const fem::DofMap& dofs,
+                      const std::vector<joints::Joint>& joints,
+                      std::vector<std::string>& warnings);
 
 /// Identifies the non-fixed terms of every joint from the tests. Throws std::invalid_argument
-/// when there are fewer equations than unknowns or the unknowns are not separable.
+/// when there are fewer equations than unknowns or the unknowns are not separable. Tests from
+/// stepped-sine tables contribute harmonic 1 only (with a warning if others were asked).
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
               const std::vector<joints::Joint>& joints, const std::vector<TestSpectrum>& tests,
               const FitOptions& options = {}, std::vector<std::string> warnings = {});
+/// The same from measurements: their warnings are passed on.
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
+              const std::vector<joints::Joint>& joints,
+              const std::vector<Measurement>& measurements, const FitOptions& options = {});
+/// The same from sine tests (time records or stepped-sine rows, e.g. from io::read_tests),
+/// reduced with measure() to the largest harmonic asked.
+FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
+              const std::vector<joints::Joint>& joints, const std::vector<SineTest>& tests,
+              const FitOptions& options = {});
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
               const std::vector<joints::Joint>& joints, const std::vector<Record>& records,
               const FitOptions& options = {});
+
+/// The options measure() needs for a fit with these options.
+MeasureOptions measure_options(const FitOptions& options);
 
 } // namespace jointid::identify

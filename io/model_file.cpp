@@ -850,14 +850,15 @@ private:
       const toml::node& terms_node =
           t.need("terms", "a list of terms such as [\"k\", \"c\", \"k3\"]");
       const toml::array& terms =
-          t.to_array(terms_node, "key 'terms'", "term names (k, c, k2, k3, c2, c3, fc)");
+          t.to_array(terms_node, "key 'terms'", "term names (" + joints::term_names() + ")");
       if (terms.empty()) t.fail_at(terms_node, "key 'terms'", "expected at least one term");
       for (const auto& n : terms) {
         const std::string name = t.to_string(n, "key 'terms'");
         try {
           j.terms.push_back(joints::parse_term(name));
         } catch (const std::invalid_argument&) {
-          t.fail_at(n, "key 'terms'", "expected one of k, c, k2, k3, c2, c3, fc, got " + shown(n));
+          t.fail_at(n, "key 'terms'",
+                    "expected one of " + joints::term_names() + ", got " + shown(n));
         }
         if (j.term_index(j.terms.back()) != static_cast<int>(j.terms.size()) - 1)
           t.fail_at(n, "key 'terms'", "term '" + name + "' is listed twice");
@@ -896,6 +897,7 @@ private:
           j.fixed[index] = true;
         }
       }
+      j.given = has_value;
       joint_lines_.push_back(t.line());
       out_.joints.push_back(std::move(j));
     }

@@ -68,6 +68,8 @@ CsvText scan(const std::filesystem::path& path, std::string_view header_example)
   csv.name = path.string();
   csv.text = read_file(path);
   std::string_view rest = csv.text;
+  // Some test systems start their CSV files with a UTF-8 byte-order mark: skip it.
+  if (rest.starts_with("\xEF\xBB\xBF")) rest.remove_prefix(3);
   int number = 0;
   while (!rest.empty()) {
     const auto newline = rest.find('\n');
@@ -358,6 +360,8 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
       csv.fail(csv.rows[i].number,
                fmt::format("column 1 (freq_hz): expected a frequency > 0 Hz, got {}", data[0][i]));
   table.freq_hz = data[0];
+  for (const Line& row : csv.rows)
+    table.lines.push_back(row.number);
   table.values.resize(static_cast<Eigen::Index>(n),
                       static_cast<Eigen::Index>(table.channels.size()));
   for (std::size_t i = 0; i < n; ++i)
@@ -365,6 +369,85 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
       table.values(static_cast<Eigen::Index>(i),
                    static_cast<Eigen::Index>(c)) = {data[1 + 2 * c][i], data[2 + 2 * c][i]};
   return table;
+}
+
+std::string stepped_sine_csv(const SteppedSineTable& table,
+                             const std::vector<std::string>& comments) {
+  const auto rows = static_cast<Eigen::Index>(table.freq_hz.size());
+  if (table.values.rows() != rows ||
+      table.values.cols() != static_cast<Eigen::Index>(table.channels.size()))
+    throw Error(fmt::format("stepped-sine table: {} × {} values for {} tests and {} channels",
+                            table.values.rows(), table.values.cols(), rows,
+                            table.channels.size()));
+  if (!table.values.allFinite())
+    throw Error("stepped-sine table: NaN or infinite values");
+  std::string out;
+  auto inserter = std::back_inserter(out);
+  for (const auto& comment : comments)
+    out += fmt::format("# {}\n", comment);
+  out += "freq_hz";
+  for (const auto& c : table.channels)
+    fmt::format_to(inserter, ",{}.re,{}.im", c, c);
+  out += "\n";
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    if (!std::isfinite(table.freq_hz[static_cast<std::size_t>(i)]))
+      throw Error("stepped-sine table: a frequency is not finite");
+    fmt::format_to(inserter, "{}", table.freq_hz[static_cast<std::size_t>(i)]);
+    for (Eigen::Index c = 0; c < table.values.cols(); ++c)
+      fmt::format_to(inserter, ",{},{}", table.values(i, c).real(), table.values(i, c).imag());
+    out += "\n";
+  }
+  return out;
+}
+
+std::vector<identify::SineTest> stepped_sine_tests(const SteppedSineTable& table,
+                                                   const std::filesystem::path& path) {
+  std::vector<identify::Channel> channels;
+  for (const auto& name : table.channels)
+    channels.push_back(identify::parse_channel_name(name));
+  std::vector<identify::SineTest> tests;
+  for (std::size_t i = 0; i < table.freq_hz.size(); ++i) {
+    identify::Phasors row;
+    row.source = fmt::format("{}:{}", path.string(), i < table.lines.size() ? table.lines[i] : 0);
+    row.frequency_hz = table.freq_hz[i];
+    for (std::size_t c = 0; c < channels.size(); ++c)
+      row.channels.push_back({channels[c].quantity, channels[c].at,
+                              table.values(static_cast<Eigen::Index>(i),
+                                           static_cast<Eigen::Index>(c))});
+    tests.emplace_back(std::move(row));
+  }
+  return tests;
+}
+
+std::vector<identify::SineTest> read_tests(const std::vector<std::filesystem::path>& paths) {
+  std::vector<identify::SineTest> tests;
+  std::map<std::filesystem::path, std::string> seen;
+  for (const auto& path : paths) {
+    std::error_code ec;
+    std::filesystem::path key = std::filesystem::weakly_canonical(path, ec);
+    if (ec) key = path;
+    if (const auto [it, inserted] = seen.emplace(key, path.string()); !inserted)
+      throw Error(fmt::format("{}: given twice{} (each test would count twice and the "
+                              "uncertainty come out falsely small)",
+                              path.string(),
+                              it->second == path.string() ? "" : " (also as " + it->second + ")"));
+    const CsvText csv = scan(path, "t,f@7:uy,x@7:uy (a time record) or "
+                                   "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im (a "
+                                   "stepped-sine table)");
+    const std::string_view first = split_fields(csv.header.text).front();
+    if (first == "t") {
+      tests.emplace_back(read_record(path));
+    } else if (first == "freq_hz") {
+      for (auto& t : stepped_sine_tests(read_stepped_sine(path), path))
+        tests.push_back(std::move(t));
+    } else {
+      csv.fail(csv.header.number,
+               fmt::format("header: the first column must be 't' (a time record) or 'freq_hz' (a "
+                           "stepped-sine table), got \"{}\"",
+                           first));
+    }
+  }
+  return tests;
 }
 
 } // namespace jointid::io

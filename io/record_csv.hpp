@@ -5,6 +5,7 @@
 /// Stepped-sine table: `#` comments, then `freq_hz,<channel>.re,<channel>.im,...`, one test
 /// per row, complex peak amplitudes with x(t) = Re(X e^{iωt}).
 #include "fem/dof_map.hpp"
+#include "identify/measurement.hpp"
 #include "identify/record.hpp"
 #include "joints/joint.hpp"
 
@@ -45,9 +46,26 @@ struct SteppedSineTable {
   std::vector<double> freq_hz;       ///< one per test, Hz
   std::vector<std::string> channels; ///< "x@7:uy", ...
   Eigen::MatrixXcd values;           ///< tests × channels, complex peak amplitudes (SI)
+  std::vector<int> lines;            ///< line of each test in the file
 };
 
 /// Reads a stepped-sine table; throws io::Error naming file, line and column as read_record.
 SteppedSineTable read_stepped_sine(const std::filesystem::path& path);
+
+/// The CSV text of a stepped-sine table: each comment as `# ...` lines, the header and one row
+/// per test, every number in its shortest form that reads back bit-exactly. Throws io::Error
+/// if the sizes disagree or a value is not finite.
+std::string stepped_sine_csv(const SteppedSineTable& table,
+                             const std::vector<std::string>& comments = {});
+
+/// The table's tests as sine tests; each one's source is "<path>:<line>".
+std::vector<identify::SineTest> stepped_sine_tests(const SteppedSineTable& table,
+                                                   const std::filesystem::path& path);
+
+/// Reads measured sine tests from files of either kind, told apart by the header's first
+/// column: `t` (a time record: one test) or `freq_hz` (a stepped-sine table: one test per
+/// row). Throws io::Error naming the file for anything else, and when a file is given twice
+/// (its tests would count twice and the intervals come out falsely narrow).
+std::vector<identify::SineTest> read_tests(const std::vector<std::filesystem::path>& paths);
 
 } // namespace jointid::io

@@ -7,81 +7,80 @@
 namespace jointid::joints {
 
 namespace {
-struct Info {
-  std::string_view name, effect, unit;
-};
-constexpr std::array<Info, 7> info{{
-    {"k", "linear stiffness", "N/m"},
-    {"c", "viscous damping", "N s/m"},
-    {"k2", "quadratic stiffness", "N/m^2"},
-    {"k3", "cubic stiffness", "N/m^3"},
-    {"c2", "velocity-squared damping", "N s^2/m^2"},
-    {"c3", "cubic damping", "N s^3/m^3"},
-    {"fc", "Coulomb friction", "N"},
+
+double zero(double, double) {
+  return 0.0;
+}
+double one(double, double) {
+  return 1.0;
+}
+
+constexpr std::array<TermInfo, 7> table{{
+    {Term::k, "k", "linear stiffness", "N/m", "N m/rad", [](double y, double) { return y; }, one,
+     zero, Nature::conservative, 1, false, false},
+    {Term::c, "c", "viscous damping", "N s/m", "N m s/rad", [](double, double v) { return v; },
+     zero, one, Nature::dissipative, 1, false, false},
+    {Term::k2, "k2", "quadratic stiffness", "N/m^2", "N m/rad^2",
+     [](double y, double) { return y * y; }, [](double y, double) { return 2.0 * y; }, zero,
+     Nature::conservative, 2, true, false},
+    {Term::k3, "k3", "cubic stiffness", "N/m^3", "N m/rad^3",
+     [](double y, double) { return y * y * y; }, [](double y, double) { return 3.0 * y * y; },
+     zero, Nature::conservative, 3, false, false},
+    {Term::c2, "c2", "velocity-squared damping", "N s^2/m^2", "N m s^2/rad^2",
+     [](double, double v) { return v * std::abs(v); }, zero,
+     [](double, double v) { return 2.0 * std::abs(v); }, Nature::dissipative, 2, false, false},
+    {Term::c3, "c3", "cubic damping", "N s^3/m^3", "N m s^3/rad^3",
+     [](double, double v) { return v * v * v; }, zero,
+     [](double, double v) { return 3.0 * v * v; }, Nature::dissipative, 3, false, false},
+    {Term::fc, "fc", "Coulomb friction", "N", "N m",
+     [](double, double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; }, zero, zero,
+     Nature::dissipative, 0, false, true},
 }};
+
 } // namespace
 
+const std::array<TermInfo, 7>& term_table() {
+  return table;
+}
+
+const TermInfo& term_info(Term t) {
+  return table[static_cast<std::size_t>(t)];
+}
+
 std::string_view term_name(Term t) {
-  return info[static_cast<int>(t)].name;
+  return term_info(t).name;
 }
 std::string_view term_effect(Term t) {
-  return info[static_cast<int>(t)].effect;
+  return term_info(t).effect;
 }
 std::string_view term_unit(Term t) {
-  return info[static_cast<int>(t)].unit;
+  return term_info(t).unit;
+}
+
+std::string term_names() {
+  std::string names;
+  for (const TermInfo& info : table)
+    names += (names.empty() ? "" : ", ") + std::string(info.name);
+  return names;
 }
 
 Term parse_term(std::string_view name) {
-  for (Term t : all_terms)
-    if (term_name(t) == name) return t;
-  throw std::invalid_argument("unknown joint term '" + std::string(name) +
-                              "': expected one of k, c, k2, k3, c2, c3, fc");
+  for (const TermInfo& info : table)
+    if (info.name == name) return info.term;
+  throw std::invalid_argument("unknown joint term '" + std::string(name) + "': expected one of " +
+                              term_names());
 }
 
 double basis(Term t, double y, double v) {
-  switch (t) {
-  case Term::k:
-    return y;
-  case Term::c:
-    return v;
-  case Term::k2:
-    return y * y;
-  case Term::k3:
-    return y * y * y;
-  case Term::c2:
-    return v * std::abs(v);
-  case Term::c3:
-    return v * v * v;
-  case Term::fc:
-    return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0;
-  }
-  return 0.0;
+  return term_info(t).g(y, v);
 }
 
-double basis_dy(Term t, double y, double) {
-  switch (t) {
-  case Term::k:
-    return 1.0;
-  case Term::k2:
-    return 2.0 * y;
-  case Term::k3:
-    return 3.0 * y * y;
-  default:
-    return 0.0;
-  }
+double basis_dy(Term t, double y, double v) {
+  return term_info(t).dg_dy(y, v);
 }
 
-double basis_dydot(Term t, double, double v) {
-  switch (t) {
-  case Term::c:
-    return 1.0;
-  case Term::c2:
-    return 2.0 * std::abs(v);
-  case Term::c3:
-    return 3.0 * v * v;
-  default:
-    return 0.0;
-  }
+double basis_dydot(Term t, double y, double v) {
+  return term_info(t).dg_dydot(y, v);
 }
 
 } // namespace jointid::joints

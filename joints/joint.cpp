@@ -27,7 +27,8 @@ void validate_joints(const std::vector<Joint>& joints, const fem::DofMap& dofs) 
     if (!names.insert(j.name).second)
       throw std::invalid_argument("duplicate joint name '" + j.name + "'");
     if (j.terms.empty()) throw std::invalid_argument(which + " has no terms");
-    if (j.values.size() != j.terms.size() || j.fixed.size() != j.terms.size())
+    if (j.values.size() != j.terms.size() || j.fixed.size() != j.terms.size() ||
+        (!j.given.empty() && j.given.size() != j.terms.size()))
       throw std::invalid_argument(which + ": values and terms differ in number");
     std::set<Term> seen;
     for (Term t : j.terms)

@@ -20,12 +20,16 @@ struct Joint {
   std::vector<Term> terms;
   std::vector<double> values; ///< b_j, same order as terms (known or starting values)
   std::vector<bool> fixed;    ///< true: b_j is known and held, not identified
+  /// true where `values` holds a value given in the model file; false: unknown (starts at 0).
+  /// Empty: every value is given.
+  std::vector<bool> given;
 
   bool to_ground() const { return node_b == 0; }
   /// g(y, ẏ) with the joint's values.
   double force(double y, double ydot) const;
   /// Index of a term in `terms`, or -1.
   int term_index(Term t) const;
+  bool has_value(std::size_t term) const { return given.empty() || given[term]; }
 };
 
 /// Checks the joints against the model's DOF map (nodes exist, DOFs present and free, names

@@ -263,7 +263,7 @@ TEST_F(CliTest, BadModelFailsAndKeepsTheOldResult) {
 TEST_F(CliTest, RecordWithoutTheJointChannelFails) {
   ASSERT_EQ(simulate_.status, 0) << simulate_.err;
   identify::Record r = io::read_record(record_files()[0]);
-  r.channels.erase(r.channels.begin() + 1); // drop x@7:uy
+  r.channels.erase(r.channels.begin() + 1, r.channels.begin() + 3); // drop x@7:uy and v@7:uy
   const fs::path partial = dir() / "no_x.csv";
   io::write_record(partial, r);
   const fs::path result = dir() / "old_result2.json";

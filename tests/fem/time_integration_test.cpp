@@ -35,7 +35,7 @@ Complex fundamental(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double o
 
 joints::Joint joint(std::string name, int node, int node_b, Dof dof,
                     std::vector<joints::Term> terms, std::vector<double> values) {
-  joints::Joint j{std::move(name), node, node_b, dof, std::move(terms), std::move(values), {}};
+  joints::Joint j{std::move(name), node, node_b, dof, std::move(terms), std::move(values), {}, {}};
   j.fixed.assign(j.terms.size(), true);
   return j;
 }

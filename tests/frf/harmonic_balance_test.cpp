@@ -22,7 +22,7 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 
 joints::Joint make(std::string name, int node, int node_b, std::vector<Term> terms,
                    std::vector<double> values) {
-  joints::Joint j{std::move(name), node, node_b, Dof::uy, std::move(terms), std::move(values), {}};
+  joints::Joint j{std::move(name), node, node_b, Dof::uy, std::move(terms), std::move(values), {}, {}};
   j.fixed.assign(j.terms.size(), true);
   return j;
 }

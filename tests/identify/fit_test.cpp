@@ -21,8 +21,8 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 
 joints::Joint make_joint(std::string name, int node, int node_b, std::vector<Term> terms,
                          std::vector<double> values) {
-  joints::Joint j{std::move(name),   node, node_b, fem::Dof::uy, std::move(terms),
-                  std::move(values), {}};
+  joints::Joint j{std::move(name), node, node_b, fem::Dof::uy, std::move(terms),
+                  std::move(values), {}, {}};
   j.fixed.assign(j.terms.size(), false);
   return j;
 }
@@ -254,7 +254,7 @@ TEST_F(FitTest, WarnsAboutUnsteadyAndClippedRecordsAndDerivedVelocity) {
   identify::Record no_velocity = records[2];
   no_velocity.channels.pop_back();
   const identify::FitResult r =
-      identify::fit(H, system.dofs, truth, {growing, clipped, no_velocity});
+      identify::fit(H, system.dofs, truth, std::vector<identify::Record>{growing, clipped, no_velocity});
   auto warned = [&](const std::string& source, const std::string& what) {
     for (const auto& w : r.warnings)
       if (w.find(source) != std::string::npos && w.find(what) != std::string::npos) return true;
@@ -281,7 +281,10 @@ TEST_F(FitTest, DerivedVelocityStillIdentifies) {
 TEST_F(FitTest, MissingJointChannelNamesTheRecordAndChannel) {
   const std::vector<joints::Joint> truth{make_joint("tip", 7, 0, {Term::k}, {4800})};
   identify::Record r = hb_record(truth, 7, 3.0, 80.0);
-  r.channels.erase(r.channels.begin() + 1); // drop x@7:uy
+  ASSERT_EQ(r.channels[1].name(), "x@7:uy");
+  ASSERT_EQ(r.channels[2].name(), "v@7:uy");
+  // Velocity alone would do (the displacement is derived from it): drop both.
+  r.channels.erase(r.channels.begin() + 1, r.channels.begin() + 3);
   try {
     identify::fit(H, system.dofs, truth, std::vector<identify::Record>{r});
     FAIL();

@@ -119,3 +119,40 @@ TEST(Basis, ParseTermRejectsUnknownNames) {
     EXPECT_NE(message.find("k, c, k2, k3, c2, c3, fc"), std::string::npos) << message;
   }
 }
+
+TEST(Basis, TableEntriesAreInEnumOrder) {
+  for (Term t : all_terms) {
+    EXPECT_EQ(term_info(t).term, t);
+    EXPECT_EQ(&term_info(t), &term_table()[static_cast<std::size_t>(t)]);
+  }
+}
+
+// The properties the table declares (degree, parity, nature) are checked on g itself, so a
+// wrong entry — which would mislead discovery's diagnosis — fails here.
+TEST(Basis, DeclaredPropertiesHoldForTheForceLaw) {
+  for (Term t : all_terms) {
+    const TermInfo& info = term_info(t);
+    for (double y : samples)
+      for (double v : samples) {
+        const double g = basis(t, y, v);
+        // Homogeneity: g(s y, s v) = s^degree g(y, v).
+        for (double s : {0.5, 3.0})
+          EXPECT_NEAR(basis(t, s * y, s * v), std::pow(s, info.degree) * g,
+                      1e-12 * (1 + std::abs(g)) * std::pow(s, info.degree))
+              << info.name << " s=" << s;
+        // Parity: even terms are unchanged by (y, v) → (−y, −v), the others change sign.
+        EXPECT_DOUBLE_EQ(basis(t, -y, -v), info.even ? g : -g) << info.name;
+        // Nature: a conservative force ignores ẏ, a dissipative one ignores y.
+        if (info.nature == Nature::conservative)
+          EXPECT_EQ(basis(t, y, 2.0 * v + 1.0), g) << info.name;
+        else
+          EXPECT_EQ(basis(t, 2.0 * y + 1.0, v), g) << info.name;
+      }
+    EXPECT_EQ(is_linear(t), t == Term::k || t == Term::c) << info.name;
+    EXPECT_FALSE(info.rotational_unit.empty()) << info.name;
+  }
+}
+
+TEST(Basis, NameListComesFromTheTable) {
+  EXPECT_EQ(term_names(), "k, c, k2, k3, c2, c3, fc");
+}

@@ -18,7 +18,7 @@ namespace {
 
 Joint make(std::string name, int node, int node_b, std::vector<Term> terms,
            std::vector<double> values, Dof dof = Dof::uy) {
-  Joint j{std::move(name), node, node_b, dof, std::move(terms), std::move(values), {}};
+  Joint j{std::move(name), node, node_b, dof, std::move(terms), std::move(values), {}, {}};
   j.fixed.assign(j.terms.size(), false);
   return j;
 }

@@ -1,0 +1,830 @@
+#include "discover/discover.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <future>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+#include <stdexcept>
+
+namespace jointid::discover {
+
+namespace {
+
+using Complex = std::complex<double>;
+constexpr double inf = std::numeric_limits<double>::infinity();
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+std::string pct(double fraction) {
+  return fmt::format("{:.3g} %", 100.0 * fraction);
+}
+
+std::string number(double v) {
+  return fmt::format("{:.4g}", v);
+}
+
+void add_unique(std::vector<int>& list, int value) {
+  if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
+}
+
+// A value compared: test i, response j, harmonic k.
+struct Entry {
+  int test, response, harmonic;
+  Complex measured;
+  double variance; // E|δX|², NaN when unknown
+};
+
+// The substructure's receptance (its damping scaled) and the harmonic-balance problems of
+// every test built on it.
+struct Simulator {
+  double scale = 1.0;
+  frf::ModalSynthesis synthesis;
+  std::vector<frf::HarmonicBalance> balance;
+};
+
+class Engine {
+public:
+  Engine(const frf::Substructure& sub, const std::vector<joints::Joint>& start,
+         const std::vector<identify::Measurement>& tests, const Options& o)
+      : sub_(sub), dofs_(sub.dofs()), tests_(tests), o_(o) {
+    if (tests.empty()) throw std::invalid_argument("discover: no tests");
+    if (start.empty()) throw std::invalid_argument("discover: the model has no joints");
+    if (o.harmonics.empty()) throw std::invalid_argument("discover: no harmonics to fit");
+    for (int k : o.harmonics)
+      if (k < 0) throw std::invalid_argument("discover: harmonics must be >= 0");
+    K_ = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
+    if (o.balance.harmonics < K_)
+      throw std::invalid_argument("discover: the harmonic balance needs at least as many "
+                                  "harmonics as are compared");
+    joints::validate_joints(start, dofs_);
+    layout_ = start;
+
+    // Equations: the joints' DOFs, every force and every response of every test.
+    synthesis_dofs_ = joints::joint_dof_set(start, dofs_);
+    double f_max = 0.0;
+    for (const auto& m : tests) {
+      if (m.harmonics < K_ && !m.fundamental_only)
+        throw std::invalid_argument(m.source + ": measured to harmonic " +
+                                    std::to_string(m.harmonics) + ", but " + std::to_string(K_) +
+                                    " are compared");
+      std::vector<int> forces, responses;
+      for (const auto& at : m.force_at)
+        forces.push_back(equation(m, "force channel f@", at));
+      for (std::size_t j = 0; j < m.response_at.size(); ++j)
+        responses.push_back(equation(
+            m, std::string(1, identify::quantity_letter(m.measured_as[j])) + "@",
+            m.response_at[j]));
+      for (int e : forces)
+        add_unique(synthesis_dofs_, e);
+      for (int e : responses)
+        add_unique(synthesis_dofs_, e);
+      force_eq_.push_back(std::move(forces));
+      response_eq_.push_back(std::move(responses));
+      f_max = std::max(f_max, m.frequency_hz);
+    }
+    f_max_ = f_max * o.balance.harmonics;
+    base_ = std::make_unique<frf::ModalSynthesis>(
+        sub.synthesis(synthesis_dofs_, f_max_, &notes_));
+
+    // The compared values.
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+      const auto& m = tests[i];
+      for (std::size_t j = 0; j < m.response_at.size(); ++j)
+        for (int k = 0; k <= K_; ++k) {
+          if (!m.has_harmonic(k) || (k == 0 && !m.has_mean[j])) continue;
+          entries_.push_back({static_cast<int>(i), static_cast<int>(j), k,
+                              m.X(k, static_cast<Eigen::Index>(j)),
+                              m.X_variance(k, static_cast<Eigen::Index>(j))});
+          values_ += k == 0 ? 1 : 2;
+          measured2_ += std::norm(entries_.back().measured);
+          if (!(entries_.back().variance > 0.0)) noise_known_ = false;
+        }
+    }
+    if (!(measured2_ > 0.0)) throw std::invalid_argument("discover: every response is zero");
+    if (noise_known_) {
+      double noise2 = 0.0;
+      for (const auto& e : entries_)
+        noise2 += e.variance;
+      noise_gap_ = std::sqrt(noise2 / measured2_);
+    }
+  }
+
+  Result run() {
+    Result out;
+    out.tests = static_cast<int>(tests_.size());
+    out.compared_values = values_;
+    out.noise_gap = noise_known_ ? noise_gap_ : -1.0;
+    out.warnings = notes_;
+    for (const auto& m : tests_)
+      out.warnings.insert(out.warnings.end(), m.warnings.begin(), m.warnings.end());
+
+    // 1. The starting model: values not given are identified from all tests.
+    State state;
+    std::vector<joints::Joint> joints = layout_;
+    std::vector<std::string> missing;
+    for (const auto& j : joints)
+      for (std::size_t t = 0; t < j.terms.size(); ++t)
+        if (!j.has_value(t) && !j.fixed[t])
+          missing.push_back(fmt::format("{} of '{}'", joints::term_name(j.terms[t]), j.name));
+    const bool fitted = !missing.empty();
+    identify::FitResult start_fit;
+    if (fitted) {
+      start_fit = identify(joints, simulator(1.0), all_tests());
+      joints = start_fit.identified(joints);
+      std::string values;
+      for (const auto& je : start_fit.joints)
+        for (const auto& te : je.terms)
+          if (!te.fixed)
+            values += fmt::format("{}{} of '{}' = {} {}", values.empty() ? "" : ", ",
+                                  joints::term_name(te.term), je.name, number(te.value),
+                                  joints::term_unit(te.term));
+      out.start_notes.push_back(fmt::format(
+          "No value was given for {}: the starting terms were identified from all {} tests "
+          "(harmonics {}): {}.",
+          join(missing), tests_.size(), join_harmonics(), values));
+    } else {
+      out.start_notes.push_back("Every starting term has a value in the model file; those values "
+                                "are the starting model.");
+    }
+    state = evaluate(joints, 1.0);
+    state.fit = start_fit;
+    if (!state.converged)
+      out.warnings.push_back("the harmonic balance did not converge for every test with the "
+                             "starting model");
+    out.states.push_back(state);
+    bool values_fitted = fitted;
+
+    // 2. Add what explains the disagreement, while something significant is left.
+    for (int step = 0; step < o_.max_steps; ++step) {
+      if (at_noise_level(state)) {
+        out.stop_reason = fmt::format("the gap ({}) is at the noise level ({}): nothing "
+                                      "significant is left to explain",
+                                      number(state.gap), number(noise_gap_));
+        break;
+      }
+      std::vector<Candidate> ranking;
+      std::vector<State> states;
+      auto consider = [&](Candidate c, State s) {
+        ranking.push_back(std::move(c));
+        states.push_back(std::move(s));
+      };
+      if (!values_fitted) consider_refit(state, consider);
+      for (const auto& j : state.joints)
+        for (joints::Term t : o_.terms)
+          if (j.term_index(t) < 0) consider_term(state, j.name, t, consider);
+      if (o_.substructure_damping) consider_damping(state, consider);
+
+      // Admissible and better than the current model by the criterion, best first.
+      std::vector<std::size_t> order(ranking.size());
+      for (std::size_t i = 0; i < order.size(); ++i) {
+        order[i] = i;
+        Candidate& c = ranking[i];
+        c.explained = 1.0 - std::pow(c.gap / state.gap, 2);
+        if (c.rejected.empty() && !(c.criterion < state.criterion))
+          c.rejected = fmt::format("not significant (information criterion {} vs {} now)",
+                                   number(c.criterion), number(state.criterion));
+      }
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return ranking[a].criterion < ranking[b].criterion;
+      });
+      if (step == 0) out.diagnosis = diagnose(state, ranking);
+
+      std::optional<std::size_t> chosen;
+      double cv_now = -1.0;
+      for (std::size_t i : order) {
+        Candidate& c = ranking[i];
+        if (!c.rejected.empty()) continue;
+        if (cv_now < 0.0) cv_now = cross_validated(state.joints, state.damping_scale);
+        c.cv_gap = cross_validated(states[i].joints, states[i].damping_scale);
+        if (cv_now >= 0.0 && c.cv_gap >= 0.0 && !(c.cv_gap < cv_now)) {
+          c.rejected = fmt::format("does not predict held-out tests better (cross-validated "
+                                   "gap {} vs {} now)",
+                                   number(c.cv_gap), number(cv_now));
+          continue;
+        }
+        chosen = i;
+        break;
+      }
+      Step s;
+      for (std::size_t i : order)
+        s.ranking.push_back(ranking[i]);
+      if (!chosen) {
+        const Candidate& best = ranking[order.front()];
+        out.stop_reason = fmt::format(
+            "no addition is significant (the best, {}, was rejected: {}); the gap stays at {}",
+            best.name(), best.rejected, number(state.gap));
+        out.last_ranking = std::move(s.ranking);
+        break;
+      }
+      s.added = ranking[*chosen];
+      s.gap_before = state.gap;
+      s.cv_before = cv_now;
+      s.cv_after = s.added.cv_gap;
+      state = std::move(states[*chosen]);
+      s.gap_after = state.gap;
+      s.finding = fmt::format(
+          "Added {} ({}) = {} [{}, {}]: the gap fell from {} to {} ({} of it explained).",
+          s.added.name(), s.added.effect(), number(s.added.value), number(s.added.ci_low),
+          number(s.added.ci_high), number(s.gap_before), number(s.gap_after),
+          pct(s.added.explained));
+      values_fitted = true;
+      out.steps.push_back(std::move(s));
+      out.states.push_back(state);
+      if (step + 1 == o_.max_steps)
+        out.stop_reason = fmt::format("stopped after the maximum of {} steps", o_.max_steps);
+    }
+    if (out.stop_reason.empty())
+      out.stop_reason = fmt::format("stopped after the maximum of {} steps", o_.max_steps);
+    for (const auto& s : out.states) {
+      out.gap.push_back(s.gap);
+      out.comparisons.push_back(compare(s));
+    }
+    out.at_noise_level = at_noise_level(out.states.back());
+    if (out.steps.empty() && out.at_noise_level && out.diagnosis.findings.empty())
+      out.diagnosis.findings.push_back(fmt::format(
+          "The starting model reproduces the measurement to the noise level (gap {}, noise {}): "
+          "nothing is missing.",
+          number(state.gap), number(noise_gap_)));
+    out.diagnosis.findings.push_back(summary(out));
+    return out;
+  }
+
+private:
+  using Consider = std::function<void(Candidate, State)>;
+
+  int equation(const identify::Measurement& m, const std::string& what, const fem::NodeDof& at) {
+    try {
+      return dofs_.equation(at);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(m.source + ": channel " + what + fem::to_string(at) + ": " +
+                                  e.what());
+    }
+  }
+
+  static std::string join(const std::vector<std::string>& items) {
+    std::string s;
+    for (std::size_t i = 0; i < items.size(); ++i)
+      s += (i == 0 ? "" : i + 1 == items.size() ? " and " : ", ") + items[i];
+    return s;
+  }
+  std::string join_harmonics() const {
+    std::vector<std::string> h;
+    for (int k : o_.harmonics)
+      h.push_back(std::to_string(k));
+    return join(h);
+  }
+
+  std::vector<int> all_tests() const {
+    std::vector<int> all(tests_.size());
+    for (std::size_t i = 0; i < all.size(); ++i)
+      all[i] = static_cast<int>(i);
+    return all;
+  }
+
+  const Simulator& simulator(double scale) {
+    for (const auto& s : simulators_)
+      if (s->scale == scale) return *s;
+    auto s = std::make_unique<Simulator>(
+        Simulator{scale, scale == 1.0 ? *base_ : base_->with_damping_scale(scale), {}});
+    for (std::size_t i = 0; i < tests_.size(); ++i)
+      s->balance.emplace_back(s->synthesis, layout_, dofs_, force_eq_[i], response_eq_[i],
+                              tests_[i].frequency_hz, o_.balance);
+    // Keep the model's own damping and the latest few scales.
+    if (simulators_.size() > 4) simulators_.erase(simulators_.begin() + 1);
+    simulators_.push_back(std::move(s));
+    return *simulators_.back();
+  }
+
+  // Identifies every non-fixed term from the tests `use`, with the damping scaled.
+  identify::FitResult identify(const std::vector<joints::Joint>& joints, const Simulator& sim,
+                               const std::vector<int>& use) const {
+    std::vector<std::string> warnings;
+    std::vector<identify::TestSpectrum> spectra;
+    for (int i : use)
+      spectra.push_back(identify::spectrum(tests_[i], dofs_, joints, warnings));
+    const identify::ReceptanceFn H = [&sim](double w, std::span<const int> rows,
+                                            std::span<const int> cols) {
+      return sim.synthesis.receptance(w, rows, cols);
+    };
+    identify::FitOptions fo;
+    fo.harmonics = o_.harmonics;
+    return identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
+  }
+
+  int parameters(const std::vector<joints::Joint>& joints, double scale) const {
+    int p = scale != 1.0 ? 1 : 0;
+    for (const auto& j : joints)
+      for (bool f : j.fixed)
+        p += f ? 0 : 1;
+    return p;
+  }
+
+  // Simulates every test (or those in `only`) with these joints; previous states seed Newton.
+  State evaluate(const std::vector<joints::Joint>& joints, double scale) {
+    const Simulator& sim = simulator(scale);
+    State s;
+    s.joints = joints;
+    s.damping_scale = scale;
+    s.parameters = parameters(joints, scale);
+    s.X.assign(tests_.size(), Eigen::MatrixXcd());
+    for (std::size_t i = 0; i < tests_.size(); ++i) {
+      const frf::HarmonicBalanceResult r = sim.balance[i].solve(joints, tests_[i].F);
+      s.converged = s.converged && r.converged && r.X.allFinite();
+      s.X[i] = r.X.topRows(K_ + 1);
+    }
+    double S = 0.0, chi2 = 0.0;
+    for (const auto& e : entries_) {
+      if (s.X[e.test].size() == 0) continue;
+      const double d = std::norm(e.measured - s.X[e.test](e.harmonic, e.response));
+      S += d;
+      chi2 += noise_known_ ? 2.0 * d / e.variance : 0.0;
+    }
+    s.gap = std::sqrt(S / measured2_);
+    s.chi2 = noise_known_ ? chi2 : nan;
+    const double N = values_, penalty = s.parameters * std::log(N);
+    s.criterion = !s.converged ? inf
+                  : noise_known_ ? chi2 + penalty
+                                 : N * std::log(std::max(S, 1e-300 * measured2_) / N) + penalty;
+    return s;
+  }
+
+  bool at_noise_level(const State& s) const {
+    if (!noise_known_) return false;
+    return s.chi2 / values_ <= 1.0 + 3.0 * std::sqrt(2.0 / values_);
+  }
+
+  // Fills a candidate from a fit and the state it gave.
+  static void take_fit(Candidate& c, const identify::FitResult& fit, const std::string& joint,
+                       joints::Term term) {
+    for (const auto& je : fit.joints)
+      if (je.name == joint)
+        for (const auto& te : je.terms)
+          if (te.term == term) {
+            c.value = te.value;
+            c.std = te.std;
+            c.ci_low = te.ci_low;
+            c.ci_high = te.ci_high;
+          }
+  }
+
+  static std::string physical_problem(const std::vector<joints::Joint>& joints) {
+    for (const auto& j : joints)
+      for (std::size_t t = 0; t < j.terms.size(); ++t)
+        if (joints::term_info(j.terms[t]).nature == joints::Nature::dissipative &&
+            j.values[t] < 0.0)
+          return fmt::format("not physical: {} of '{}' came out negative ({}), a joint that "
+                             "gives energy",
+                             joints::term_name(j.terms[t]), j.name, number(j.values[t]));
+    return {};
+  }
+
+  void consider_refit(const State& state, const Consider& consider) {
+    Candidate c;
+    c.refit = true;
+    c.joint = state.joints.front().name;
+    try {
+      const identify::FitResult fit =
+          identify(state.joints, simulator(state.damping_scale), all_tests());
+      State s = evaluate(fit.identified(state.joints), state.damping_scale);
+      s.fit = fit;
+      fill(c, s);
+      consider(std::move(c), std::move(s));
+    } catch (const std::invalid_argument& e) {
+      c.rejected = std::string("cannot be identified: ") + e.what();
+      c.gap = c.criterion = inf;
+      consider(std::move(c), state);
+    }
+  }
+
+  void consider_term(const State& state, const std::string& joint, joints::Term term,
+                     const Consider& consider) {
+    Candidate c;
+    c.joint = joint;
+    c.term = term;
+    std::vector<joints::Joint> joints = state.joints;
+    for (auto& j : joints)
+      if (j.name == joint) {
+        j.terms.push_back(term);
+        j.values.push_back(0.0);
+        j.fixed.push_back(false);
+        if (!j.given.empty()) j.given.push_back(false);
+      }
+    try {
+      const identify::FitResult fit = identify(joints, simulator(state.damping_scale), all_tests());
+      joints = fit.identified(joints);
+      take_fit(c, fit, joint, term);
+      State s = evaluate(joints, state.damping_scale);
+      s.fit = fit;
+      fill(c, s);
+      if (c.rejected.empty()) c.rejected = physical_problem(joints);
+      if (c.rejected.empty() && c.ci_low <= 0.0 && c.ci_high >= 0.0)
+        c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 0",
+                                 number(c.ci_low), number(c.ci_high));
+      consider(std::move(c), std::move(s));
+    } catch (const std::invalid_argument& e) {
+      c.rejected = std::string("cannot be identified: ") + e.what();
+      c.gap = c.criterion = inf;
+      consider(std::move(c), state);
+    }
+  }
+
+  // The substructure's damping scaled by s (ln s searched by golden section on the
+  // criterion, every joint term identified again at each trial).
+  void consider_damping(const State& state, const Consider& consider) {
+    Candidate c;
+    c.joint = "substructure";
+    std::map<double, State> tried;
+    auto trial = [&](double u) -> double {
+      const double s = std::exp(u);
+      try {
+        const identify::FitResult fit = identify(state.joints, simulator(s), all_tests());
+        State st = evaluate(fit.identified(state.joints), s);
+        st.fit = fit;
+        if (!st.converged) return inf;
+        const double f = st.criterion;
+        tried.emplace(u, std::move(st));
+        return f;
+      } catch (const std::invalid_argument&) {
+        return inf;
+      }
+    };
+    // A coarse scan, then golden section around the best point.
+    const double lo = std::log(0.05), hi = std::log(20.0);
+    double best_u = 0.0, best_f = inf;
+    for (int i = 0; i <= 8; ++i) {
+      const double u = lo + (hi - lo) * i / 8.0, f = trial(u);
+      if (f < best_f) best_f = f, best_u = u;
+    }
+    const double g = (std::sqrt(5.0) - 1.0) / 2.0, width = (hi - lo) / 8.0;
+    double a = best_u - width, b = best_u + width;
+    double c1 = b - g * (b - a), c2 = a + g * (b - a), f1 = trial(c1), f2 = trial(c2);
+    for (int it = 0; it < 14; ++it) {
+      if (f1 < f2)
+        b = c2, c2 = c1, f2 = f1, c1 = b - g * (b - a), f1 = trial(c1);
+      else
+        a = c1, c1 = c2, f1 = f2, c2 = a + g * (b - a), f2 = trial(c2);
+    }
+    if (tried.empty()) {
+      c.rejected = "the damping scale could not be identified";
+      c.gap = c.criterion = inf;
+      consider(std::move(c), state);
+      return;
+    }
+    auto best = std::min_element(tried.begin(), tried.end(), [](const auto& x, const auto& y) {
+      return x.second.criterion < y.second.criterion;
+    });
+    const double u = best->first;
+    // Its uncertainty from the curvature of the misfit in ln s: χ² with known noise, else
+    // S / σ̂² with σ̂² = S_min / (N − p); σ_u² = 2 / (∂²misfit/∂u²).
+    const double h = 0.02;
+    auto state_at = [&](double uu) -> const State* {
+      if (!tried.count(uu) && !std::isfinite(trial(uu))) return nullptr;
+      return &tried.at(uu);
+    };
+    double sigma_u = nan;
+    const State* s0 = state_at(u);
+    const State* sp = state_at(u + h);
+    const State* sm = state_at(u - h);
+    if (s0 && sp && sm) {
+      const double sigma2 = s0->gap * s0->gap * measured2_ / std::max(1, values_ - s0->parameters);
+      auto misfit = [&](const State* st) {
+        return noise_known_ ? st->chi2 : st->gap * st->gap * measured2_ / sigma2;
+      };
+      const double curvature = (misfit(sp) - 2.0 * misfit(s0) + misfit(sm)) / (h * h);
+      if (curvature > 0.0) sigma_u = std::sqrt(2.0 / curvature);
+    }
+    State st = tried.at(u);
+    c.value = std::exp(u);
+    c.std = c.value * sigma_u;
+    c.ci_low = std::exp(u - 1.96 * sigma_u);
+    c.ci_high = std::exp(u + 1.96 * sigma_u);
+    fill(c, st);
+    if (c.rejected.empty() && std::isfinite(sigma_u) && c.ci_low <= 1.0 && c.ci_high >= 1.0)
+      c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 1",
+                               number(c.ci_low), number(c.ci_high));
+    if (c.rejected.empty()) c.rejected = physical_problem(st.joints);
+    consider(std::move(c), std::move(st));
+  }
+
+  void fill(Candidate& c, const State& s) const {
+    c.gap = s.gap;
+    c.criterion = s.criterion;
+    c.converged = s.converged;
+    if (!s.converged) c.rejected = "a re-simulation did not converge";
+  }
+
+  // The gap of leave-one-test-out (or k-fold) predictions: each fold's tests are predicted by
+  // the model identified from the others. < 0 when the folds cannot be identified.
+  double cross_validated(const std::vector<joints::Joint>& joints, double scale) {
+    const int n = static_cast<int>(tests_.size());
+    if (n < 4) return -1.0;
+    const int folds = n <= 30 ? n : o_.folds;
+    const Simulator& sim = simulator(scale);
+    double S = 0.0;
+    for (int f = 0; f < folds; ++f) {
+      std::vector<int> train, held;
+      for (int i = 0; i < n; ++i)
+        (i % folds == f ? held : train).push_back(i);
+      std::vector<joints::Joint> fitted;
+      try {
+        fitted = identify(joints, sim, train).identified(joints);
+      } catch (const std::invalid_argument&) {
+        return -1.0;
+      }
+      for (int i : held) {
+        const frf::HarmonicBalanceResult r = sim.balance[i].solve(fitted, tests_[i].F);
+        if (!r.converged) return inf;
+        for (const auto& e : entries_)
+          if (e.test == i) S += std::norm(e.measured - r.X(e.harmonic, e.response));
+      }
+    }
+    return std::sqrt(S / measured2_);
+  }
+
+  std::vector<Comparison> compare(const State& s) const {
+    std::vector<Comparison> out;
+    for (std::size_t i = 0; i < tests_.size(); ++i) {
+      const auto& m = tests_[i];
+      for (std::size_t j = 0; j < m.response_at.size(); ++j) {
+        const auto jj = static_cast<Eigen::Index>(j);
+        Comparison c;
+        c.test = m.source;
+        c.channel = std::string(1, identify::quantity_letter(m.measured_as[j])) + "@" +
+                    fem::to_string(m.response_at[j]);
+        c.frequency_hz = m.frequency_hz;
+        c.force = identify::force_level(m);
+        c.measured = m.X(1, jj);
+        c.simulated = s.X[i](1, jj);
+        c.amplitude_error = std::abs(c.simulated) / std::max(std::abs(c.measured), 1e-300) - 1.0;
+        c.phase_error_deg = std::arg(c.simulated / c.measured) * 180.0 / std::numbers::pi;
+        double hm = 0.0, hs = 0.0;
+        if (!m.fundamental_only)
+          for (int k = 2; k <= K_; ++k)
+            hm += std::norm(m.X(k, jj)), hs += std::norm(s.X[i](k, jj));
+        c.harmonics_measured = std::sqrt(hm) / std::max(std::abs(c.measured), 1e-300);
+        c.harmonics_simulated = std::sqrt(hs) / std::max(std::abs(c.measured), 1e-300);
+        out.push_back(c);
+      }
+    }
+    return out;
+  }
+
+  Diagnosis diagnose(const State& s, const std::vector<Candidate>& ranking) const {
+    Diagnosis d;
+    // Which channel disagrees most.
+    std::map<std::string, std::pair<double, double>> per_channel; // error², measured²
+    double even = 0.0, even_noise = 0.0;
+    std::string even_where;
+    for (const auto& e : entries_) {
+      const auto& m = tests_[e.test];
+      const std::string ch =
+          std::string(1, identify::quantity_letter(m.measured_as[e.response])) + "@" +
+          fem::to_string(m.response_at[e.response]);
+      const Complex err = e.measured - s.X[e.test](e.harmonic, e.response);
+      per_channel[ch].first += std::norm(err);
+      per_channel[ch].second += std::norm(e.measured);
+      if (e.harmonic == 0 || e.harmonic == 2) {
+        const double x1 = std::abs(m.X(1, e.response));
+        const double ratio = std::abs(err) / std::max(x1, 1e-300);
+        const double noise = e.variance > 0.0 ? std::sqrt(e.variance) / std::max(x1, 1e-300) : 0.0;
+        if (ratio - 3.0 * noise > even - 3.0 * even_noise)
+          even = ratio, even_noise = noise, even_where = ch;
+      }
+    }
+    for (const auto& [ch, v] : per_channel) {
+      const double rel = std::sqrt(v.first / std::max(v.second, 1e-300));
+      if (rel > d.channel_error) d.channel_error = rel, d.channel = ch;
+    }
+    d.even_content = even;
+    const bool any_harmonics = std::any_of(tests_.begin(), tests_.end(),
+                                           [](const auto& m) { return !m.fundamental_only; });
+    d.even_harmonics = any_harmonics && even > 3.0 * even_noise &&
+                       (noise_known_ || even > 1e-3);
+
+    // Best admissible-looking candidates of each family (by how much of the gap they explain).
+    auto best = [&](auto&& keep) {
+      double share = 0.0;
+      const Candidate* who = nullptr;
+      for (const auto& c : ranking)
+        if (c.converged && std::isfinite(c.gap) && keep(c) && c.explained > share)
+          share = c.explained, who = &c;
+      return std::pair{share, who};
+    };
+    const auto [lin, lin_c] = best([](const Candidate& c) { return c.linear(); });
+    const auto [non, non_c] = best([](const Candidate& c) { return !c.linear(); });
+    const auto [cons, cons_c] = best([](const Candidate& c) {
+      return c.term && !c.linear() &&
+             joints::term_info(*c.term).nature == joints::Nature::conservative;
+    });
+    const auto [diss, diss_c] = best([](const Candidate& c) {
+      return c.term && !c.linear() &&
+             joints::term_info(*c.term).nature == joints::Nature::dissipative;
+    });
+    d.linear_explains = lin;
+    d.nonlinear_explains = non;
+    d.conservative_explains = cons;
+    d.dissipative_explains = diss;
+    const bool significant = std::any_of(ranking.begin(), ranking.end(),
+                                         [](const Candidate& c) { return c.rejected.empty(); });
+
+    if (noise_known_)
+      d.findings.push_back(fmt::format(
+          "The starting model leaves a gap of {} against a noise level of {} (the gap a perfect "
+          "model would leave, from the records' own scatter).",
+          number(s.gap), number(noise_gap_)));
+    else
+      d.findings.push_back(fmt::format("The starting model leaves a gap of {}; the noise level "
+                                       "is unknown (stepped-sine tables carry no time records).",
+                                       number(s.gap)));
+    if (!d.channel.empty())
+      d.findings.push_back(fmt::format("The largest disagreement is at channel {} ({} of its "
+                                       "measured amplitude over all tests).",
+                                       d.channel, pct(d.channel_error)));
+    for (const auto& f : level_evidence())
+      d.findings.push_back(f);
+    if (!significant) {
+      d.findings.push_back(
+          "No candidate explains a significant share of the disagreement: nothing is missing "
+          "that these tests can reveal.");
+      return d;
+    }
+    // Linear or not: can a linear correction do as well as a non-linear term?
+    const double N = values_;
+    const double lin_crit = lin_c ? lin_c->criterion : inf, non_crit = non_c ? non_c->criterion : inf;
+    d.level_dependent = non_crit + std::log(N) < lin_crit;
+    if (*d.level_dependent) {
+      d.findings.push_back(fmt::format(
+          "The disagreement changes with force level (non-linear): the best linear correction{} "
+          "explains {} of it, the best non-linear term ({}) {}.",
+          lin_c ? " (" + lin_c->name() + ")" : std::string(), pct(std::max(lin, 0.0)),
+          non_c->name(), pct(non)));
+    } else {
+      d.findings.push_back(fmt::format(
+          "The disagreement does not change with force level: a linear model error. The best "
+          "linear correction ({}) explains {} of it{}; no non-linear term does better.",
+          lin_c ? lin_c->name() : std::string("none"), pct(std::max(lin, 0.0)),
+          non_c ? fmt::format(", the best non-linear term ({}) {}", non_c->name(), pct(non))
+                : std::string()));
+    }
+    // Where.
+    std::map<std::string, double> by_joint;
+    for (const auto& c : ranking)
+      if (c.converged && std::isfinite(c.gap) && (!c.refit))
+        by_joint[c.joint] = std::max(by_joint[c.joint], c.explained);
+    const Candidate* where = *d.level_dependent ? non_c : lin_c;
+    if (where) {
+      d.joint = where->joint;
+      std::string others;
+      for (const auto& [name, share] : by_joint)
+        if (name != d.joint)
+          others += fmt::format("{}{} at most {}", others.empty() ? "" : ", ",
+                                name == "substructure" ? std::string("the substructure")
+                                                       : "terms at '" + name + "'",
+                                pct(std::max(share, 0.0)));
+      d.findings.push_back(fmt::format(
+          "It sits at {}: {} explain{} {}{}.",
+          d.joint == "substructure" ? std::string("the substructure") : "joint '" + d.joint + "'",
+          d.joint == "substructure" ? std::string("its damping")
+                                    : "terms at '" + d.joint + "'",
+          d.joint == "substructure" ? "s" : "", pct(by_joint[d.joint]),
+          others.empty() ? "" : "; " + others));
+    }
+    if (*d.level_dependent) {
+      d.nature = cons > diss ? "conservative" : "dissipative";
+      if (d.nature == "conservative") {
+        std::string how;
+        if (cons_c && cons_c->term == joints::Term::k3)
+          how = cons_c->value > 0.0 ? " (hardening: the resonance rises with level)"
+                                    : " (softening: the resonance falls with level)";
+        d.findings.push_back(fmt::format(
+            "Conservative: a stiffness term ({}) explains {}, the best damping term {}{}.",
+            cons_c->name(), pct(cons), diss_c ? "(" + diss_c->name() + ") " + pct(diss) : "none",
+            how));
+      } else {
+        d.findings.push_back(fmt::format(
+            "Dissipative: a damping term ({}) explains {}, the best stiffness term {}; the "
+            "damping changes with level.",
+            diss_c->name(), pct(diss),
+            cons_c ? "(" + cons_c->name() + ") " + pct(cons) : std::string("none")));
+      }
+    }
+    if (d.even_harmonics)
+      d.findings.push_back(fmt::format(
+          "Even harmonics: the measured response at {} holds a mean or second harmonic of {} of "
+          "its fundamental that the model does not produce{}: an asymmetric force (k2).",
+          even_where, pct(even),
+          noise_known_ ? fmt::format(" (noise {})", pct(even_noise)) : std::string()));
+    else if (any_harmonics)
+      d.findings.push_back("No even harmonics beyond the noise: the missing force is symmetric.");
+    else
+      d.findings.push_back("The tables give the fundamental only: harmonics cannot be judged.");
+    return d;
+  }
+
+  // Direct evidence of level dependence: tests at the same frequency (within 0.5 %) and force
+  // levels apart by 1.5× or more, compared by their measured receptance X₁/F₁.
+  std::vector<std::string> level_evidence() const {
+    double worst = 0.0, noise = 0.0;
+    std::string text;
+    for (std::size_t a = 0; a < tests_.size(); ++a)
+      for (std::size_t b = a + 1; b < tests_.size(); ++b) {
+        const auto &ta = tests_[a], &tb = tests_[b];
+        if (std::abs(ta.frequency_hz - tb.frequency_hz) > 0.005 * ta.frequency_hz) continue;
+        const double Fa = identify::force_level(ta), Fb = identify::force_level(tb);
+        if (std::max(Fa, Fb) < 1.5 * std::min(Fa, Fb) || ta.force_at.empty() ||
+            tb.force_at.empty())
+          continue;
+        for (std::size_t j = 0; j < ta.response_at.size(); ++j) {
+          const int jb = tb.response_index(ta.response_at[j]);
+          if (jb < 0) continue;
+          const Complex Ra = ta.X(1, static_cast<Eigen::Index>(j)) / ta.F(1, 0),
+                        Rb = tb.X(1, jb) / tb.F(1, 0);
+          const double change = std::abs(Ra - Rb) / std::max(std::abs(Rb), 1e-300);
+          const double va = ta.X_variance(1, static_cast<Eigen::Index>(j)),
+                       vb = tb.X_variance(1, jb);
+          const double sd = va > 0.0 && vb > 0.0
+                                ? std::sqrt(va / std::norm(ta.F(1, 0)) + vb / std::norm(tb.F(1, 0))) /
+                                      std::abs(Rb)
+                                : 0.0;
+          if (change > worst) {
+            worst = change, noise = sd;
+            text = fmt::format(
+                "At {} Hz the measured receptance at {}@{} changes by {} between {} and {} "
+                "(force amplitude){}.",
+                number(ta.frequency_hz), identify::quantity_letter(ta.measured_as[j]),
+                fem::to_string(ta.response_at[j]), pct(change), number(std::min(Fa, Fb)),
+                number(std::max(Fa, Fb)),
+                sd > 0.0 ? fmt::format("; the noise alone would change it by about {}", pct(sd))
+                         : std::string());
+          }
+        }
+      }
+    (void)noise;
+    if (text.empty()) return {};
+    return {text};
+  }
+
+  std::string summary(const Result& r) const {
+    std::string added;
+    for (const auto& s : r.steps)
+      added += (added.empty() ? "" : ", ") + s.added.name();
+    const double first = r.gap.front(), last = r.gap.back();
+    std::string noise = noise_known_ ? fmt::format("; the noise level is {}", number(noise_gap_))
+                                     : std::string("; the noise level is unknown");
+    if (added.empty())
+      return fmt::format("Nothing was added: the gap stays at {}{}. {}.", number(last), noise,
+                         r.stop_reason);
+    return fmt::format("Added {}: the gap shrank from {} to {} ({}× smaller){}{}.", added,
+                       number(first), number(last), number(first / std::max(last, 1e-300)), noise,
+                       r.at_noise_level ? ", which it has reached" : "");
+  }
+
+  const frf::Substructure& sub_;
+  const fem::DofMap& dofs_;
+  const std::vector<identify::Measurement>& tests_;
+  Options o_;
+  int K_ = 1;
+  std::vector<joints::Joint> layout_;
+  std::vector<int> synthesis_dofs_;
+  std::vector<std::vector<int>> force_eq_, response_eq_;
+  double f_max_ = 0.0;
+  std::vector<std::string> notes_;
+  std::unique_ptr<frf::ModalSynthesis> base_;
+  std::vector<std::unique_ptr<Simulator>> simulators_;
+  std::vector<Entry> entries_;
+  int values_ = 0;
+  double measured2_ = 0.0;
+  bool noise_known_ = true;
+  double noise_gap_ = nan;
+};
+
+} // namespace
+
+std::string Candidate::name() const {
+  if (refit) return "refit of the starting values";
+  if (!term) return "substructure damping";
+  return fmt::format("{} at '{}'", joints::term_name(*term), joint);
+}
+
+std::string Candidate::effect() const {
+  if (refit) return "linear terms identified again";
+  if (!term) return "substructure damping";
+  return std::string(joints::term_effect(*term));
+}
+
+bool Candidate::linear() const {
+  return refit || !term || joints::is_linear(*term);
+}
+
+Result discover(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,
+                const std::vector<identify::Measurement>& tests, const Options& options) {
+  Engine engine(substructure, start, tests, options);
+  return engine.run();
+}
+
+} // namespace jointid::discover

@@ -1,0 +1,148 @@
+#pragma once
+/// Model discovery: find where simulation and measurement disagree, name the missing effect at
+/// the right joint, add it, and show the gap shrink.
+///
+/// **The gap.** A model (the substructure and its joints with values) re-simulates every
+/// measured test by harmonic balance, driven by the measured force harmonics, and is compared
+/// with the measurement at every response channel and every compared harmonic k = 0 … K (only
+/// harmonic 1 for stepped-sine rows, and harmonic 0 only where the mean displacement was
+/// measured), all as displacements:
+///
+///     gap = sqrt( Σ |X_meas − X_sim|² / Σ |X_meas|² )       (sums over tests, channels, k)
+///
+/// The noise gap is what a perfect model would leave, sqrt(Σ E|δX|² / Σ |X_meas|²), with
+/// E|δX|² the noise variance of each measured harmonic that identify::measure estimates from
+/// the record itself; it is unknown for stepped-sine tables. "Explains p % of the gap" means
+/// the squared gap falls by p %.
+///
+/// **The loop.** Terms without values are identified first (with all tests). Then, while the
+/// gap is above the noise level, every candidate — each term of the library at each joint that
+/// lacks it, and a scale factor on the substructure's damping (a linear model error) — is added
+/// in turn, every non-fixed term is identified again (identify::fit, the equation-error least
+/// squares of METHOD.md), and all tests are re-simulated. A candidate may be added only if
+///  1. every re-simulation converged and its value is physical (no negative damping),
+///  2. its 95 % interval excludes 0,
+///  3. it lowers the Bayesian information criterion — with known noise χ² + p ln N, else
+///     N ln(S/N) + p ln N (S the squared gap, N real compared values, p identified
+///     parameters) — so an extra term must buy more than ln N in χ², and
+///  4. it predicts held-out tests better: the leave-one-test-out cross-validated gap falls.
+/// The admissible candidate with the lowest criterion is added; the loop stops when the gap is
+/// at the noise level (χ²/N within 3 standard deviations of 1), when no candidate is admissible,
+/// or after max_steps.
+#include "frf/harmonic_balance.hpp"
+#include "frf/substructure.hpp"
+#include "identify/fit.hpp"
+#include "identify/measurement.hpp"
+#include "joints/joint.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace jointid::discover {
+
+struct Options {
+  /// Harmonics used in the fits; the comparison uses 0 … max of them (tables: 1).
+  std::vector<int> harmonics{1, 2, 3};
+  /// The re-simulations' harmonic balance.
+  frf::HarmonicBalanceOptions balance{.harmonics = 15};
+  /// Terms tried at every joint (those a joint already has are skipped).
+  std::vector<joints::Term> terms{joints::all_terms.begin(), joints::all_terms.end()};
+  /// Also try a scale factor on the substructure's modal damping (a linear model error).
+  bool substructure_damping = true;
+  int max_steps = 6;
+  /// Leave-one-test-out cross-validation above this many tests uses this many folds instead.
+  int folds = 10;
+};
+
+/// One candidate addition to the model, and what it gave.
+struct Candidate {
+  std::string joint;                ///< joint name; "substructure" for the damping scale
+  std::optional<joints::Term> term; ///< empty: the substructure's damping scale; or a refit
+  bool refit = false;               ///< no addition: the starting values identified again
+  std::string name() const;         ///< "k3 at 'tip'", "substructure damping", "refit"
+  std::string effect() const;       ///< "cubic stiffness", "substructure damping", …
+  bool linear() const;              ///< k, c, a refit or the damping scale
+  double value = 0.0;               ///< identified coefficient (SI), or the damping scale
+  double std = 0.0;
+  double ci_low = 0.0, ci_high = 0.0;
+  double gap = 0.0;       ///< after adding it
+  double criterion = 0.0; ///< information criterion after adding it
+  double explained = 0.0; ///< share of the squared gap it removes (negative: worse)
+  bool converged = true;  ///< every re-simulation converged
+  double cv_gap = -1.0;   ///< cross-validated gap (< 0: not computed)
+  std::string rejected;   ///< why it may not be added; empty: admissible
+};
+
+/// A model and how well it reproduces the measurement.
+struct State {
+  std::vector<joints::Joint> joints;
+  double damping_scale = 1.0; ///< on the substructure's damping
+  int parameters = 0;         ///< identified coefficients (and the damping scale)
+  double gap = 0.0;
+  double chi2 = 0.0;          ///< Σ |e|² / (E|δX|²/2) when the noise is known, else NaN
+  double criterion = 0.0;
+  bool converged = true;
+  std::vector<Eigen::MatrixXcd> X; ///< per test: simulated harmonics 0 … K at its responses
+  identify::FitResult fit;         ///< the identification that gave the values (if any)
+};
+
+struct Step {
+  Candidate added;
+  double gap_before = 0.0, gap_after = 0.0;
+  double cv_before = -1.0, cv_after = -1.0;
+  std::vector<Candidate> ranking; ///< every candidate tried, lowest criterion first
+  std::string finding;            ///< one sentence
+};
+
+/// The fundamental of one test at one channel, measured and simulated.
+struct Comparison {
+  std::string test, channel;
+  double frequency_hz = 0.0, force = 0.0;
+  std::complex<double> measured, simulated; ///< X_1, m or rad
+  double amplitude_error = 0.0;            ///< |X_sim| / |X_meas| − 1
+  double phase_error_deg = 0.0;            ///< arg(X_sim / X_meas)
+  double harmonics_measured = 0.0;         ///< sqrt(Σ_{k≥2} |X_k|²) / |X_1|, measured
+  double harmonics_simulated = 0.0;
+};
+
+struct Diagnosis {
+  /// Does the disagreement change with force level? Empty when nothing significant is found.
+  std::optional<bool> level_dependent;
+  double linear_explains = 0.0;    ///< best linear candidate's share of the squared gap
+  double nonlinear_explains = 0.0; ///< best non-linear candidate's share
+  std::string joint;               ///< where it sits (joint name, or "substructure")
+  std::string channel;             ///< the channel with the largest relative error
+  double channel_error = 0.0;      ///< its relative error, ‖e‖/‖X_meas‖ over the tests
+  std::string nature;              ///< "conservative", "dissipative", or empty
+  double conservative_explains = 0.0, dissipative_explains = 0.0;
+  bool even_harmonics = false;     ///< unexplained harmonic 0 or 2 above the noise
+  double even_content = 0.0;       ///< largest |X_meas − X_sim| at k = 0, 2 over |X_1|
+  std::vector<std::string> findings; ///< the diagnosis as sentences
+};
+
+struct Result {
+  int tests = 0, compared_values = 0;
+  std::vector<std::string> start_notes; ///< what was identified to start
+  std::vector<State> states;            ///< [0] the start, [i] after step i
+  std::vector<Step> steps;
+  /// The candidates of the last attempt, when it added nothing (empty otherwise).
+  std::vector<Candidate> last_ranking;
+  std::vector<double> gap; ///< per state
+  double noise_gap = -1.0; ///< < 0: unknown (stepped-sine tables)
+  bool at_noise_level = false;
+  Diagnosis diagnosis;
+  std::string stop_reason;
+  std::vector<std::string> warnings;
+  /// Per state: the fundamental at every test and channel.
+  std::vector<std::vector<Comparison>> comparisons;
+};
+
+/// Runs the loop on measurements reduced by identify::measure (with harmonics ≥ those asked).
+/// `start` holds the joints of the starting model (values not given are identified first).
+/// Throws std::invalid_argument for inputs that cannot be compared (no tests, a channel at a
+/// DOF the model lacks, joints whose DOFs are not measured).
+Result discover(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,
+                const std::vector<identify::Measurement>& tests, const Options& options = {});
+
+} // namespace jointid::discover

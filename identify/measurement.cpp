@@ -1,0 +1,349 @@
+#include "identify/measurement.hpp"
+
+#include "identify/harmonics.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+namespace jointid::identify {
+
+namespace {
+
+constexpr double two_pi = 2.0 * std::numbers::pi;
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using Complex = std::complex<double>;
+
+std::string percent(double fraction) {
+  std::ostringstream s;
+  s.precision(3);
+  s << 100.0 * fraction << " %";
+  return s.str();
+}
+
+// Fraction of samples sitting at the channel's extreme values (a flat top: clipping). A
+// displacement that is flat because the point is at rest (its measured velocity is zero, as
+// in a friction joint's stick phase) is not clipped: pass that velocity to exempt it.
+double clipped_fraction(const Eigen::VectorXd& x, const Eigen::VectorXd* velocity = nullptr) {
+  const double hi = x.maxCoeff(), lo = x.minCoeff(),
+               tol = 1e-9 * std::max(std::abs(hi), std::abs(lo));
+  if (hi - lo <= tol) return 0.0;
+  const double vmax = velocity ? velocity->cwiseAbs().maxCoeff() : 0.0;
+  int at_edge = 0;
+  for (int i = 0; i < x.size(); ++i) {
+    const bool resting = velocity && std::abs((*velocity)(i)) <= 1e-6 * vmax;
+    if ((hi - x(i) <= tol || x(i) - lo <= tol) && !resting) ++at_edge;
+  }
+  return static_cast<double>(at_edge) / static_cast<double>(x.size());
+}
+
+// A periodic signal from its harmonics 0 … K at the times t.
+Eigen::VectorXd synthesise(const Eigen::VectorXd& t, const Eigen::VectorXcd& X, double omega) {
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(t.size(), X(0).real());
+  for (Eigen::Index i = 0; i < t.size(); ++i)
+    for (Eigen::Index k = 1; k < X.size(); ++k)
+      x(i) += (X(k) * std::polar(1.0, static_cast<double>(k) * omega * t(i))).real();
+  return x;
+}
+
+// Harmonics of the derivative (power > 0) or of the integral (power < 0) of a periodic signal:
+// multiply harmonic k by (ikω)^power; the mean of an integral is unknown and set to 0.
+Eigen::VectorXcd differentiate(const Eigen::VectorXcd& X, double omega, int power) {
+  Eigen::VectorXcd Y(X.size());
+  Y(0) = 0.0;
+  for (Eigen::Index k = 1; k < X.size(); ++k)
+    Y(k) = X(k) * std::pow(Complex(0.0, static_cast<double>(k) * omega), power);
+  return Y;
+}
+
+// The samples of one channel's data over the analysed span (whole periods), with the span's
+// noise estimate: either the synchronous average of the periods or the trimmed record.
+struct Span {
+  Eigen::VectorXd t;      // analysed times (one period when averaged)
+  int samples = 0;        // samples of the record behind the span (n)
+  int periods = 1;        // periods averaged
+  bool averaged = false;
+  int dense_harmonics = 0; // harmonics a many-harmonic fit can resolve here
+};
+
+Eigen::VectorXd average_periods(const Eigen::VectorXd& x, int per_period, int periods) {
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(per_period);
+  for (int p = 0; p < periods; ++p)
+    mean += x.segment(static_cast<Eigen::Index>(p) * per_period, per_period);
+  return mean / periods;
+}
+
+// Noise variance of a channel's samples: scatter about the synchronous average (averaged
+// spans), or the residual of a many-harmonic fit; NaN when neither has degrees of freedom.
+double noise_variance(const Eigen::VectorXd& raw, const Span& span, double omega) {
+  if (span.averaged) {
+    const int per = static_cast<int>(span.t.size());
+    const Eigen::VectorXd mean = average_periods(raw, per, span.periods);
+    double ss = 0.0;
+    for (int p = 0; p < span.periods; ++p)
+      ss += (raw.segment(static_cast<Eigen::Index>(p) * per, per) - mean).squaredNorm();
+    return ss / (span.samples - per);
+  }
+  const int K = span.dense_harmonics, dof = span.samples - (2 * K + 1);
+  if (K < 1 || dof < std::max(20, span.samples / 4)) return nan;
+  const Eigen::VectorXcd X = fit_harmonics(span.t, raw, omega, K);
+  return (raw - synthesise(span.t, X, omega)).squaredNorm() / dof;
+}
+
+Measurement measure_record(const Record& r, const MeasureOptions& o) {
+  auto fail = [&](const std::string& what) { throw std::invalid_argument(r.source + ": " + what); };
+  const int K = o.harmonics;
+  if (K < 1) throw std::invalid_argument("measure: need at least harmonic 1");
+  Measurement m;
+  m.source = r.source;
+  m.harmonics = K;
+  const auto forces = r.all(Quantity::force);
+  if (forces.empty()) fail("no force channel (expected a column such as f@7:uy)");
+  // Response DOFs in order of first appearance, each with its best channel (x, then v, then a).
+  std::vector<const Channel*> best;
+  for (const auto& c : r.channels) {
+    if (c.quantity == Quantity::force) continue;
+    const int i = m.response_index(c.at);
+    if (i < 0) {
+      m.response_at.push_back(c.at);
+      m.measured_as.push_back(c.quantity);
+      best.push_back(&c);
+    } else if (static_cast<int>(c.quantity) < static_cast<int>(m.measured_as[i])) {
+      m.measured_as[i] = c.quantity;
+      best[i] = &c;
+    }
+  }
+  if (best.empty())
+    fail("no response channel (expected x, v or a columns such as x@7:uy next to the force)");
+
+  m.frequency_hz =
+      r.excitation_hz ? *r.excitation_hz : estimate_frequency(r.t, forces.front()->samples);
+  if (!(m.frequency_hz > 0.0)) fail("excitation frequency must be > 0 Hz");
+  const double omega = two_pi * m.frequency_hz, dt = r.dt();
+  const int n = whole_period_samples(r.t, m.frequency_hz);
+  if (n == 0)
+    fail("shorter than one period of the excitation (" + std::to_string(m.frequency_hz) + " Hz)");
+  const double nyquist = 0.5 / dt;
+  if (K * m.frequency_hz >= nyquist)
+    fail("harmonic " + std::to_string(K) + " (" + std::to_string(K * m.frequency_hz) +
+         " Hz) is at or above the Nyquist frequency of the sampling (" + std::to_string(nyquist) +
+         " Hz): sample faster, or ask fewer harmonics");
+  if (n < 2 * (K + 1) * 4)
+    fail("too few samples per period to resolve harmonic " + std::to_string(K));
+
+  // The span analysed: the synchronous average of the periods when a period holds a whole
+  // number of samples, else the whole periods as they are.
+  Span span;
+  span.samples = n;
+  const double per_period = 1.0 / (m.frequency_hz * dt);
+  const int per = static_cast<int>(std::lround(per_period));
+  const double periods = n * dt * m.frequency_hz;
+  span.periods = static_cast<int>(std::lround(periods));
+  span.averaged = span.periods >= 2 && std::abs(per_period - per) <= 1e-6 * per_period &&
+                  static_cast<long long>(per) * span.periods == n;
+  if (span.averaged) {
+    span.t = r.t.head(per);
+    m.periods_averaged = span.periods;
+  } else {
+    span.t = r.t.head(n);
+    span.periods = 1;
+  }
+  m.t = span.t;
+  span.dense_harmonics = std::min(64, (static_cast<int>(std::floor(per_period)) - 1) / 4);
+  auto analysed = [&](const Eigen::VectorXd& raw) -> Eigen::VectorXd {
+    const Eigen::VectorXd head = raw.head(n);
+    return span.averaged ? average_periods(head, per, span.periods) : head;
+  };
+  if (periods < 2.0 - 1e-9)
+    m.warnings.push_back(r.source + ": only " + std::to_string(static_cast<int>(periods)) +
+                         " period; steady state cannot be checked (record at least 2)");
+
+  for (const auto& c : r.channels) {
+    const Channel* v =
+        c.quantity == Quantity::displacement ? r.find(Quantity::velocity, c.at) : nullptr;
+    const double clipped = clipped_fraction(c.samples, v ? &v->samples : nullptr);
+    if (clipped > 0.01)
+      m.warnings.push_back(r.source + ": channel " + c.name() + " looks clipped (" +
+                           percent(clipped) + " of samples at its extremes)");
+  }
+
+  Eigen::MatrixXd f(span.t.size(), static_cast<Eigen::Index>(forces.size()));
+  for (std::size_t i = 0; i < forces.size(); ++i) {
+    m.force_at.push_back(forces[i]->at);
+    f.col(static_cast<Eigen::Index>(i)) = analysed(forces[i]->samples);
+  }
+  m.F = fit_harmonics(span.t, f, omega, K);
+
+  const auto nr = static_cast<Eigen::Index>(best.size());
+  m.X.resize(K + 1, nr);
+  m.X_variance.resize(K + 1, nr);
+  m.x.resize(span.t.size(), nr);
+  m.v.resize(span.t.size(), nr);
+  const int dense = std::max(K, span.dense_harmonics);
+  for (Eigen::Index j = 0; j < nr; ++j) {
+    const Channel& c = *best[j];
+    const fem::NodeDof at = c.at;
+    const Eigen::VectorXd samples = analysed(c.samples);
+    const double variance = noise_variance(c.samples.head(n), span, omega);
+    m.channel_noise.push_back(std::sqrt(variance));
+    const int power = c.quantity == Quantity::displacement ? 0
+                      : c.quantity == Quantity::velocity   ? 1
+                                                           : 2;
+    // Harmonics of the measured quantity, then of the displacement; many of them where a
+    // signal is derived from another (a kink in a stick-slip velocity has slow-decaying ones).
+    const bool derive = power != 0 || !r.find(Quantity::velocity, at);
+    const Eigen::VectorXcd Q = fit_harmonics(span.t, samples, omega, derive ? dense : K);
+    const Eigen::VectorXcd Xd = power == 0 ? Q : differentiate(Q, omega, -power);
+    m.X.col(j) = Xd.head(K + 1);
+    m.has_mean.push_back(power == 0);
+    for (int k = 0; k <= K; ++k) {
+      const double gain = k == 0 ? 1.0 : std::pow(k * omega, -2.0 * power);
+      m.X_variance(k, j) = (k == 0 ? (power == 0 ? variance / n : nan) : 4.0 * variance / n) * gain;
+    }
+    // Displacement and velocity samples for the basis functions.
+    if (power == 0) {
+      m.x.col(j) = samples;
+      if (const Channel* v = r.find(Quantity::velocity, at)) {
+        m.v.col(j) = analysed(v->samples);
+      } else {
+        m.v.col(j) = synthesise(span.t, differentiate(Q, omega, 1), omega);
+        m.warnings.push_back(r.source + ": no velocity channel v@" + fem::to_string(at) +
+                             "; velocity derived from displacement");
+      }
+    } else {
+      m.x.col(j) = synthesise(span.t, Xd, omega);
+      m.v.col(j) = power == 1 ? samples : synthesise(span.t, differentiate(Q, omega, -1), omega);
+      m.warnings.push_back(r.source + ": no displacement channel x@" + fem::to_string(at) +
+                           "; displacement derived from " +
+                           (power == 1 ? "velocity" : "acceleration") +
+                           " (its mean is unknown and taken as 0)");
+    }
+  }
+
+  // Steady state: the fundamental over the first and the last half of the record, on the
+  // largest response, allowing for the difference the noise alone would make.
+  if (periods >= 2.0 - 1e-9) {
+    Eigen::Index big = 0;
+    m.X.row(1).cwiseAbs().maxCoeff(&big);
+    const Eigen::VectorXd t = r.t.head(n), x = best[big]->samples.head(n);
+    const int half = whole_period_samples(t.head(n / 2), m.frequency_hz);
+    if (half > 0) {
+      const Eigen::VectorXcd a = fit_harmonics(t.head(half), Eigen::VectorXd(x.head(half)), omega, 1);
+      const Eigen::VectorXcd b = fit_harmonics(t.tail(half), Eigen::VectorXd(x.tail(half)), omega, 1);
+      const double size = std::max(std::abs(b(1)), 1e-300);
+      const double change = std::abs(a(1) - b(1)) / size;
+      const double sigma = m.channel_noise[big];
+      const double allowance = std::isfinite(sigma) ? 4.0 * 2.0 * sigma / std::sqrt(half) / size : 0.0;
+      if (change > o.steady_tolerance + allowance)
+        m.warnings.push_back(r.source + ": not a steady state (first and last half differ by " +
+                             percent(change) + ")");
+    }
+  }
+  return m;
+}
+
+Measurement measure_phasors(const Phasors& row, const MeasureOptions& o) {
+  auto fail = [&](const std::string& what) {
+    throw std::invalid_argument(row.source + ": " + what);
+  };
+  if (!(row.frequency_hz > 0.0)) fail("excitation frequency must be > 0 Hz");
+  const int K = std::max(1, o.harmonics);
+  Measurement m;
+  m.source = row.source;
+  m.frequency_hz = row.frequency_hz;
+  m.harmonics = K;
+  m.fundamental_only = true;
+  const double omega = two_pi * row.frequency_hz;
+  std::vector<Complex> forces, responses;
+  for (const auto& c : row.channels) {
+    if (c.quantity == Quantity::force) {
+      m.force_at.push_back(c.at);
+      forces.push_back(c.value);
+      continue;
+    }
+    const int power = c.quantity == Quantity::displacement ? 0
+                      : c.quantity == Quantity::velocity   ? 1
+                                                           : 2;
+    const Complex X = c.value * std::pow(Complex(0.0, omega), -power);
+    const int i = m.response_index(c.at);
+    if (i < 0) {
+      m.response_at.push_back(c.at);
+      m.measured_as.push_back(c.quantity);
+      responses.push_back(X);
+    } else if (static_cast<int>(c.quantity) < static_cast<int>(m.measured_as[i])) {
+      m.measured_as[i] = c.quantity;
+      responses[i] = X;
+    }
+  }
+  if (forces.empty()) fail("no force channel (expected columns such as f@7:uy.re, f@7:uy.im)");
+  if (responses.empty()) fail("no response channel (expected x, v or a columns)");
+  const auto nf = static_cast<Eigen::Index>(forces.size()),
+             nr = static_cast<Eigen::Index>(responses.size());
+  m.F = Eigen::MatrixXcd::Zero(K + 1, nf);
+  m.X = Eigen::MatrixXcd::Zero(K + 1, nr);
+  m.X_variance = Eigen::MatrixXd::Constant(K + 1, nr, nan);
+  for (Eigen::Index i = 0; i < nf; ++i)
+    m.F(1, i) = forces[i];
+  // One period of the fundamental's sinusoid, finely sampled, for the basis functions.
+  const int samples = 64 * (K + 1);
+  m.t = Eigen::VectorXd::LinSpaced(samples, 0.0, (samples - 1.0) / (samples * row.frequency_hz));
+  m.x.resize(samples, nr);
+  m.v.resize(samples, nr);
+  for (Eigen::Index j = 0; j < nr; ++j) {
+    m.X(1, j) = responses[j];
+    m.has_mean.push_back(false);
+    m.channel_noise.push_back(nan);
+    for (int i = 0; i < samples; ++i) {
+      const Complex e = std::polar(1.0, omega * m.t(i));
+      m.x(i, j) = (responses[j] * e).real();
+      m.v(i, j) = (Complex(0.0, omega) * responses[j] * e).real();
+    }
+  }
+  return m;
+}
+
+} // namespace
+
+std::string PhasorChannel::name() const {
+  return std::string(1, quantity_letter(quantity)) + "@" + fem::to_string(at);
+}
+
+const std::string& source_of(const SineTest& test) {
+  return std::visit([](const auto& t) -> const std::string& { return t.source; }, test);
+}
+
+int Measurement::response_index(const fem::NodeDof& at) const {
+  for (std::size_t i = 0; i < response_at.size(); ++i)
+    if (response_at[i] == at) return static_cast<int>(i);
+  return -1;
+}
+
+int Measurement::force_index(const fem::NodeDof& at) const {
+  for (std::size_t i = 0; i < force_at.size(); ++i)
+    if (force_at[i] == at) return static_cast<int>(i);
+  return -1;
+}
+
+Measurement measure(const SineTest& test, const MeasureOptions& options) {
+  if (const auto* record = std::get_if<Record>(&test)) return measure_record(*record, options);
+  return measure_phasors(std::get<Phasors>(test), options);
+}
+
+std::vector<Measurement> measure(const std::vector<SineTest>& tests,
+                                 const MeasureOptions& options) {
+  std::vector<Measurement> out;
+  out.reserve(tests.size());
+  for (const auto& t : tests)
+    out.push_back(measure(t, options));
+  return out;
+}
+
+double force_level(const Measurement& m) {
+  return m.F.cols() > 0 && m.F.rows() > 1 ? m.F.row(1).cwiseAbs().maxCoeff() : 0.0;
+}
+
+} // namespace jointid::identify

@@ -1,0 +1,98 @@
+#pragma once
+/// Sine tests as measured, and their reduction to harmonics (nothing here depends on the joints).
+///
+/// A test is either a time record (Record: DESIGN.md's measurement CSV) or one row of a
+/// stepped-sine table (Phasors: the complex fundamental of every channel, x(t) = Re(X e^{iωt}),
+/// peak, SI). measure() turns either into a Measurement:
+///  - the excitation frequency;
+///  - harmonics 0 … K of every force channel and of the *displacement* at every response DOF,
+///    whichever quantity was measured there (X = V/(ikω) from velocity, X = −A/(kω)² from
+///    acceleration; the mean of a displacement derived that way is unknown and set to 0);
+///  - the noise variance of those harmonics, estimated from the record itself (the scatter of
+///    its periods about their synchronous average, or else the residual of a many-harmonic fit);
+///  - one period of displacement and velocity at every response DOF, on which the joints' basis
+///    functions are evaluated: the synchronous average of the record's periods (it divides the
+///    noise variance by the number of periods before the non-linear basis functions see it), or
+///    for a table the sinusoid of the fundamental.
+#include "fem/dof.hpp"
+#include "identify/record.hpp"
+
+#include <Eigen/Core>
+#include <complex>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace jointid::identify {
+
+/// One channel of a stepped-sine row: its complex amplitude at the excitation frequency.
+struct PhasorChannel {
+  Quantity quantity = Quantity::displacement;
+  fem::NodeDof at;
+  std::complex<double> value; ///< peak, SI, x(t) = Re(value · e^{iωt})
+  std::string name() const;   ///< "x@7:uy"
+};
+
+/// One sine test of a stepped-sine table: the fundamental of every channel.
+struct Phasors {
+  std::string source; ///< "table.csv:12" (file and line), for messages
+  double frequency_hz = 0.0;
+  std::vector<PhasorChannel> channels;
+};
+
+/// A sine test as measured: a time record or a stepped-sine row.
+using SineTest = std::variant<Record, Phasors>;
+const std::string& source_of(const SineTest& test);
+
+struct MeasureOptions {
+  int harmonics = 3; ///< K: harmonics 0 … K are extracted from records (tables give 1)
+  /// Warn when the fundamental of the first and last half of a record differ by more than
+  /// this (relative), beyond what the record's noise explains.
+  double steady_tolerance = 1e-3;
+};
+
+struct Measurement {
+  std::string source;
+  double frequency_hz = 0.0;
+  int harmonics = 0; ///< K: rows 0 … K of F, X and X_variance
+  /// From a stepped-sine table: only harmonic 1 was measured (rows 0 and 2 … K are 0).
+  bool fundamental_only = false;
+
+  std::vector<fem::NodeDof> force_at;
+  Eigen::MatrixXcd F; ///< (K+1) × forces, N or N·m
+
+  std::vector<fem::NodeDof> response_at; ///< every DOF with a x, v or a channel, in file order
+  std::vector<Quantity> measured_as;     ///< per response DOF: x if measured, else v, else a
+  Eigen::MatrixXcd X;                    ///< (K+1) × responses: displacement, m or rad
+  /// E|δX|² of every entry of X from the record's noise (m²); NaN where unknown (tables).
+  Eigen::MatrixXd X_variance;
+  /// Per response DOF: false when its mean displacement is unknown (derived from v or a).
+  std::vector<bool> has_mean;
+
+  /// Uniform samples over whole periods starting at t[0] (one period when the record's periods
+  /// were averaged): displacement and velocity at every response DOF, for the basis functions.
+  Eigen::VectorXd t;
+  Eigen::MatrixXd x, v;
+  int periods_averaged = 1;
+  /// Per response DOF: noise standard deviation of its measured channel's samples (its own
+  /// unit), NaN where unknown.
+  std::vector<double> channel_noise;
+
+  std::vector<std::string> warnings;
+
+  int response_index(const fem::NodeDof& at) const; ///< -1 when not measured
+  int force_index(const fem::NodeDof& at) const;    ///< -1 when there is no force there
+  bool has_harmonic(int k) const { return fundamental_only ? k == 1 : k >= 0 && k <= harmonics; }
+};
+
+/// Reduces one test. Throws std::invalid_argument naming the test's source: no force channel,
+/// no response channel, shorter than a period, harmonic K above the record's Nyquist frequency.
+/// Warnings (not periodic, clipped, only one period, derived velocity) go to Measurement::warnings.
+Measurement measure(const SineTest& test, const MeasureOptions& options = {});
+std::vector<Measurement> measure(const std::vector<SineTest>& tests,
+                                 const MeasureOptions& options = {});
+
+/// The force amplitude of a measurement: the largest |F_1| of its force channels (N or N·m).
+double force_level(const Measurement& m);
+
+} // namespace jointid::identify

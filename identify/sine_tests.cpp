@@ -1,0 +1,252 @@
+#include "identify/sine_tests.hpp"
+
+#include "fem/time_integration.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+namespace jointid::identify {
+
+namespace {
+
+constexpr double two_pi = 2.0 * std::numbers::pi;
+
+std::string compact(double value) {
+  return fmt::format("{}", value);
+}
+
+void add_unique(std::vector<int>& list, int value) {
+  if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
+}
+
+std::string describe(const joints::Joint& j) {
+  std::string text =
+      fmt::format("joint '{}': {}:{} {}", j.name, j.node, fem::dof_name(j.dof),
+                  j.to_ground() ? std::string("to ground") : fmt::format("to node {}", j.node_b));
+  for (std::size_t t = 0; t < j.terms.size(); ++t)
+    text += fmt::format("{} {} = {}", t == 0 ? ";" : ",", joints::term_name(j.terms[t]),
+                        compact(j.values[t]));
+  return text;
+}
+
+// The derivative of a periodic signal sampled uniformly over whole periods, from its
+// harmonics below the Nyquist frequency.
+Eigen::VectorXd periodic_derivative(const Eigen::VectorXd& x, double omega, int periods) {
+  const auto n = x.size();
+  const auto per = n / periods; // samples per period
+  const auto K = (per - 1) / 2;
+  Eigen::VectorXd dx = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 1; k <= K; ++k) {
+    const double step = two_pi * static_cast<double>(k) / static_cast<double>(per);
+    std::complex<double> X = 0.0;
+    for (Eigen::Index i = 0; i < n; ++i)
+      X += x(i) * std::polar(1.0, -step * static_cast<double>(i % per));
+    const std::complex<double> D =
+        std::complex<double>(0.0, static_cast<double>(k) * omega) * X * (2.0 / static_cast<double>(n));
+    for (Eigen::Index i = 0; i < n; ++i)
+      dx(i) += (D * std::polar(1.0, step * static_cast<double>(i % per))).real();
+  }
+  return dx;
+}
+
+} // namespace
+
+std::string sine_test_name(const SineTestPlan& plan) {
+  return fmt::format("sine_f{}Hz_F{}N.csv", compact(plan.frequency_hz), compact(plan.amplitude));
+}
+
+std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
+                                               const std::vector<joints::Joint>& joints,
+                                               const fem::NodeDof& force_at,
+                                               const std::vector<SineTestPlan>& plans,
+                                               const SimulationOptions& o) {
+  // 1. Everything that can be checked before computing.
+  if (plans.empty()) throw std::invalid_argument("simulate: no tests");
+  for (const auto& p : plans) {
+    if (!(std::isfinite(p.frequency_hz) && p.frequency_hz > 0.0))
+      throw std::invalid_argument(
+          fmt::format("simulate: expected frequencies > 0 Hz, got {}", p.frequency_hz));
+    if (!(std::isfinite(p.amplitude) && p.amplitude > 0.0))
+      throw std::invalid_argument(fmt::format(
+          "simulate: expected finite amplitudes > 0 (N or N m), got {}", p.amplitude));
+  }
+  std::set<std::string> names;
+  for (const auto& p : plans)
+    if (!names.insert(sine_test_name(p)).second)
+      throw std::invalid_argument(fmt::format("simulate: the test at {} Hz, {} N is listed twice",
+                                              compact(p.frequency_hz), compact(p.amplitude)));
+  if (o.periods < 1)
+    throw std::invalid_argument(
+        fmt::format("simulate: periods: expected at least 1, got {}", o.periods));
+  if (o.steps_per_period < 8)
+    throw std::invalid_argument(fmt::format(
+        "simulate: steps per period: expected at least 8, got {}", o.steps_per_period));
+  const int keep = o.samples_per_period > 0 ? o.samples_per_period : o.steps_per_period;
+  if (keep < 8 || o.steps_per_period % keep != 0)
+    throw std::invalid_argument(fmt::format(
+        "simulate: samples per period: expected at least 8 and a divisor of the {} steps per "
+        "period, got {}",
+        o.steps_per_period, keep));
+  const int stride = o.steps_per_period / keep;
+  if (o.quantities.empty())
+    throw std::invalid_argument("simulate: no response quantity asked (x, v or a)");
+  for (Quantity q : o.quantities)
+    if (q == Quantity::force)
+      throw std::invalid_argument("simulate: force is always written; responses are x, v or a");
+  const bool time_domain = o.method == SimulationMethod::time_integration;
+  if (time_domain && !sub.system())
+    throw std::invalid_argument("simulate: time integration needs a finite element model; this "
+                                "substructure is given by its modes (use harmonic balance)");
+
+  const fem::DofMap& dofs = sub.dofs();
+  joints::validate_joints(joints, dofs);
+  const int force_equation = dofs.equation(force_at);
+  // Outputs: every joint DOF, then the force DOF, then the extra ones.
+  std::vector<int> outputs = joints::joint_dof_set(joints, dofs);
+  add_unique(outputs, force_equation);
+  for (const auto& at : o.extra_outputs)
+    add_unique(outputs, dofs.equation(at));
+  const auto nout = static_cast<Eigen::Index>(outputs.size());
+
+  auto make_test = [&](const SineTestPlan& plan, const Eigen::VectorXd& t,
+                       const Eigen::VectorXd& force, const Eigen::MatrixXd& u,
+                       const Eigen::MatrixXd& v) {
+    SimulatedTest s;
+    s.plan = plan;
+    Record& r = s.record;
+    r.source = sine_test_name(plan);
+    r.excitation_hz = plan.frequency_hz;
+    const auto n = static_cast<Eigen::Index>((t.size() + stride - 1) / stride);
+    auto sampled = [&](const Eigen::VectorXd& x) {
+      Eigen::VectorXd y(n);
+      for (Eigen::Index i = 0; i < n; ++i)
+        y(i) = x(i * stride);
+      return y;
+    };
+    r.t = sampled(t);
+    r.channels.push_back({Quantity::force, force_at, sampled(force)});
+    const double omega = two_pi * plan.frequency_hz;
+    for (Eigen::Index j = 0; j < nout; ++j) {
+      const fem::NodeDof at = dofs.node_dof(outputs[j]);
+      for (Quantity q : o.quantities) {
+        if (q == Quantity::displacement) r.channels.push_back({q, at, sampled(u.col(j))});
+        if (q == Quantity::velocity) r.channels.push_back({q, at, sampled(v.col(j))});
+        if (q == Quantity::acceleration)
+          r.channels.push_back({q, at, periodic_derivative(sampled(v.col(j)), omega, o.periods)});
+      }
+    }
+    s.comments.push_back(fmt::format("sine force {} N (peak) at {} Hz on {}",
+                                     compact(plan.amplitude), compact(plan.frequency_hz),
+                                     fem::to_string(force_at)));
+    for (const auto& j : joints)
+      s.comments.push_back(describe(j));
+    return s;
+  };
+
+  std::vector<SimulatedTest> out;
+  if (time_domain) {
+    const fem::SparseMatrix C = sub.damping_matrix();
+    const joints::JointForces forces(joints, dofs);
+    fem::SteadyStateOptions options;
+    options.steps_per_period = o.steps_per_period;
+    options.output_periods = o.periods;
+    options.max_periods = std::max(options.max_periods, o.periods + 2);
+    options.tolerance = o.steady_tolerance;
+    for (const auto& plan : plans) {
+      const fem::SteadyState s =
+          fem::steady_state(*sub.system(), C, &forces,
+                            {force_equation, plan.amplitude, plan.frequency_hz}, outputs, options);
+      if (s.status == fem::SteadyStateStatus::newton_failed)
+        throw std::runtime_error(
+            fmt::format("time integration at {} Hz, {} N: the joints' Newton iteration failed in "
+                        "period {}",
+                        compact(plan.frequency_hz), compact(plan.amplitude), s.periods_run));
+      SimulatedTest test = make_test(plan, s.t, s.force, s.u, s.v);
+      test.comments.push_back(fmt::format(
+          "method: time (Newmark, average acceleration, {} steps per period{})",
+          o.steps_per_period,
+          stride > 1 ? fmt::format(", every {}th step recorded", stride) : std::string()));
+      const bool converged = s.status == fem::SteadyStateStatus::converged;
+      test.comments.push_back(fmt::format(
+          "periods run: {} from rest ({}; last period-to-period change {:.3g}); the record "
+          "holds the last {}",
+          s.periods_run, converged ? "steady state reached" : "NOT periodic", s.period_change,
+          o.periods));
+      if (!converged) {
+        const std::string what =
+            fmt::format("{}: not a periodic steady state after {} periods (last period-to-period "
+                        "change {:.3g})",
+                        test.record.source, s.periods_run, s.period_change);
+        test.comments.push_back("WARNING: " + what);
+        test.warnings.push_back(what);
+      }
+      out.push_back(std::move(test));
+    }
+  } else {
+    double f_max = 0.0;
+    for (const auto& p : plans)
+      f_max = std::max(f_max, p.frequency_hz);
+    std::vector<std::string> notes;
+    const frf::ModalSynthesis synthesis =
+        sub.synthesis(outputs, 4.0 * o.balance.harmonics * f_max, &notes);
+    for (const auto& plan : plans) {
+      const frf::HarmonicBalanceResult hb =
+          frf::harmonic_balance(synthesis, joints, dofs, force_equation, plan.amplitude,
+                                plan.frequency_hz, outputs, o.balance);
+      const int samples = o.periods * o.steps_per_period;
+      const double h = 1.0 / (plan.frequency_hz * o.steps_per_period);
+      const double omega = two_pi * plan.frequency_hz;
+      Eigen::VectorXd t(samples), force(samples);
+      Eigen::MatrixXd u(samples, nout), v(samples, nout);
+      for (int i = 0; i < samples; ++i) {
+        t(i) = i * h;
+        force(i) = plan.amplitude * std::sin(omega * t(i));
+        for (Eigen::Index j = 0; j < nout; ++j) {
+          u(i, j) = hb.displacement(static_cast<int>(j), t(i));
+          v(i, j) = hb.velocity(static_cast<int>(j), t(i));
+        }
+      }
+      SimulatedTest test = make_test(plan, t, force, u, v);
+      test.comments.push_back(fmt::format(
+          "method: hb (harmonic balance, harmonics 0 to {}{})", o.balance.harmonics,
+          synthesis.has_residual() ? "; modal synthesis with residual flexibility" : ""));
+      for (const auto& note : notes)
+        test.comments.push_back(note);
+      test.comments.push_back(fmt::format(
+          "harmonic balance: {} after {} iterations (relative residual {:.3g}); {} "
+          "periods sampled from the harmonics",
+          hb.converged ? "converged" : "NOT converged", hb.iterations, hb.residual, o.periods));
+      if (!hb.converged) {
+        const std::string what =
+            fmt::format("{}: the harmonic balance did not converge (relative residual {:.3g})",
+                        test.record.source, hb.residual);
+        test.comments.push_back("WARNING: " + what);
+        test.warnings.push_back(what);
+      }
+      out.push_back(std::move(test));
+    }
+  }
+  return out;
+}
+
+void add_noise(Record& record, double level, std::uint64_t seed, bool force) {
+  if (!(level >= 0.0) || !std::isfinite(level))
+    throw std::invalid_argument(fmt::format("noise: expected a level >= 0, got {}", level));
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (auto& c : record.channels) {
+    if (c.quantity == Quantity::force && !force) continue;
+    const double mean = c.samples.mean();
+    const double rms = std::sqrt((c.samples.array() - mean).square().mean());
+    for (Eigen::Index i = 0; i < c.samples.size(); ++i)
+      c.samples(i) += level * rms * normal(rng);
+  }
+}
+
+} // namespace jointid::identify

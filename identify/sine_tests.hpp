@@ -1,0 +1,65 @@
+#pragma once
+/// Virtual sine tests: the model with its joints at their values, driven by F0 sin(2π f t) at
+/// one DOF, simulated to its periodic steady state, and written as measurement records
+/// (DESIGN.md's CSV contract) — by implicit time integration of the finite element model
+/// (exact stick–slip friction) or by harmonic balance on the joint DOFs. Optionally with
+/// measurement noise, so that identification and discovery can be tested on data whose truth
+/// is known.
+#include "frf/harmonic_balance.hpp"
+#include "frf/substructure.hpp"
+#include "identify/record.hpp"
+#include "joints/joint.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace jointid::identify {
+
+struct SineTestPlan {
+  double frequency_hz = 0.0; ///< Hz
+  double amplitude = 0.0;    ///< N or N·m (peak)
+};
+
+enum class SimulationMethod { time_integration, harmonic_balance };
+
+struct SimulationOptions {
+  SimulationMethod method = SimulationMethod::time_integration;
+  int periods = 8;              ///< periods in each record
+  int steps_per_period = 2048;  ///< time steps per period (time integration; samples for hb)
+  int samples_per_period = 0;   ///< samples kept per period; 0: every step. Must divide steps.
+  /// Response channels written at every output DOF: any of displacement, velocity,
+  /// acceleration (acceleration: the derivative of the velocity from its harmonics).
+  std::vector<Quantity> quantities{Quantity::displacement, Quantity::velocity};
+  /// Outputs beyond the joints' DOFs and the force DOF.
+  std::vector<fem::NodeDof> extra_outputs;
+  frf::HarmonicBalanceOptions balance{}; ///< harmonic balance
+  double steady_tolerance = 1e-10;       ///< time integration: period-to-period change
+};
+
+struct SimulatedTest {
+  Record record; ///< source = its file name, sine_f<freq>Hz_F<amp>N.csv
+  SineTestPlan plan;
+  std::vector<std::string> comments; ///< how it was made, for the CSV's comment lines
+  std::vector<std::string> warnings; ///< not periodic, not converged
+};
+
+/// "sine_f3.4Hz_F80N.csv": numbers in their shortest exact form.
+std::string sine_test_name(const SineTestPlan& plan);
+
+/// Simulates every test. Outputs: every joint DOF, then the force DOF, then `extra_outputs`
+/// (each once). Throws std::invalid_argument for bad plans or options (naming the value), or a
+/// force DOF the model lacks; std::runtime_error when a time step's joint iteration fails.
+/// Time integration needs a finite element substructure.
+std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& substructure,
+                                               const std::vector<joints::Joint>& joints,
+                                               const fem::NodeDof& force_at,
+                                               const std::vector<SineTestPlan>& plans,
+                                               const SimulationOptions& options = {});
+
+/// Adds white Gaussian noise to every channel of a record (force too, unless `force` is
+/// false): standard deviation `level` × the channel's RMS about its mean. Deterministic for a
+/// given generator state.
+void add_noise(Record& record, double level, std::uint64_t seed, bool force = true);
+
+} // namespace jointid::identify

@@ -1,0 +1,331 @@
+#include "io/discovery_report.hpp"
+
+#include "io/chart.hpp"
+#include "io/files.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace jointid::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::array<std::array<int, 3>, 10> palette{{{31, 119, 180},
+                                                      {255, 127, 14},
+                                                      {44, 160, 44},
+                                                      {214, 39, 40},
+                                                      {148, 103, 189},
+                                                      {140, 86, 75},
+                                                      {227, 119, 194},
+                                                      {127, 127, 127},
+                                                      {188, 189, 34},
+                                                      {23, 190, 207}}};
+
+std::string g4(double v) {
+  return std::isfinite(v) ? fmt::format("{:.4g}", v) : std::string("—");
+}
+
+std::string pct(double f) {
+  return std::isfinite(f) ? fmt::format("{:.3g} %", 100.0 * f) : std::string("—");
+}
+
+// Values closer than 3 % (relative) fall into one group; returns each value's group and the
+// groups' representative values, ascending.
+std::pair<std::vector<int>, std::vector<double>> groups(const std::vector<double>& values) {
+  std::vector<double> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<double> reps;
+  for (double v : sorted)
+    if (reps.empty() || std::abs(v - reps.back()) > 0.03 * std::max(std::abs(v), 1e-300))
+      reps.push_back(v);
+  std::vector<int> of(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    int best = 0;
+    for (std::size_t g = 0; g < reps.size(); ++g)
+      if (std::abs(values[i] - reps[g]) < std::abs(values[i] - reps[best]))
+        best = static_cast<int>(g);
+    of[i] = best;
+  }
+  return {of, reps};
+}
+
+// One panel: measured (points) and simulated (lines) receptance per group, for one channel.
+Chart response_chart(const std::vector<discover::Comparison>& list, const std::string& channel,
+                     const std::string& title) {
+  std::vector<const discover::Comparison*> rows;
+  for (const auto& c : list)
+    if (c.channel == channel) rows.push_back(&c);
+  std::vector<double> freq, force;
+  for (const auto* c : rows)
+    freq.push_back(c->frequency_hz), force.push_back(c->force);
+  const auto [fgroup, freps] = groups(freq);
+  const auto [lgroup, lreps] = groups(force);
+  const bool over_frequency = freps.size() >= lreps.size();
+  const bool by_force = std::all_of(force.begin(), force.end(), [](double f) { return f > 0.0; });
+  Chart chart;
+  chart.title = title;
+  chart.x_label = over_frequency ? "excitation frequency (Hz)" : "force amplitude (N)";
+  chart.y_label = by_force ? fmt::format("|X1/F1| at {} (m/N)", channel)
+                           : fmt::format("|X1| at {} (m)", channel);
+  chart.log_y = true;
+  const auto& group = over_frequency ? lgroup : fgroup;
+  const auto& reps = over_frequency ? lreps : freps;
+  for (std::size_t g = 0; g < reps.size(); ++g) {
+    std::vector<std::pair<double, std::pair<double, double>>> pts;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (group[i] != static_cast<int>(g)) continue;
+      const double scale = by_force ? 1.0 / rows[i]->force : 1.0;
+      pts.push_back({over_frequency ? rows[i]->frequency_hz : rows[i]->force,
+                     {std::abs(rows[i]->measured) * scale, std::abs(rows[i]->simulated) * scale}});
+    }
+    std::sort(pts.begin(), pts.end());
+    Series measured, simulated;
+    const std::string label =
+        over_frequency ? fmt::format("{} N", g4(reps[g])) : fmt::format("{} Hz", g4(reps[g]));
+    measured.label = "measured, " + label;
+    simulated.label = "model, " + label;
+    measured.style = Series::Style::points;
+    simulated.style = Series::Style::line;
+    measured.color = simulated.color = palette[g % palette.size()];
+    measured.width = 2.5;
+    for (const auto& [x, y] : pts) {
+      if (!(y.first > 0.0) || !(y.second > 0.0)) continue;
+      measured.x.push_back(x), measured.y.push_back(y.first);
+      simulated.x.push_back(x), simulated.y.push_back(y.second);
+    }
+    if (measured.x.empty()) continue;
+    chart.series.push_back(std::move(simulated));
+    chart.series.push_back(std::move(measured));
+  }
+  return chart;
+}
+
+std::vector<std::string> channels_of(const std::vector<discover::Comparison>& list) {
+  std::vector<std::string> out;
+  for (const auto& c : list)
+    if (std::find(out.begin(), out.end(), c.channel) == out.end()) out.push_back(c.channel);
+  if (out.size() > 4) out.resize(4);
+  return out;
+}
+
+std::string model_text(const discover::State& s) {
+  std::string text;
+  for (const auto& j : s.joints) {
+    std::string terms;
+    for (const auto t : j.terms)
+      terms += (terms.empty() ? "" : " + ") + std::string(joints::term_name(t));
+    text += fmt::format("{}'{}': {}", text.empty() ? "" : "; ", j.name, terms);
+  }
+  if (s.damping_scale != 1.0) text += fmt::format("; substructure damping ×{}", g4(s.damping_scale));
+  return text;
+}
+
+std::string short_name(const discover::Candidate& c) {
+  if (c.refit) return "refit";
+  if (!c.term) return "damping x";
+  return fmt::format("{}@{}", joints::term_name(*c.term), c.joint);
+}
+
+} // namespace
+
+std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover::Result& r,
+                                             const ReportContext& context,
+                                             std::vector<std::string>& warnings) {
+  std::vector<fs::path> written;
+  std::string why;
+  const bool plots = context.plots && can_render_charts(&why);
+  if (context.plots && !plots)
+    warnings.push_back("no plots in the report: " + why + " (run under xvfb-run -a)");
+  auto plot = [&](const std::string& name, const Figure& figure) -> std::string {
+    if (!plots) return "";
+    write_chart_png(dir / name, figure);
+    written.push_back(dir / name);
+    return fmt::format("![{}]({})\n\n", name, name);
+  };
+
+  std::string md = "# Model discovery\n\n";
+  md += fmt::format("Model `{}`; {} tests", context.model, r.tests);
+  if (!context.inputs.empty()) {
+    md += " from ";
+    for (std::size_t i = 0; i < context.inputs.size() && i < 6; ++i)
+      md += fmt::format("{}`{}`", i ? ", " : "", context.inputs[i]);
+    if (context.inputs.size() > 6) md += fmt::format(" and {} more", context.inputs.size() - 6);
+  }
+  md += fmt::format("; {} real values compared.\n\n", r.compared_values);
+  md += "The **gap** is `sqrt(Σ|X_meas − X_sim|² / Σ|X_meas|²)` over every test, response channel "
+        "and compared harmonic (all as displacements); the **noise level** is the gap a perfect "
+        "model would leave, from the noise the records themselves show.\n\n";
+  md += fmt::format("**Result.** {}\n\n", r.diagnosis.findings.empty()
+                                               ? std::string()
+                                               : r.diagnosis.findings.back());
+
+  md += "## Diagnosis\n\n";
+  for (std::size_t i = 0; i + 1 < r.diagnosis.findings.size(); ++i)
+    md += "- " + r.diagnosis.findings[i] + "\n";
+  md += "\n## Starting model\n\n";
+  for (const auto& n : r.start_notes)
+    md += n + "\n\n";
+  md += fmt::format("Model: {}. Gap {}.\n\n", model_text(r.states.front()), g4(r.gap.front()));
+
+  md += "## Steps\n\n";
+  if (r.steps.empty()) {
+    md += "Nothing was added.\n\n";
+  } else {
+    md += "| step | added | effect | value | 95 % interval | gap before | gap after | explained "
+          "|\n|---|---|---|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < r.steps.size(); ++i) {
+      const auto& s = r.steps[i];
+      md += fmt::format("| {} | {} | {} | {} | [{}, {}] | {} | {} | {} |\n", i + 1, s.added.name(),
+                        s.added.effect(), g4(s.added.value), g4(s.added.ci_low),
+                        g4(s.added.ci_high), g4(s.gap_before), g4(s.gap_after),
+                        pct(s.added.explained));
+    }
+    md += "\n";
+  }
+  md += fmt::format("Stopped: {}.\n\n", r.stop_reason);
+
+  // The gap per step.
+  {
+    Chart c;
+    c.title = "Gap after each step";
+    c.x_label = "step (0: starting model)";
+    c.y_label = "gap";
+    c.log_y = true;
+    Series gap;
+    gap.label = "gap";
+    gap.style = Series::Style::line_points;
+    for (std::size_t i = 0; i < r.gap.size(); ++i)
+      if (r.gap[i] > 0.0) gap.x.push_back(static_cast<double>(i)), gap.y.push_back(r.gap[i]);
+    if (gap.x.size() == 1) { // one point: draw it as a short flat segment
+      gap.x.push_back(0.25);
+      gap.y.push_back(gap.y.front());
+    }
+    c.series.push_back(gap);
+    if (r.noise_gap > 0.0) {
+      Series noise;
+      noise.label = "noise level";
+      noise.style = Series::Style::dashed;
+      noise.x = {0.0, std::max(1.0, static_cast<double>(r.gap.size() - 1))};
+      noise.y = {r.noise_gap, r.noise_gap};
+      c.series.push_back(noise);
+    }
+    md += "## Gap per step\n\n" + plot("gap.png", Figure{1000, 600, 1, {c}});
+  }
+
+  // Measured and simulated responses, before and after each step.
+  md += "## Measured and simulated response\n\n";
+  md += "Points: measured; lines: the model (harmonic balance). Colours: force levels (or "
+        "frequencies).\n\n";
+  const std::size_t figures = std::max<std::size_t>(1, r.steps.size());
+  for (std::size_t i = 0; i < figures; ++i) {
+    Figure f;
+    const bool none = r.steps.empty();
+    const auto& before = r.comparisons[none ? 0 : i];
+    const auto& after = r.comparisons[none ? 0 : i + 1];
+    const auto channels = channels_of(after);
+    f.columns = none ? 1 : 2;
+    f.width = none ? 900 : 1600;
+    f.height = 520 * static_cast<int>(channels.size());
+    for (const auto& ch : channels) {
+      if (none) {
+        f.charts.push_back(response_chart(after, ch, "Starting model (nothing added)"));
+        continue;
+      }
+      f.charts.push_back(response_chart(
+          before, ch, fmt::format("Before step {}: {}", i + 1, model_text(r.states[i]))));
+      f.charts.push_back(response_chart(
+          after, ch,
+          fmt::format("After step {} (+ {})", i + 1, r.steps[i].added.name())));
+    }
+    md += none ? "" : fmt::format("### Step {}: {}\n\n", i + 1, r.steps[i].finding);
+    md += plot(fmt::format("response_{}.png", i + 1), f);
+  }
+
+  // The candidates of every step.
+  md += "## Candidates\n\n";
+  md += "Share of the squared gap each candidate explains when added (all non-fixed terms "
+        "identified again, every test re-simulated); a candidate may be added only if it is "
+        "admissible and lowers the information criterion and the cross-validated gap.\n\n";
+  std::vector<std::pair<std::string, const std::vector<discover::Candidate>*>> rankings;
+  for (std::size_t i = 0; i < r.steps.size(); ++i)
+    rankings.push_back({fmt::format("Step {} (added {})", i + 1, r.steps[i].added.name()),
+                        &r.steps[i].ranking});
+  if (!r.last_ranking.empty())
+    rankings.push_back({fmt::format("Step {} (nothing added)", r.steps.size() + 1),
+                        &r.last_ranking});
+  for (std::size_t i = 0; i < rankings.size(); ++i) {
+    const auto& [title, ranking] = rankings[i];
+    Chart c;
+    c.title = title;
+    c.y_label = "share of the gap explained (%)";
+    c.legend = false;
+    Series bars;
+    bars.style = Series::Style::bars;
+    for (const auto& cand : *ranking) {
+      if (!std::isfinite(cand.explained)) continue;
+      c.x_categories.push_back(short_name(cand));
+      bars.x.push_back(static_cast<double>(c.x_categories.size()));
+      bars.y.push_back(100.0 * std::max(0.0, cand.explained));
+    }
+    if (!bars.x.empty()) {
+      c.series.push_back(bars);
+      md += "### " + title + "\n\n" + plot(fmt::format("candidates_{}.png", i + 1),
+                                           Figure{1200, 500, 1, {c}});
+    }
+    md += "| candidate | effect | value | 95 % interval | gap | explained | verdict |\n"
+          "|---|---|---|---|---|---|---|\n";
+    for (const auto& cand : *ranking)
+      md += fmt::format("| {} | {} | {} | [{}, {}] | {} | {} | {} |\n", cand.name(), cand.effect(),
+                        g4(cand.value), g4(cand.ci_low), g4(cand.ci_high), g4(cand.gap),
+                        pct(cand.explained), cand.rejected.empty() ? "admissible" : cand.rejected);
+    md += "\n";
+  }
+
+  // Final model and per-test agreement.
+  md += "## Final model\n\n";
+  md += "| joint | term | effect | value | unit | 95 % interval |\n|---|---|---|---|---|---|\n";
+  const auto& last = r.states.back();
+  for (const auto& j : last.joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      std::string ci = j.fixed[t] ? "fixed" : "—";
+      for (const auto& je : last.fit.joints)
+        if (je.name == j.name)
+          for (const auto& te : je.terms)
+            if (te.term == j.terms[t] && !te.fixed)
+              ci = fmt::format("[{}, {}]", g4(te.ci_low), g4(te.ci_high));
+      md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", j.name, joints::term_name(j.terms[t]),
+                        joints::term_effect(j.terms[t]), g4(j.values[t]),
+                        joints::term_unit(j.terms[t]), ci);
+    }
+  if (last.damping_scale != 1.0)
+    md += fmt::format("| substructure | damping_scale | substructure damping | {} | — | — |\n",
+                      g4(last.damping_scale));
+  md += "\n## Agreement per test (fundamental)\n\n";
+  md += "| test | channel | f (Hz) | force | amplitude error, start | final | phase error (deg), "
+        "start | final | harmonics 2+ measured | final model |\n"
+        "|---|---|---|---|---|---|---|---|---|---|\n";
+  const auto& first = r.comparisons.front();
+  const auto& final = r.comparisons.back();
+  for (std::size_t i = 0; i < final.size(); ++i)
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", final[i].test,
+                      final[i].channel, g4(final[i].frequency_hz), g4(final[i].force),
+                      pct(first[i].amplitude_error), pct(final[i].amplitude_error),
+                      g4(first[i].phase_error_deg), g4(final[i].phase_error_deg),
+                      pct(final[i].harmonics_measured), pct(final[i].harmonics_simulated));
+  if (!r.warnings.empty()) {
+    md += "\n## Warnings\n\n";
+    for (const auto& w : r.warnings)
+      md += "- " + w + "\n";
+  }
+  write_file_atomically(dir / "report.md", md);
+  written.push_back(dir / "report.md");
+  return written;
+}
+
+} // namespace jointid::io
