@@ -11,13 +11,15 @@ namespace {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
 
-// A joint's force g and its derivatives, Coulomb friction regularised as fc·tanh(ẏ/width).
+// A joint's smooth force g and its derivatives. Coulomb friction is left out when it is
+// handled exactly (`width` = 0), else regularised as fc·tanh(ẏ/width).
 void joint_force(const joints::Joint& j, double y, double v, double width, double& g, double& gy,
                  double& gv) {
   g = gy = gv = 0.0;
   for (std::size_t t = 0; t < j.terms.size(); ++t) {
     const double b = j.values[t];
     if (joints::is_dry_friction(j.terms[t])) {
+      if (width == 0.0) continue;
       const double th = std::tanh(v / width);
       g += b * th;
       gv += b * (1.0 - th * th) / width;
@@ -29,49 +31,56 @@ void joint_force(const joints::Joint& j, double y, double v, double width, doubl
   }
 }
 
-// The equations of one solve. Unknowns z, per joint j, at offset j (2K + 1): Re Y_0, then
-// Re Y_k, Im Y_k for k = 1 … K.
+// A joint with exact dry friction: its limit, its augmentation r (N s/m) and a compliance c
+// (m/N) that puts its residual rows in metres like the others.
+struct Friction {
+  int joint;
+  double limit, r, c;
+};
+
+// The equations of one solve. Unknowns z: per joint j, at offset j (2K + 1), Re Y_0, then
+// Re Y_k, Im Y_k for k = 1 … K; then per friction joint f, at offset (nj + f)(2K + 1), its
+// force harmonics Λ packed the same way (N).
 struct Equations {
   int K, nj, Nt;
   const std::vector<CMatrix>& Hyy;
   CMatrix HyF_F; // (K+1) × nj: H_yf(kω) F_k, the joints' response to the force alone
   const std::vector<joints::Joint>& joints;
-  double width;
+  double width; // 0: friction exact
+  std::vector<Friction> friction;
   // Per sample n: ∂y_n/∂z and ∂ẏ_n/∂z of one joint (Nt × (2K+1)), and the forward transform
   // from samples to packed harmonics ((2K+1) × Nt).
   const Eigen::MatrixXd& dy, &dv, &forward;
 
-  int size() const { return nj * (2 * K + 1); }
+  int m() const { return 2 * K + 1; }
+  int size() const { return (nj + static_cast<int>(friction.size())) * m(); }
 
-  Eigen::MatrixXcd unpack(const Eigen::VectorXd& z) const {
-    Eigen::MatrixXcd Y(K + 1, nj);
-    for (int j = 0; j < nj; ++j) {
-      const int o = j * (2 * K + 1);
+  Eigen::MatrixXcd unpack(const Eigen::VectorXd& z, int blocks, int first = 0) const {
+    Eigen::MatrixXcd Y(K + 1, blocks);
+    for (int j = 0; j < blocks; ++j) {
+      const int o = (first + j) * m();
       Y(0, j) = z(o);
       for (int k = 1; k <= K; ++k)
         Y(k, j) = Complex(z(o + 2 * k - 1), z(o + 2 * k));
     }
     return Y;
   }
-  Eigen::VectorXd pack(const Eigen::MatrixXcd& Y) const {
-    Eigen::VectorXd z(size());
-    for (int j = 0; j < nj; ++j) {
-      const int o = j * (2 * K + 1);
+  void pack(const Eigen::MatrixXcd& Y, Eigen::VectorXd& z, int first = 0) const {
+    for (int j = 0; j < Y.cols(); ++j) {
+      const int o = (first + j) * m();
       z(o) = Y(0, j).real();
       for (int k = 1; k <= K; ++k)
         z(o + 2 * k - 1) = Y(k, j).real(), z(o + 2 * k) = Y(k, j).imag();
     }
-    return z;
   }
 
-  // Harmonics of the joint forces (K+1) × nj and, if asked, their derivatives with respect to
-  // the joint's own unknowns (one (2K+1) × (2K+1) block per joint, packed like z).
+  // Harmonics of the joints' smooth forces (K+1) × nj and, if asked, their derivatives with
+  // respect to the joint's own unknowns (one (2K+1) × (2K+1) block per joint, packed like z).
   Eigen::MatrixXcd forces(const Eigen::VectorXd& z, std::vector<Eigen::MatrixXd>* dG) const {
-    const int m = 2 * K + 1;
     Eigen::MatrixXcd G(K + 1, nj);
     Eigen::VectorXd g(Nt), gy(Nt), gv(Nt);
     for (int j = 0; j < nj; ++j) {
-      const Eigen::VectorXd zj = z.segment(j * m, m);
+      const Eigen::VectorXd zj = z.segment(j * m(), m());
       const Eigen::VectorXd y = dy * zj, v = dv * zj;
       for (int n = 0; n < Nt; ++n)
         joint_force(joints[j], y(n), v(n), width, g(n), gy(n), gv(n));
@@ -79,37 +88,77 @@ struct Equations {
       G(0, j) = Gp(0);
       for (int k = 1; k <= K; ++k)
         G(k, j) = Complex(Gp(2 * k - 1), Gp(2 * k));
-      if (dG)
-        (*dG)[j] = forward * (gy.asDiagonal() * dy + gv.asDiagonal() * dv);
+      if (dG) (*dG)[j] = forward * (gy.asDiagonal() * dy + gv.asDiagonal() * dv);
     }
+    for (std::size_t f = 0; f < friction.size(); ++f) // exact friction forces, as unknowns
+      G.col(friction[f].joint) += unpack(z, 1, nj + static_cast<int>(f)).col(0);
     return G;
   }
 
-  // R = z − pack(H_yf F) + pack(H_yy G(z)), and its Jacobian J = I + ∂pack(H_yy G)/∂z.
+  // Adds ∂pack(H_yy(kω) G_k)/∂(unknowns of joint b's force) = `d` (packed rows) to the rows of
+  // joint a, columns `col`.
+  void add_coupling(Eigen::MatrixXd& J, int a, int b, int col, const Eigen::MatrixXd& d) const {
+    for (int k = 0; k <= K; ++k) {
+      const Complex h = Hyy[k](a, b);
+      if (k == 0) { // the mean is real
+        J.block(a * m(), col, 1, m()) += h.real() * d.row(0);
+        continue;
+      }
+      const auto re = d.row(2 * k - 1), im = d.row(2 * k);
+      J.block(a * m() + 2 * k - 1, col, 1, m()) += h.real() * re - h.imag() * im;
+      J.block(a * m() + 2 * k, col, 1, m()) += h.imag() * re + h.real() * im;
+    }
+  }
+
+  // R = [z_Y − pack(H_yf F) + pack(H_yy G(z)); c (Λ − AFT[proj(λ + r ẏ)])] and its
+  // (generalised) Jacobian.
   Eigen::VectorXd residual(const Eigen::VectorXd& z, double load, Eigen::MatrixXd* J) const {
     std::vector<Eigen::MatrixXd> dG(J ? nj : 0);
     const Eigen::MatrixXcd G = forces(z, J ? &dG : nullptr);
     Eigen::MatrixXcd R(K + 1, nj);
     for (int k = 0; k <= K; ++k)
       R.row(k) = -load * HyF_F.row(k) + (Hyy[k] * G.row(k).transpose()).transpose();
-    Eigen::VectorXd r = z + pack(R);
+    Eigen::VectorXd r = z;
+    Eigen::VectorXd packed(nj * m());
+    pack(R, packed);
+    r.head(nj * m()) += packed;
     if (J) {
-      const int m = 2 * K + 1;
       J->setIdentity(size(), size());
       for (int a = 0; a < nj; ++a)
         for (int b = 0; b < nj; ++b)
-          for (int k = 0; k <= K; ++k) {
-            const Complex h = Hyy[k](a, b);
-            if (k == 0) { // the mean is real
-              J->block(a * m, b * m, 1, m) += h.real() * dG[b].row(0);
-              continue;
-            }
-            const auto re = dG[b].row(2 * k - 1), im = dG[b].row(2 * k);
-            J->block(a * m + 2 * k - 1, b * m, 1, m) += h.real() * re - h.imag() * im;
-            J->block(a * m + 2 * k, b * m, 1, m) += h.imag() * re + h.real() * im;
-          }
+          add_coupling(*J, a, b, b * m(), dG[b]);
+      const Eigen::MatrixXd unit = Eigen::MatrixXd::Identity(m(), m());
+      for (std::size_t f = 0; f < friction.size(); ++f)
+        for (int a = 0; a < nj; ++a)
+          add_coupling(*J, a, friction[f].joint, (nj + static_cast<int>(f)) * m(), unit);
+    }
+    for (std::size_t f = 0; f < friction.size(); ++f) {
+      const Friction& fr = friction[f];
+      const int o = (nj + static_cast<int>(f)) * m(), oy = fr.joint * m();
+      const Eigen::VectorXd lambda = dy * z.segment(o, m()), v = dv * z.segment(oy, m());
+      Eigen::VectorXd p(Nt), stick(Nt);
+      for (int n = 0; n < Nt; ++n) {
+        const double trial = lambda(n) + fr.r * v(n);
+        stick(n) = std::abs(trial) < fr.limit ? 1.0 : 0.0;
+        p(n) = std::clamp(trial, -fr.limit, fr.limit);
+      }
+      r.segment(o, m()) = fr.c * (z.segment(o, m()) - forward * p);
+      if (J) {
+        J->block(o, o, m(), m()) =
+            fr.c * (Eigen::MatrixXd::Identity(m(), m()) - forward * stick.asDiagonal() * dy);
+        J->block(o, oy, m(), m()) = -fr.c * fr.r * (forward * stick.asDiagonal() * dv);
+      }
     }
     return r;
+  }
+
+  // |z| with the force unknowns in metres (through each friction joint's compliance).
+  double norm(const Eigen::VectorXd& z) const {
+    double s = z.head(nj * m()).squaredNorm();
+    for (std::size_t f = 0; f < friction.size(); ++f)
+      s += std::pow(friction[f].c, 2) *
+           z.segment((nj + static_cast<int>(f)) * m(), m()).squaredNorm();
+    return std::sqrt(s);
   }
 };
 
@@ -120,7 +169,7 @@ bool newton(const Equations& P, Eigen::VectorXd& z, double load, const HarmonicB
   Eigen::VectorXd r = P.residual(z, load, &J);
   for (int it = 0; it < o.max_iterations; ++it) {
     ++iterations;
-    res_norm = r.norm() / std::max(z.norm(), 1e-300);
+    res_norm = r.norm() / std::max(P.norm(z), 1e-300);
     if (res_norm < o.tolerance) return true;
     const Eigen::VectorXd step = J.partialPivLu().solve(-r);
     double t = 1.0;
@@ -136,7 +185,7 @@ bool newton(const Equations& P, Eigen::VectorXd& z, double load, const HarmonicB
     if (!improved) return res_norm < o.tolerance;
     r = P.residual(z, load, &J);
   }
-  res_norm = r.norm() / std::max(z.norm(), 1e-300);
+  res_norm = r.norm() / std::max(P.norm(z), 1e-300);
   return res_norm < o.tolerance;
 }
 
@@ -179,7 +228,7 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   K_ = o.harmonics;
   nj_ = static_cast<int>(joints.size());
   nf_ = static_cast<int>(force_equations.size());
-  Nt_ = o.time_samples > 0 ? o.time_samples : 32 * (K_ + 1);
+  Nt_ = o.time_samples > 0 ? o.time_samples : 16 * (K_ + 1);
   frequency_hz_ = frequency_hz;
   omega_ = two_pi * frequency_hz;
   for (const auto& j : joints)
@@ -231,8 +280,23 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
   CMatrix HyF_F(K_ + 1, nj_);
   for (int k = 0; k <= K_; ++k)
     HyF_F.row(k) = (HyF_[k] * Fk.row(k).transpose()).transpose();
-  const Equations P{K_,  nj_, Nt_, Hyy_, HyF_F, joints, options_.friction_width, dy, dv,
-                    forward};
+  const bool exact = options_.exact_friction;
+  std::vector<Friction> friction;
+  for (int j = 0; j < nj_; ++j) {
+    const int t = joints[j].term_index(joints::Term::fc);
+    if (t < 0 || !exact) continue;
+    const double limit = joints[j].values[t];
+    if (!(limit >= 0.0))
+      throw std::invalid_argument("harmonic balance: joint '" + joints[j].name +
+                                  "': Coulomb friction fc must be >= 0 N, got " +
+                                  std::to_string(limit));
+    // Scales: the joint's dynamic compliance at the fundamental, c = |H_yy(ω)_jj|, and r = 1 /
+    // (ω c), so that r ẏ is a force of the size the structure's dynamic stiffness gives.
+    const double c = std::max(std::abs(Hyy_[1](j, j)), 1e-300);
+    friction.push_back({j, limit, 1.0 / (omega_ * c), c});
+  }
+  const Equations P{K_,    nj_, Nt_, Hyy_,   HyF_F, joints, exact ? 0.0 : options_.friction_width,
+                    friction, dy, dv, forward};
 
   HarmonicBalanceResult out;
   out.frequency_hz = frequency_hz_;
@@ -240,7 +304,8 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
   if (start) {
     if (start->rows() != K_ + 1 || start->cols() != nj_)
       throw std::invalid_argument("harmonic balance: the start has the wrong shape");
-    z = P.pack(*start);
+    z = Eigen::VectorXd::Zero(P.size());
+    P.pack(*start, z);
   } else {
     // The linear response with the joints' linear terms (degree 1 in the term table).
     Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K_ + 1, nj_);
@@ -260,7 +325,22 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
       Y.row(k) = D.partialPivLu().solve(HyF_F.row(k).transpose()).transpose();
     }
     Y.row(0) = Y.row(0).real().cast<Complex>().eval();
-    z = P.pack(Y);
+    z = Eigen::VectorXd::Zero(P.size());
+    P.pack(Y, z);
+  }
+  // Friction forces to start: what the start's motion demands of them, Λ = H_yy⁻¹ (H_yf F − Y)
+  // − G_smooth, which the projection then brings within ±fc.
+  if (!friction.empty()) {
+    const Eigen::MatrixXcd Y = P.unpack(z, nj_), G = P.forces(z, nullptr);
+    for (int k = 0; k <= K_; ++k) {
+      const CVector need =
+          Hyy_[k].fullPivLu().solve((HyF_F.row(k) - Y.row(k)).transpose()) - G.row(k).transpose();
+      for (std::size_t f = 0; f < friction.size(); ++f) {
+        Eigen::MatrixXcd L = P.unpack(z, 1, nj_ + static_cast<int>(f));
+        L(k, 0) = k == 0 ? Complex(need(friction[f].joint).real()) : need(friction[f].joint);
+        P.pack(L, z, nj_ + static_cast<int>(f));
+      }
+    }
   }
   const Eigen::VectorXd z_start = z;
   out.converged = newton(P, z, 1.0, options_, out.iterations, out.residual);
@@ -272,7 +352,7 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
       out.converged = newton(P, z, static_cast<double>(s) / steps, options_, out.iterations,
                              out.residual);
   }
-  out.Y = P.unpack(z);
+  out.Y = P.unpack(z, nj_);
   out.G = P.forces(z, nullptr);
   out.X.resize(K_ + 1, HoB_.empty() ? 0 : HoB_[0].rows());
   for (int k = 0; k <= K_; ++k)

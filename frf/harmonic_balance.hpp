@@ -4,9 +4,16 @@
 ///     Y_k = H_yf(kω) F_k − H_yy(kω) G_k(Y),   k = 0 … K,
 /// where G_k are the harmonics of the joint forces g(y(t), ẏ(t)) computed by alternating
 /// frequency and time (AFT). Newton's method with the analytic Jacobian of the AFT forces
-/// (from ∂g/∂y and ∂g/∂ẏ at the time samples), amplitude continuation when it fails. Dry
-/// friction is regularised here: sign(ẏ) ≈ tanh(ẏ/width). Complex amplitudes are peak values
-/// with x(t) = Re Σ_k X_k e^{ikωt}; units SI.
+/// (from ∂g/∂y and ∂g/∂ẏ at the time samples), load continuation when it fails.
+///
+/// Dry friction is exact (set-valued, no regularisation): a friction joint's force harmonics Λ
+/// are unknowns too, and at the time samples t_n the Coulomb law holds in the form
+///     λ(t_n) = proj_[−fc, fc]( λ(t_n) + r ẏ(t_n) )      (r > 0),
+/// which says |λ| ≤ fc with ẏ = 0 (stick) or λ = fc sign(ẏ) (slip) — the same law the time
+/// integrator enforces at each step; its residual Λ − AFT[proj(…)] is solved with the rest by
+/// semi-smooth Newton. With `exact_friction = false` friction is regularised instead:
+/// sign(ẏ) ≈ tanh(ẏ/width). Complex amplitudes are peak values with
+/// x(t) = Re Σ_k X_k e^{ikωt}; units SI.
 #include "frf/receptance.hpp"
 #include "joints/joint.hpp"
 
@@ -14,8 +21,9 @@ namespace jointid::frf {
 
 struct HarmonicBalanceOptions {
   int harmonics = 9;            ///< K, harmonics 0 … K
-  int time_samples = 0;         ///< AFT samples per period; 0: 32 (K + 1)
-  double friction_width = 1e-4; ///< m/s (or rad/s): tanh regularisation of Coulomb friction
+  int time_samples = 0;         ///< AFT samples per period; 0: 16 (K + 1)
+  bool exact_friction = true;   ///< set-valued Coulomb friction; false: regularised
+  double friction_width = 1e-4; ///< m/s (or rad/s): tanh regularisation, when not exact
   double tolerance = 1e-12;     ///< on the residual, relative to |Y|
   int max_iterations = 60;
   int continuation_steps = 20; ///< amplitude steps tried when the direct solve fails
@@ -26,7 +34,7 @@ struct HarmonicBalanceResult {
   int iterations = 0;
   double residual = 0.0;
   Eigen::MatrixXcd Y; ///< (K+1) × n_joints: harmonics of the joint deformations
-  Eigen::MatrixXcd G; ///< (K+1) × n_joints: harmonics of the joint forces g
+  Eigen::MatrixXcd G; ///< (K+1) × n_joints: harmonics of the joint forces g (friction included)
   Eigen::MatrixXcd X; ///< (K+1) × n_outputs: harmonics of the output displacements
   double frequency_hz = 0.0;
   /// Displacement and velocity of output j at times t (reconstructed from the harmonics).
@@ -50,7 +58,8 @@ public:
                   const HarmonicBalanceOptions& options = {});
   /// F: harmonics 0, 1, … of the forces (rows beyond K are ignored, missing ones are 0), one
   /// column per force equation. `start` (K+1 × n_joints), if given, is the first Newton guess;
-  /// otherwise the linear response with the joints' linear terms (k, c) is.
+  /// otherwise the linear response with the joints' linear terms (k, c) is. Throws
+  /// std::invalid_argument for a negative friction limit fc (a joint that gives energy).
   HarmonicBalanceResult solve(const std::vector<joints::Joint>& joints, const Eigen::MatrixXcd& F,
                               const Eigen::MatrixXcd* start = nullptr) const;
   const HarmonicBalanceOptions& options() const { return options_; }

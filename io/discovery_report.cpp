@@ -35,73 +35,96 @@ std::string pct(double f) {
   return std::isfinite(f) ? fmt::format("{:.3g} %", 100.0 * f) : std::string("—");
 }
 
-// Values closer than 3 % (relative) fall into one group; returns each value's group and the
-// groups' representative values, ascending.
-std::pair<std::vector<int>, std::vector<double>> groups(const std::vector<double>& values) {
-  std::vector<double> sorted = values;
-  std::sort(sorted.begin(), sorted.end());
-  std::vector<double> reps;
-  for (double v : sorted)
-    if (reps.empty() || std::abs(v - reps.back()) > 0.03 * std::max(std::abs(v), 1e-300))
-      reps.push_back(v);
-  std::vector<int> of(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    int best = 0;
-    for (std::size_t g = 0; g < reps.size(); ++g)
-      if (std::abs(values[i] - reps[g]) < std::abs(values[i] - reps[best]))
-        best = static_cast<int>(g);
-    of[i] = best;
-  }
-  return {of, reps};
-}
-
-// One panel: measured (points) and simulated (lines) receptance per group, for one channel.
-Chart response_chart(const std::vector<discover::Comparison>& list, const std::string& channel,
+// One panel for one channel: measured receptance (points) and the model's response curves
+// (lines), one colour per force level (or per frequency, for sweeps over level).
+Chart response_chart(const std::vector<discover::Comparison>& list,
+                     const std::vector<discover::ResponseCurve>& curves, const std::string& channel,
                      const std::string& title) {
   std::vector<const discover::Comparison*> rows;
   for (const auto& c : list)
     if (c.channel == channel) rows.push_back(&c);
-  std::vector<double> freq, force;
-  for (const auto* c : rows)
-    freq.push_back(c->frequency_hz), force.push_back(c->force);
-  const auto [fgroup, freps] = groups(freq);
-  const auto [lgroup, lreps] = groups(force);
-  const bool over_frequency = freps.size() >= lreps.size();
-  const bool by_force = std::all_of(force.begin(), force.end(), [](double f) { return f > 0.0; });
+  const bool over_frequency = curves.empty() || curves.front().over_frequency;
+  const bool by_force = std::all_of(rows.begin(), rows.end(), [](auto* c) { return c->force > 0.0; });
   Chart chart;
   chart.title = title;
   chart.x_label = over_frequency ? "excitation frequency (Hz)" : "force amplitude (N)";
   chart.y_label = by_force ? fmt::format("|X1/F1| at {} (m/N)", channel)
                            : fmt::format("|X1| at {} (m)", channel);
   chart.log_y = true;
-  const auto& group = over_frequency ? lgroup : fgroup;
-  const auto& reps = over_frequency ? lreps : freps;
-  for (std::size_t g = 0; g < reps.size(); ++g) {
-    std::vector<std::pair<double, std::pair<double, double>>> pts;
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      if (group[i] != static_cast<int>(g)) continue;
-      const double scale = by_force ? 1.0 / rows[i]->force : 1.0;
-      pts.push_back({over_frequency ? rows[i]->frequency_hz : rows[i]->force,
-                     {std::abs(rows[i]->measured) * scale, std::abs(rows[i]->simulated) * scale}});
+  // The sweeps up give the colours; a sweep down (another branch) is drawn dashed in its colour.
+  std::vector<const discover::ResponseCurve*> up, down;
+  for (const auto& c : curves)
+    (c.descending ? down : up).push_back(&c);
+  auto same = [&](const discover::ResponseCurve& a, const discover::ResponseCurve& b) {
+    return over_frequency ? a.level == b.level : a.frequency_hz == b.frequency_hz;
+  };
+  // Each test belongs to the curve of the nearest level (or frequency).
+  auto nearest = [&](const discover::Comparison& c) {
+    std::size_t best = 0;
+    for (std::size_t g = 0; g < up.size(); ++g) {
+      auto key = [&](std::size_t i) {
+        return over_frequency ? std::abs(std::log(c.force / up[i]->level))
+                              : std::abs(std::log(c.frequency_hz / up[i]->frequency_hz));
+      };
+      if (key(g) < key(best)) best = g;
+    }
+    return best;
+  };
+  auto line = [&](const discover::ResponseCurve& curve, Series& model) {
+    const auto it = std::find(curve.channels.begin(), curve.channels.end(), channel);
+    if (it == curve.channels.end()) return;
+    const auto& X = curve.X1[static_cast<std::size_t>(it - curve.channels.begin())];
+    for (std::size_t p = 0; p < curve.x.size(); ++p) {
+      const double force = over_frequency ? curve.level : curve.x[p];
+      const double y = std::abs(X[p]) / (by_force ? force : 1.0);
+      if (std::isfinite(y) && y > 0.0) model.x.push_back(curve.x[p]), model.y.push_back(y);
+    }
+  };
+  for (std::size_t g = 0; g < std::max<std::size_t>(1, up.size()); ++g) {
+    Series measured, model;
+    measured.style = Series::Style::points;
+    measured.width = 2.5;
+    model.style = Series::Style::line;
+    measured.color = model.color = palette[g % palette.size()];
+    std::vector<std::pair<double, double>> pts;
+    for (const auto* c : rows) {
+      if (!up.empty() && nearest(*c) != g) continue;
+      const double y = std::abs(c->measured) / (by_force ? c->force : 1.0);
+      if (y > 0.0) pts.push_back({over_frequency ? c->frequency_hz : c->force, y});
     }
     std::sort(pts.begin(), pts.end());
-    Series measured, simulated;
-    const std::string label =
-        over_frequency ? fmt::format("{} N", g4(reps[g])) : fmt::format("{} Hz", g4(reps[g]));
-    measured.label = "measured, " + label;
-    simulated.label = "model, " + label;
-    measured.style = Series::Style::points;
-    simulated.style = Series::Style::line;
-    measured.color = simulated.color = palette[g % palette.size()];
-    measured.width = 2.5;
-    for (const auto& [x, y] : pts) {
-      if (!(y.first > 0.0) || !(y.second > 0.0)) continue;
-      measured.x.push_back(x), measured.y.push_back(y.first);
-      simulated.x.push_back(x), simulated.y.push_back(y.second);
+    for (const auto& [x, y] : pts)
+      measured.x.push_back(x), measured.y.push_back(y);
+    if (!up.empty()) {
+      const auto& curve = *up[g];
+      const std::string label = over_frequency ? fmt::format("{:.3g} N", curve.level)
+                                               : fmt::format("{:.3g} Hz", curve.frequency_hz);
+      measured.label = "measured, " + label;
+      model.label = "model, " + label;
+      line(curve, model);
+      for (const auto* d : down)
+        if (same(*d, curve)) {
+          Series back = model;
+          back.label = "model, " + label + ", swept down";
+          back.style = Series::Style::dashed;
+          back.x.clear(), back.y.clear();
+          line(*d, back);
+          if (!back.x.empty()) chart.series.push_back(std::move(back));
+        }
+    } else { // no curves: the model at the tests
+      measured.label = "measured";
+      model.label = "model";
+      std::vector<std::pair<double, double>> sim;
+      for (const auto* c : rows) {
+        const double y = std::abs(c->simulated) / (by_force ? c->force : 1.0);
+        if (std::isfinite(y) && y > 0.0) sim.push_back({c->frequency_hz, y});
+      }
+      std::sort(sim.begin(), sim.end());
+      for (const auto& [x, y] : sim)
+        model.x.push_back(x), model.y.push_back(y);
     }
-    if (measured.x.empty()) continue;
-    chart.series.push_back(std::move(simulated));
-    chart.series.push_back(std::move(measured));
+    if (!model.x.empty()) chart.series.push_back(std::move(model));
+    if (!measured.x.empty()) chart.series.push_back(std::move(measured));
   }
   return chart;
 }
@@ -194,33 +217,44 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   {
     Chart c;
     c.title = "Gap after each step";
-    c.x_label = "step (0: starting model)";
     c.y_label = "gap";
     c.log_y = true;
+    c.x_categories.push_back("start");
+    for (const auto& s : r.steps)
+      c.x_categories.push_back("+ " + short_name(s.added));
     Series gap;
     gap.label = "gap";
     gap.style = Series::Style::line_points;
     for (std::size_t i = 0; i < r.gap.size(); ++i)
-      if (r.gap[i] > 0.0) gap.x.push_back(static_cast<double>(i)), gap.y.push_back(r.gap[i]);
+      if (r.gap[i] > 0.0) gap.x.push_back(static_cast<double>(i + 1)), gap.y.push_back(r.gap[i]);
     if (gap.x.size() == 1) { // one point: draw it as a short flat segment
-      gap.x.push_back(0.25);
+      gap.x.push_back(1.25);
       gap.y.push_back(gap.y.front());
     }
     c.series.push_back(gap);
+    const double right = std::max(2.0, static_cast<double>(r.gap.size()));
     if (r.noise_gap > 0.0) {
       Series noise;
       noise.label = "noise level";
       noise.style = Series::Style::dashed;
-      noise.x = {0.0, std::max(1.0, static_cast<double>(r.gap.size() - 1))};
+      noise.x = {1.0, right};
       noise.y = {r.noise_gap, r.noise_gap};
       c.series.push_back(noise);
+      if (r.simulation_gap > 0.0) {
+        Series floor = noise;
+        floor.label = "noise and simulation error (final model)";
+        const double level = std::hypot(r.noise_gap, r.simulation_gap);
+        floor.y = {level, level};
+        c.series.push_back(floor);
+      }
     }
     md += "## Gap per step\n\n" + plot("gap.png", Figure{1000, 600, 1, {c}});
   }
 
   // Measured and simulated responses, before and after each step.
   md += "## Measured and simulated response\n\n";
-  md += "Points: measured; lines: the model (harmonic balance). Colours: force levels (or "
+  md += "Points: measured; lines: the model's response (harmonic balance, continued from point to "
+        "point) driven by a pure sine at each force level. Colours: force levels (or "
         "frequencies).\n\n";
   const std::size_t figures = std::max<std::size_t>(1, r.steps.size());
   for (std::size_t i = 0; i < figures; ++i) {
@@ -234,14 +268,16 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     f.height = 520 * static_cast<int>(channels.size());
     for (const auto& ch : channels) {
       if (none) {
-        f.charts.push_back(response_chart(after, ch, "Starting model (nothing added)"));
+        f.charts.push_back(
+            response_chart(after, r.curves.front(), ch, "Starting model (nothing added)"));
         continue;
       }
-      f.charts.push_back(response_chart(
-          before, ch, fmt::format("Before step {}: {}", i + 1, model_text(r.states[i]))));
-      f.charts.push_back(response_chart(
-          after, ch,
-          fmt::format("After step {} (+ {})", i + 1, r.steps[i].added.name())));
+      f.charts.push_back(response_chart(before, r.curves[i], ch,
+                                        fmt::format("Before step {}: {}", i + 1,
+                                                    model_text(r.states[i]))));
+      f.charts.push_back(response_chart(after, r.curves[i + 1], ch,
+                                        fmt::format("After step {} (+ {})", i + 1,
+                                                    r.steps[i].added.name())));
     }
     md += none ? "" : fmt::format("### Step {}: {}\n\n", i + 1, r.steps[i].finding);
     md += plot(fmt::format("response_{}.png", i + 1), f);

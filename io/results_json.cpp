@@ -95,6 +95,7 @@ std::string discovery_json(const discover::Result& r) {
   out["tests"] = r.tests;
   out["compared_values"] = r.compared_values;
   out["noise_gap"] = r.noise_gap >= 0.0 ? number(r.noise_gap) : Json(nullptr);
+  out["simulation_gap"] = number(r.simulation_gap);
   out["at_noise_level"] = r.at_noise_level;
   Json start;
   start["notes"] = r.start_notes;
