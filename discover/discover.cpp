@@ -1,5 +1,9 @@
 #include "discover/discover.hpp"
 
+#include "identify/statistics.hpp"
+
+#include <Eigen/Dense>
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -41,6 +45,10 @@ struct Entry {
   Complex measured;
   double variance;         // E|δX|² of the measurement noise, NaN when unknown
   double simulation = 0.0; // E|δX|² of the simulation's own error (harmonic truncation)
+  double force = 0.0;      // E|δX_sim|² from the noise in the measured force that drives it
+  // The variance of the difference measured − simulated, and its real degrees of freedom.
+  double total() const { return variance + simulation + force; }
+  int dof() const { return harmonic == 0 ? 1 : 2; }
 };
 
 // The substructure's receptance (its damping scaled) and the harmonic-balance problems of
@@ -93,6 +101,17 @@ public:
       f_max = std::max(f_max, m.frequency_hz);
     }
     f_max_ = f_max * o.balance.harmonics;
+    // The force that drives each re-simulation: the measured harmonics, except those that are
+    // noise (a force harmonic within 5 standard deviations of 0 is taken as 0): driven through
+    // a resonance, noise alone would give the model responses the structure never had.
+    for (const auto& m : tests) {
+      Eigen::MatrixXcd F = m.F;
+      for (Eigen::Index k = 0; k < F.rows(); ++k)
+        for (Eigen::Index c = 0; c < F.cols(); ++c)
+          if (k != 1 && m.F_variance.size() > 0 && std::norm(F(k, c)) <= 25.0 * m.F_variance(k, c))
+            F(k, c) = 0.0;
+      drive_.push_back(std::move(F));
+    }
     // The measured joint deformations: the harmonic balance starts from them, so that it
     // finds the periodic solution on the measured branch (hardening joints have several).
     const std::vector<int> set2 = joints::joint_dof_set(start, dofs_);
@@ -177,6 +196,7 @@ public:
     }
     state = evaluate(joints, simulator(1.0));
     state.fit = start_fit;
+    if (fitted) state = refine(state, simulator(1.0));
     if (!state.converged)
       out.warnings.push_back("the harmonic balance did not converge for every test with the "
                              "starting model");
@@ -208,6 +228,34 @@ public:
       for (auto& [c, s] : outcomes) {
         ranking.push_back(std::move(c));
         states.push_back(std::move(s));
+      }
+      // The finalists — the best few by the criterion, simulated and converged — identified
+      // again by output error, and judged again (the equation-error estimate screens; noise in
+      // the measured deformation biases it, e.g. a stiff joint's damping).
+      {
+        std::vector<std::size_t> by(ranking.size());
+        std::iota(by.begin(), by.end(), std::size_t{0});
+        std::stable_sort(by.begin(), by.end(), [&](std::size_t a, std::size_t b) {
+          return ranking[a].criterion < ranking[b].criterion;
+        });
+        std::vector<std::size_t> finalists;
+        for (std::size_t i : by)
+          if (std::isfinite(ranking[i].criterion) && ranking[i].converged &&
+              finalists.size() < static_cast<std::size_t>(o_.finalists))
+            finalists.push_back(i);
+        std::vector<std::function<State()>> refinements;
+        for (std::size_t i : finalists)
+          refinements.push_back([&, i] {
+            const auto sim = make_simulator(states[i].damping_scale, false);
+            return refine(states[i], *sim);
+          });
+        std::vector<State> refined = run_parallel(refinements);
+        for (std::size_t f = 0; f < finalists.size(); ++f) {
+          const std::size_t i = finalists[f];
+          if (!refined[f].converged) continue;
+          states[i] = std::move(refined[f]);
+          judge(ranking[i], states[i]);
+        }
       }
 
       // Admissible and better than the current model by the criterion, best first.
@@ -276,12 +324,22 @@ public:
       out.stop_reason = fmt::format("stopped after the maximum of {} steps", o_.max_steps);
     out.simulation_gap = estimate_simulation_error(state);
     out.states.back() = state;
+    if (noise_known_) out.noise_gap = noise_gap_;
     for (const auto& s : out.states) {
       out.gap.push_back(s.gap);
       out.comparisons.push_back(compare(s));
       out.curves.push_back(curves(s));
     }
     out.at_noise_level = at_noise_level(out.states.back());
+    out.chi2_per_value = out.states.back().chi2 / values_;
+    if (std::getenv("JOINTID_DEBUG_CHI2")) {
+      double c[8] = {0}; int n[8] = {0};
+      for (const auto& e : entries_) {
+        const double d = std::norm(e.measured - out.states.back().X[e.test](e.harmonic, e.response));
+        c[e.harmonic] += e.dof() * d / e.total(); n[e.harmonic] += e.dof();
+      }
+      for (int k = 0; k <= K_; ++k) fmt::print(stderr, "harmonic {}: chi2/n {:.3f} ({} values)\n", k, c[k] / n[k], n[k]);
+    }
     if (out.steps.empty() && out.at_noise_level && out.diagnosis.findings.empty())
       out.diagnosis.findings.push_back(fmt::format(
           "The starting model reproduces the measurement to the noise level (gap {}, noise {}): "
@@ -401,19 +459,176 @@ private:
   }
 
   // Simulates every test with these joints.
-  State evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim) const {
+  State evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim,
+                 const State* warm = nullptr) const {
     State s;
     s.joints = joints;
     s.damping_scale = sim.scale;
     s.parameters = parameters(joints, sim.scale);
     s.X.assign(tests_.size(), Eigen::MatrixXcd());
+    s.Y.assign(tests_.size(), Eigen::MatrixXcd());
     for (std::size_t i = 0; i < tests_.size(); ++i) {
-      const frf::HarmonicBalanceResult r = solve(sim, i, joints);
+      const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
+      const frf::HarmonicBalanceResult r = solve(sim, static_cast<int>(i), joints, start);
       s.converged = s.converged && r.converged && r.X.allFinite();
       s.X[i] = r.X.topRows(K_ + 1);
+      s.Y[i] = r.Y;
     }
     score(s);
     return s;
+  }
+
+  // Output-error refinement (maximum likelihood under the noise model): every non-fixed term is
+  // adjusted by Levenberg–Marquardt to minimise the weighted squared difference between the
+  // re-simulated and the measured harmonics, starting from the equation-error estimate (which
+  // the noise in the measured deformation makes less efficient). The 95 % intervals then come
+  // from the output-error Jacobian J (finite differences): σ̂² (JᵀJ)⁻¹, with σ̂² the weighted
+  // residual variance (at least 1 when the noise is known: a misfit beyond the noise widens the
+  // intervals, never narrows them).
+  State refine(const State& start, const Simulator& sim) const {
+    struct Param {
+      std::size_t joint, term;
+    };
+    std::vector<Param> params;
+    for (std::size_t j = 0; j < start.joints.size(); ++j)
+      for (std::size_t t = 0; t < start.joints[j].terms.size(); ++t)
+        if (!start.joints[j].fixed[t]) params.push_back({j, t});
+    const auto p = static_cast<Eigen::Index>(params.size());
+    if (p == 0) return start;
+    // Steps stay among physical models (no negative damping or friction); a start outside them
+    // (an equation-error estimate biased by noise) is first brought back to zero damping there.
+    State begin = start;
+    if (!physical_problem(start.joints).empty()) {
+      std::vector<joints::Joint> clamped = start.joints;
+      for (auto& j : clamped)
+        for (std::size_t t = 0; t < j.terms.size(); ++t)
+          if (joints::term_info(j.terms[t]).nature == joints::Nature::dissipative && !j.fixed[t])
+            j.values[t] = std::max(j.values[t], 0.0);
+      begin = evaluate(clamped, sim, &start);
+      begin.fit = start.fit;
+    }
+    if (!begin.converged || !physical_problem(begin.joints).empty()) return start;
+    std::vector<double> weight;
+    for (const auto& e : entries_)
+      weight.push_back(noise_known_ ? 1.0 / std::sqrt(e.total() / e.dof()) : 1.0);
+    auto residual = [&](const State& st) {
+      Eigen::VectorXd r(values_);
+      Eigen::Index n = 0;
+      for (std::size_t i = 0; i < entries_.size(); ++i) {
+        const auto& e = entries_[i];
+        const Complex err = e.measured - st.X[e.test](e.harmonic, e.response);
+        r(n++) = weight[i] * err.real();
+        if (e.harmonic != 0) r(n++) = weight[i] * err.imag();
+      }
+      return r;
+    };
+    auto joints_with = [&](const Eigen::VectorXd& b) {
+      std::vector<joints::Joint> j = begin.joints;
+      for (Eigen::Index q = 0; q < p; ++q)
+        j[params[q].joint].values[params[q].term] = b(q);
+      return j;
+    };
+    Eigen::VectorXd b(p), step(p);
+    std::vector<bool> dissipative(p);
+    for (Eigen::Index q = 0; q < p; ++q) {
+      dissipative[q] = joints::term_info(begin.joints[params[q].joint].terms[params[q].term]).nature ==
+                       joints::Nature::dissipative;
+      b(q) = begin.joints[params[q].joint].values[params[q].term];
+      // A finite-difference step of the parameter's own scale: its value, or (at 0, e.g. a
+      // damping brought back to 0) its equation-error estimate and standard deviation.
+      double scale = std::max(std::abs(b(q)),
+                              std::abs(start.joints[params[q].joint].values[params[q].term]));
+      for (const auto& je : start.fit.joints)
+        if (je.name == begin.joints[params[q].joint].name)
+          for (const auto& te : je.terms)
+            if (te.term == begin.joints[params[q].joint].terms[params[q].term] &&
+                std::isfinite(te.std))
+              scale = std::max(scale, te.std);
+      step(q) = 1e-5 * std::max(scale, 1e-12);
+    }
+    State current = begin;
+    Eigen::VectorXd r = residual(current);
+    double cost = r.squaredNorm(), mu = 1e-3;
+    Eigen::MatrixXd J(r.size(), p);
+    auto jacobian = [&]() -> bool {
+      for (Eigen::Index q = 0; q < p; ++q) {
+        for (double h : {step(q), -step(q)}) {
+          Eigen::VectorXd bq = b;
+          bq(q) += h;
+          const std::vector<joints::Joint> jq = joints_with(bq);
+          if (!physical_problem(jq).empty()) continue;
+          const State sq = evaluate(jq, sim, &current);
+          if (!sq.converged) continue;
+          J.col(q) = (residual(sq) - r) / h;
+          break;
+        }
+        if (!J.col(q).allFinite()) return false;
+      }
+      return true;
+    };
+    for (int iteration = 0; iteration < 12; ++iteration) {
+      J.setConstant(nan);
+      if (!jacobian()) return start;
+      const Eigen::MatrixXd A = J.transpose() * J;
+      const Eigen::VectorXd g = J.transpose() * r;
+      bool accepted = false;
+      double gain = 0.0;
+      for (int tries = 0; tries < 10 && !accepted; ++tries, mu *= 10.0) {
+        Eigen::MatrixXd M = A;
+        M.diagonal() += mu * A.diagonal() + Eigen::VectorXd::Constant(p, 1e-300);
+        Eigen::VectorXd nb = b - M.ldlt().solve(g);
+        for (Eigen::Index q = 0; q < p; ++q) // projected onto non-negative damping and friction
+          if (dissipative[q]) nb(q) = std::max(nb(q), 0.0);
+        const std::vector<joints::Joint> nj = joints_with(nb);
+        if (!nb.allFinite() || !physical_problem(nj).empty()) continue;
+        State sn = evaluate(nj, sim, &current);
+        if (!sn.converged) continue;
+        const Eigen::VectorXd rn = residual(sn);
+        if (rn.squaredNorm() < cost) {
+          gain = (cost - rn.squaredNorm()) / cost;
+          b = nb, current = std::move(sn), r = rn, cost = r.squaredNorm();
+          mu = std::max(mu / 100.0, 1e-9); // (×10 on leaving the loop)
+          accepted = true;
+        }
+      }
+      if (!accepted || gain < 1e-5) break; // a 0.001 % smaller misfit is no longer worth a step
+    }
+    // Uncertainty at the optimum.
+    J.setConstant(nan);
+    if (!jacobian()) return current;
+    const int dof = values_ - static_cast<int>(p);
+    identify::FitResult fit = begin.fit;
+    if (dof > 0) {
+      double s2 = cost / dof;
+      if (noise_known_) s2 = std::max(s2, 1.0);
+      const Eigen::MatrixXd C =
+          s2 * (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+      const double tq = identify::student_t_quantile(0.975, dof);
+      std::size_t q = 0;
+      fit.joints.clear();
+      for (std::size_t j = 0; j < current.joints.size(); ++j) {
+        identify::JointEstimate je{current.joints[j].name, {}};
+        for (std::size_t t = 0; t < current.joints[j].terms.size(); ++t) {
+          identify::TermEstimate te;
+          te.term = current.joints[j].terms[t];
+          te.value = current.joints[j].values[t];
+          te.fixed = current.joints[j].fixed[t];
+          if (!te.fixed) {
+            te.std = std::sqrt(std::max(C(static_cast<Eigen::Index>(q), static_cast<Eigen::Index>(q)), 0.0));
+            ++q;
+          }
+          te.ci_low = te.value - tq * te.std;
+          te.ci_high = te.value + tq * te.std;
+          je.terms.push_back(te);
+        }
+        fit.joints.push_back(std::move(je));
+      }
+      fit.equations = values_;
+      fit.unknowns = static_cast<int>(p);
+      fit.residual_relative = current.gap;
+    }
+    current.fit = std::move(fit);
+    return current;
   }
 
   // The gap, χ² (with the noise and the simulation's own error as the variance of each value)
@@ -423,7 +638,7 @@ private:
     for (const auto& e : entries_) {
       const double d = std::norm(e.measured - s.X[e.test](e.harmonic, e.response));
       S += d;
-      chi2 += noise_known_ ? 2.0 * d / (e.variance + e.simulation) : 0.0;
+      chi2 += noise_known_ ? e.dof() * d / e.total() : 0.0;
     }
     s.gap = std::sqrt(S / measured2_);
     s.chi2 = noise_known_ ? chi2 : nan;
@@ -433,19 +648,43 @@ private:
                                  : N * std::log(std::max(S, 1e-300 * measured2_) / N) + penalty;
   }
 
-  // The simulation's own error at this state: every test solved again with twice the harmonics,
-  // and twice their difference taken as the truncation error of the solution used. For an
-  // error falling like 1/K (dry friction: the switching times of a truncated velocity) that is
-  // what remains; for smooth joints, whose error falls exponentially, it is negligible anyway.
-  // The state is scored again with it. Returns the error as a gap.
+  // What a perfect model would still miss at this state, besides the response's own noise:
+  //  - the simulation's error: every test solved again with twice the harmonics, and twice the
+  //    difference taken as the truncation error of the solution used (for an error falling like
+  //    1/K — dry friction: the switching times of a truncated velocity — that is what remains;
+  //    smooth joints' error falls exponentially and is negligible);
+  //  - the noise of the measured force that drives the simulation, propagated through the model:
+  //    the fundamental of each force perturbed by its standard deviation, in phase and in
+  //    quadrature, E|δX|² = (|ΔX_re|² + |ΔX_im|²) / 2.
+  // The state is scored again with them. Returns the simulation error as a gap.
   double estimate_simulation_error(State& s) {
     const Simulator& fine = simulator(s.damping_scale, true);
+    const Simulator& sim = simulator(s.damping_scale);
+    for (auto& e : entries_)
+      e.force = 0.0;
+    for (std::size_t i = 0; i < tests_.size(); ++i) {
+      const auto& m = tests_[i];
+      for (Eigen::Index c = 0; c < drive_[i].cols(); ++c) {
+        const double v = m.F_variance.size() > 0 ? m.F_variance(1, c) : nan;
+        if (!(v > 0.0) || !noise_known_) continue;
+        for (Complex unit : {Complex(1.0, 0.0), Complex(0.0, 1.0)}) {
+          Eigen::MatrixXcd F = drive_[i];
+          F(1, c) += std::sqrt(v) * unit;
+          const frf::HarmonicBalanceResult r =
+              sim.balance[i].solve(s.joints, F, s.Y[i].size() > 0 ? &s.Y[i] : nullptr);
+          if (!r.converged) continue;
+          for (auto& e : entries_)
+            if (e.test == static_cast<int>(i))
+              e.force += 0.5 * std::norm(r.X(e.harmonic, e.response) - s.X[i](e.harmonic, e.response));
+        }
+      }
+    }
     double E = 0.0;
     for (std::size_t i = 0; i < tests_.size(); ++i) {
       Eigen::MatrixXcd start = Eigen::MatrixXcd::Zero(fine.harmonics + 1, layout_.size());
       start.topRows(measured_start_[i].rows()) = measured_start_[i];
-      frf::HarmonicBalanceResult r = fine.balance[i].solve(s.joints, tests_[i].F, &start);
-      if (!r.converged) r = fine.balance[i].solve(s.joints, tests_[i].F);
+      frf::HarmonicBalanceResult r = fine.balance[i].solve(s.joints, drive_[i], &start);
+      if (!r.converged) r = fine.balance[i].solve(s.joints, drive_[i]);
       for (auto& e : entries_)
         if (e.test == static_cast<int>(i)) {
           e.simulation = r.converged ? 4.0 * std::norm(r.X(e.harmonic, e.response) -
@@ -454,6 +693,12 @@ private:
           E += e.simulation;
         }
     }
+    if (noise_known_) { // the noise level: the response's noise and the force's, propagated
+      double noise2 = 0.0;
+      for (const auto& e : entries_)
+        noise2 += e.variance + e.force;
+      noise_gap_ = std::sqrt(noise2 / measured2_);
+    }
     score(s);
     return std::sqrt(E / measured2_);
   }
@@ -461,15 +706,21 @@ private:
   // Test i's steady state: from the measured deformation first, else from the linear response
   // with load continuation.
   frf::HarmonicBalanceResult solve(const Simulator& sim, int i,
-                                   const std::vector<joints::Joint>& joints) const {
-    if (!physical_problem(joints).empty()) { // e.g. fc < 0: no steady state to speak of
+                                   const std::vector<joints::Joint>& joints,
+                                   const Eigen::MatrixXcd* warm = nullptr) const {
+    if (!friction_problem(joints).empty()) { // fc < 0: no steady state to speak of
       frf::HarmonicBalanceResult none;
       none.X = Eigen::MatrixXcd::Constant(sim.harmonics + 1, response_eq_[i].size(), nan);
       return none;
     }
-    frf::HarmonicBalanceResult r = sim.balance[i].solve(joints, tests_[i].F, &measured_start_[i]);
+    frf::HarmonicBalanceResult r;
+    if (warm && warm->rows() == sim.harmonics + 1) {
+      r = sim.balance[i].solve(joints, drive_[i], warm);
+      if (r.converged) return r;
+    }
+    r = sim.balance[i].solve(joints, drive_[i], &measured_start_[i]);
     if (!r.converged) {
-      frf::HarmonicBalanceResult again = sim.balance[i].solve(joints, tests_[i].F);
+      frf::HarmonicBalanceResult again = sim.balance[i].solve(joints, drive_[i]);
       again.iterations += r.iterations;
       if (again.converged || again.residual < r.residual) r = std::move(again);
     }
@@ -495,6 +746,16 @@ private:
             c.ci_low = te.ci_low;
             c.ci_high = te.ci_high;
           }
+  }
+
+  // A negative friction limit: the harmonic balance (and the physics) has no answer for it.
+  static std::string friction_problem(const std::vector<joints::Joint>& joints) {
+    for (const auto& j : joints)
+      for (std::size_t t = 0; t < j.terms.size(); ++t)
+        if (joints::is_dry_friction(j.terms[t]) && j.values[t] < 0.0)
+          return fmt::format("not physical: fc of '{}' came out negative ({})", j.name,
+                             number(j.values[t]));
+    return {};
   }
 
   static std::string physical_problem(const std::vector<joints::Joint>& joints) {
@@ -549,15 +810,12 @@ private:
       const identify::FitResult fit = identify(joints, sim, all_tests());
       joints = fit.identified(joints);
       take_fit(c, fit, joint, term);
-      // Not simulated: a joint that gives energy has no steady state to compare.
-      if (const std::string problem = physical_problem(joints); !problem.empty())
+      // Not simulated: negative dry friction has no steady state to compare.
+      if (const std::string problem = friction_problem(joints); !problem.empty())
         return refused(std::move(c), state, problem);
       State s = evaluate(joints, sim);
       s.fit = fit;
-      fill(c, s);
-      if (c.rejected.empty() && c.ci_low <= 0.0 && c.ci_high >= 0.0)
-        c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 0",
-                                 number(c.ci_low), number(c.ci_high));
+      judge(c, s);
       return {std::move(c), std::move(s)};
     } catch (const std::invalid_argument& e) {
       return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
@@ -629,6 +887,21 @@ private:
     return {std::move(c), std::move(st)};
   }
 
+  // A term candidate's value and interval from its state's fit, and its verdict: converged,
+  // physical, its interval clear of 0 (the damping scale: of 1).
+  void judge(Candidate& c, const State& s) const {
+    c.rejected.clear();
+    if (c.term) take_fit(c, s.fit, c.joint, *c.term);
+    fill(c, s);
+    if (c.rejected.empty()) c.rejected = physical_problem(s.joints);
+    if (c.rejected.empty() && c.term && c.ci_low <= 0.0 && c.ci_high >= 0.0)
+      c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 0",
+                               number(c.ci_low), number(c.ci_high));
+    if (c.rejected.empty() && !c.term && !c.refit && c.ci_low <= 1.0 && c.ci_high >= 1.0)
+      c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 1",
+                               number(c.ci_low), number(c.ci_high));
+  }
+
   void fill(Candidate& c, const State& s) const {
     c.gap = s.gap;
     c.criterion = s.criterion;
@@ -656,12 +929,19 @@ private:
         } catch (const std::invalid_argument&) {
           return -1.0;
         }
+        // A fold's estimate may come out with negative damping or friction (fewer tests, more
+        // noise): brought back to 0, as the output-error refinement does.
+        for (auto& j : fitted)
+          for (std::size_t t = 0; t < j.terms.size(); ++t)
+            if (joints::term_info(j.terms[t]).nature == joints::Nature::dissipative && !j.fixed[t])
+              j.values[t] = std::max(j.values[t], 0.0);
         double S = 0.0;
         for (int i : held) {
           const frf::HarmonicBalanceResult r = solve(sim, i, fitted);
-          if (!r.converged) return inf;
-          for (const auto& e : entries_)
-            if (e.test == i) S += std::norm(e.measured - r.X(e.harmonic, e.response));
+          for (const auto& e : entries_) // a failed prediction counts as predicting nothing
+            if (e.test == i)
+              S += r.converged ? std::norm(e.measured - r.X(e.harmonic, e.response))
+                               : std::norm(e.measured);
         }
         return S;
       });
@@ -750,7 +1030,7 @@ private:
           const frf::HarmonicBalance& hb = over_frequency ? *at_f : *fixed_frequency;
           frf::HarmonicBalanceResult r;
           const Eigen::MatrixXcd F = frf::sine_force(amplitude);
-          if (physical_problem(state.joints).empty()) {
+          if (friction_problem(state.joints).empty()) {
             r = hb.solve(state.joints, F, previous ? &*previous : nullptr);
             if (!r.converged && previous) r = hb.solve(state.joints, F);
           }
@@ -1039,6 +1319,7 @@ private:
   std::vector<std::unique_ptr<Simulator>> simulators_;
   std::vector<Entry> entries_;
   std::vector<Eigen::MatrixXcd> measured_start_; // per test: (K_hb+1) × joints
+  std::vector<Eigen::MatrixXcd> drive_;          // per test: the force harmonics that drive it
   int values_ = 0;
   double measured2_ = 0.0;
   bool noise_known_ = true;

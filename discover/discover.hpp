@@ -59,8 +59,10 @@ struct Options {
   double min_explained = 0.05;
   /// Leave-one-test-out cross-validation above this many tests uses this many folds instead.
   int folds = 10;
+  /// Candidates refined by output error at each step (the best by the equation-error screen).
+  int finalists = 3;
   /// Points of each state's response curves for the report (0: none).
-  int curve_points = 40;
+  int curve_points = 30;
 };
 
 /// One candidate addition to the model, and what it gave.
@@ -92,6 +94,7 @@ struct State {
   double criterion = 0.0;
   bool converged = true;
   std::vector<Eigen::MatrixXcd> X; ///< per test: simulated harmonics 0 … K at its responses
+  std::vector<Eigen::MatrixXcd> Y; ///< per test: the joints' deformation harmonics (all solved)
   identify::FitResult fit;         ///< the identification that gave the values (if any)
 };
 
@@ -157,6 +160,9 @@ struct Result {
   /// the harmonics (dry friction converges slowly with the harmonics; smooth joints fast).
   double simulation_gap = 0.0;
   bool at_noise_level = false;
+  /// The final model's χ² per compared value (1 for a model that explains everything but the
+  /// noise and its own simulation error); NaN when the noise is unknown.
+  double chi2_per_value = 0.0;
   Diagnosis diagnosis;
   std::string stop_reason;
   std::vector<std::string> warnings;

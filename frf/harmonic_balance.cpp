@@ -51,6 +51,50 @@ struct Equations {
   // Per sample n: ∂y_n/∂z and ∂ẏ_n/∂z of one joint (Nt × (2K+1)), and the forward transform
   // from samples to packed harmonics ((2K+1) × Nt).
   const Eigen::MatrixXd& dy, &dv, &forward;
+  // cos(pθ_n) and sin(pθ_n), p = 0 … 2K, for the harmonics of sample weights (Nt × (2K+1)).
+  const Eigen::MatrixXd &cos2, &sin2;
+  double omega;
+
+  // forward · diag(wy) · dy + forward · diag(wv) · dv, the derivative of the harmonics of a
+  // signal w_y(t) y(t) + w_v(t) ẏ(t) with respect to the packed harmonics of y, from the
+  // harmonics W_p = (1/Nt) Σ w(θ_n) e^{−ipθ_n}, p ≤ 2K, of the weights (product-to-sum: a
+  // product of harmonics j and k has harmonics k ± j). O(Nt K + K²) instead of O(Nt K²).
+  Eigen::MatrixXd product(const Eigen::VectorXd* wy, const Eigen::VectorXd* wv) const {
+    const int M = m();
+    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(M, M);
+    auto add = [&](const Eigen::VectorXd& w, bool rate) {
+      const Eigen::VectorXd re = cos2.transpose() * w / Nt, im = -(sin2.transpose() * w) / Nt;
+      auto Re = [&](int p) { return re(std::abs(p)); };
+      auto Im = [&](int p) { return p < 0 ? -im(-p) : im(p); };
+      // The columns of y's own harmonics: 0, cos jθ, −sin jθ.
+      Eigen::MatrixXd E(M, M);
+      E(0, 0) = Re(0);
+      for (int j = 1; j <= K; ++j)
+        E(0, 2 * j - 1) = Re(j), E(0, 2 * j) = Im(j);
+      for (int k = 1; k <= K; ++k) {
+        E(2 * k - 1, 0) = 2.0 * Re(k);
+        E(2 * k, 0) = 2.0 * Im(k);
+        for (int j = 1; j <= K; ++j) {
+          E(2 * k - 1, 2 * j - 1) = Re(k - j) + Re(k + j);
+          E(2 * k - 1, 2 * j) = Im(k + j) - Im(k - j);
+          E(2 * k, 2 * j - 1) = Im(k + j) + Im(k - j);
+          E(2 * k, 2 * j) = Re(k - j) - Re(k + j);
+        }
+      }
+      if (!rate) {
+        D += E;
+        return;
+      }
+      // ẏ's columns: d/dt cos jθ = jω (−sin jθ), d/dt (−sin jθ) = −jω cos jθ.
+      for (int j = 1; j <= K; ++j) {
+        D.col(2 * j - 1) += j * omega * E.col(2 * j);
+        D.col(2 * j) -= j * omega * E.col(2 * j - 1);
+      }
+    };
+    if (wy) add(*wy, false);
+    if (wv) add(*wv, true);
+    return D;
+  }
 
   int m() const { return 2 * K + 1; }
   int size() const { return (nj + static_cast<int>(friction.size())) * m(); }
@@ -88,7 +132,7 @@ struct Equations {
       G(0, j) = Gp(0);
       for (int k = 1; k <= K; ++k)
         G(k, j) = Complex(Gp(2 * k - 1), Gp(2 * k));
-      if (dG) (*dG)[j] = forward * (gy.asDiagonal() * dy + gv.asDiagonal() * dv);
+      if (dG) (*dG)[j] = product(&gy, &gv);
     }
     for (std::size_t f = 0; f < friction.size(); ++f) // exact friction forces, as unknowns
       G.col(friction[f].joint) += unpack(z, 1, nj + static_cast<int>(f)).col(0);
@@ -145,8 +189,8 @@ struct Equations {
       r.segment(o, m()) = fr.c * (z.segment(o, m()) - forward * p);
       if (J) {
         J->block(o, o, m(), m()) =
-            fr.c * (Eigen::MatrixXd::Identity(m(), m()) - forward * stick.asDiagonal() * dy);
-        J->block(o, oy, m(), m()) = -fr.c * fr.r * (forward * stick.asDiagonal() * dv);
+            fr.c * (Eigen::MatrixXd::Identity(m(), m()) - product(&stick, nullptr));
+        J->block(o, oy, m(), m()) = -fr.c * fr.r * product(nullptr, &stick);
       }
     }
     return r;
@@ -233,6 +277,28 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   omega_ = two_pi * frequency_hz;
   for (const auto& j : joints)
     layout_.push_back({j.node, j.node_b, j.dof});
+  // Sample tables of one joint's deformation and rate, y_n = dy z and ẏ_n = dv z, and the
+  // transform from samples to packed harmonics.
+  const int m = 2 * K_ + 1;
+  dy_.resize(Nt_, m), dv_.resize(Nt_, m), forward_.resize(m, Nt_);
+  for (int n = 0; n < Nt_; ++n) {
+    const double theta = two_pi * n / Nt_;
+    dy_(n, 0) = 1.0;
+    dv_(n, 0) = 0.0;
+    forward_(0, n) = 1.0 / Nt_;
+    for (int k = 1; k <= K_; ++k) {
+      const double c = std::cos(k * theta), s = std::sin(k * theta);
+      dy_(n, 2 * k - 1) = c, dy_(n, 2 * k) = -s;
+      dv_(n, 2 * k - 1) = -k * omega_ * s, dv_(n, 2 * k) = -k * omega_ * c;
+      forward_(2 * k - 1, n) = 2.0 * c / Nt_, forward_(2 * k, n) = -2.0 * s / Nt_;
+    }
+  }
+  cos2_.resize(Nt_, 2 * K_ + 1), sin2_.resize(Nt_, 2 * K_ + 1);
+  for (int n = 0; n < Nt_; ++n)
+    for (int p = 0; p <= 2 * K_; ++p) {
+      const double a = two_pi * (static_cast<long long>(p) * n % Nt_) / Nt_;
+      cos2_(n, p) = std::cos(a), sin2_(n, p) = std::sin(a);
+    }
   // Joint DOFs (node and node_b) and the B matrix restricted to them.
   const std::vector<int> jdofs = joints::joint_dof_set(joints, dofs);
   const Eigen::MatrixXcd B = joints::joint_coordinates_on(joints, dofs, jdofs).cast<Complex>();
@@ -258,21 +324,7 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
   if (F.cols() != nf_)
     throw std::invalid_argument("harmonic balance: " + std::to_string(F.cols()) +
                                 " force columns for " + std::to_string(nf_) + " force equations");
-  // Sample tables of one joint's deformation and rate: y_n = dy z, ẏ_n = dv z.
-  const int m = 2 * K_ + 1;
-  Eigen::MatrixXd dy(Nt_, m), dv(Nt_, m), forward(m, Nt_);
-  for (int n = 0; n < Nt_; ++n) {
-    const double theta = two_pi * n / Nt_;
-    dy(n, 0) = 1.0;
-    dv(n, 0) = 0.0;
-    forward(0, n) = 1.0 / Nt_;
-    for (int k = 1; k <= K_; ++k) {
-      const double c = std::cos(k * theta), s = std::sin(k * theta);
-      dy(n, 2 * k - 1) = c, dy(n, 2 * k) = -s;
-      dv(n, 2 * k - 1) = -k * omega_ * s, dv(n, 2 * k) = -k * omega_ * c;
-      forward(2 * k - 1, n) = 2.0 * c / Nt_, forward(2 * k, n) = -2.0 * s / Nt_;
-    }
-  }
+  const Eigen::MatrixXd &dy = dy_, &dv = dv_, &forward = forward_;
   CMatrix Fk = CMatrix::Zero(K_ + 1, nf_);
   Fk.topRows(std::min<Eigen::Index>(F.rows(), K_ + 1)) =
       F.topRows(std::min<Eigen::Index>(F.rows(), K_ + 1));
@@ -296,7 +348,7 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
     friction.push_back({j, limit, 1.0 / (omega_ * c), c});
   }
   const Equations P{K_,    nj_, Nt_, Hyy_,   HyF_F, joints, exact ? 0.0 : options_.friction_width,
-                    friction, dy, dv, forward};
+                    friction, dy, dv, forward, cos2_, sin2_, omega_};
 
   HarmonicBalanceResult out;
   out.frequency_hz = frequency_hz_;

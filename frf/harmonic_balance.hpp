@@ -74,6 +74,8 @@ private:
   int K_, nj_, nf_, Nt_;
   double omega_, frequency_hz_;
   std::vector<CMatrix> Hyy_, HyF_, HoB_, HoF_; // per harmonic
+  Eigen::MatrixXd dy_, dv_, forward_;          // AFT sample tables (see solve())
+  Eigen::MatrixXd cos2_, sin2_;                // cos, sin of p θ_n, p ≤ 2K (the Jacobian)
 };
 
 /// One steady state under F0 sin(2π f t) at `force_equation`.

@@ -177,6 +177,12 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
     f.col(static_cast<Eigen::Index>(i)) = analysed(forces[i]->samples);
   }
   m.F = fit_harmonics(span.t, f, omega, K);
+  m.F_variance.resize(K + 1, f.cols());
+  for (Eigen::Index i = 0; i < f.cols(); ++i) {
+    const double variance = noise_variance(forces[i]->samples.head(n), span, omega);
+    for (int k = 0; k <= K; ++k)
+      m.F_variance(k, i) = (k == 0 ? 1.0 : 4.0) * variance / n;
+  }
 
   const auto nr = static_cast<Eigen::Index>(best.size());
   m.X.resize(K + 1, nr);
@@ -284,6 +290,7 @@ Measurement measure_phasors(const Phasors& row, const MeasureOptions& o) {
   const auto nf = static_cast<Eigen::Index>(forces.size()),
              nr = static_cast<Eigen::Index>(responses.size());
   m.F = Eigen::MatrixXcd::Zero(K + 1, nf);
+  m.F_variance = Eigen::MatrixXd::Constant(K + 1, nf, nan);
   m.X = Eigen::MatrixXcd::Zero(K + 1, nr);
   m.X_variance = Eigen::MatrixXd::Constant(K + 1, nr, nan);
   for (Eigen::Index i = 0; i < nf; ++i)

@@ -60,6 +60,8 @@ struct Measurement {
 
   std::vector<fem::NodeDof> force_at;
   Eigen::MatrixXcd F; ///< (K+1) × forces, N or N·m
+  /// E|δF|² of every entry of F from the record's noise (N²); NaN where unknown (tables).
+  Eigen::MatrixXd F_variance;
 
   std::vector<fem::NodeDof> response_at; ///< every DOF with a x, v or a channel, in file order
   std::vector<Quantity> measured_as;     ///< per response DOF: x if measured, else v, else a

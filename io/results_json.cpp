@@ -97,6 +97,7 @@ std::string discovery_json(const discover::Result& r) {
   out["noise_gap"] = r.noise_gap >= 0.0 ? number(r.noise_gap) : Json(nullptr);
   out["simulation_gap"] = number(r.simulation_gap);
   out["at_noise_level"] = r.at_noise_level;
+  out["chi2_per_value"] = number(r.chi2_per_value);
   Json start;
   start["notes"] = r.start_notes;
   start["gap"] = number(r.states.front().gap);
