@@ -29,7 +29,8 @@
 ///  5. it predicts held-out tests better: the leave-one-test-out cross-validated gap falls.
 /// The admissible candidate with the lowest criterion is added; the loop stops when the gap is
 /// at the noise level (χ²/N within 3 standard deviations of 1), when no candidate is admissible,
-/// or after max_steps. χ² weighs each value by the variance of its noise plus that of the
+/// or after max_steps. (At the noise level: χ²/N within 3 standard deviations of 1, overall and
+/// for every compared harmonic on its own.) χ² weighs each value by the variance of its noise plus that of the
 /// simulation's own error, estimated at every step by solving the current model again with
 /// twice the harmonics (the harmonic balance of dry friction converges slowly).
 #include "frf/harmonic_balance.hpp"
@@ -163,6 +164,9 @@ struct Result {
   /// The final model's χ² per compared value (1 for a model that explains everything but the
   /// noise and its own simulation error); NaN when the noise is unknown.
   double chi2_per_value = 0.0;
+  /// The same for each compared harmonic 0 … K (NaN where none is compared); empty when the
+  /// noise is unknown.
+  std::vector<double> chi2_by_harmonic;
   Diagnosis diagnosis;
   std::string stop_reason;
   std::vector<std::string> warnings;

@@ -380,11 +380,16 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
     z = Eigen::VectorXd::Zero(P.size());
     P.pack(Y, z);
   }
-  // Friction forces to start: what the start's motion demands of them, Λ = H_yy⁻¹ (H_yf F − Y)
-  // − G_smooth, which the projection then brings within ±fc.
+  // Friction forces to start. From a given start: what its motion demands of them, Λ = H_yy⁻¹
+  // (H_yf F − Y) − G_smooth, which the projection then brings within ±fc (for a converged start,
+  // its own friction forces). From the linear start: the slip law fc sign(ẏ) — that start
+  // balances the force without friction, so it would demand Λ ≈ 0, every sample would then
+  // stick wherever r|ẏ| < fc, and with every sample stuck the mean friction force is
+  // indeterminate (a singular Jacobian: Newton fails at once, e.g. 10 N at 3 Hz on the paper's
+  // cantilever with fc = 3 N).
   if (!friction.empty()) {
     const Eigen::MatrixXcd Y = P.unpack(z, nj_), G = P.forces(z, nullptr);
-    for (int k = 0; k <= K_; ++k) {
+    for (int k = 0; k <= K_ && start; ++k) {
       const CVector need =
           Hyy_[k].fullPivLu().solve((HyF_F.row(k) - Y.row(k)).transpose()) - G.row(k).transpose();
       for (std::size_t f = 0; f < friction.size(); ++f) {
@@ -392,6 +397,13 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
         L(k, 0) = k == 0 ? Complex(need(friction[f].joint).real()) : need(friction[f].joint);
         P.pack(L, z, nj_ + static_cast<int>(f));
       }
+    }
+    for (std::size_t f = 0; f < friction.size() && !start; ++f) {
+      const Eigen::VectorXd v = dv * z.segment(friction[f].joint * (2 * K_ + 1), 2 * K_ + 1);
+      Eigen::VectorXd slip(Nt_);
+      for (int n = 0; n < Nt_; ++n)
+        slip(n) = v(n) > 0.0 ? friction[f].limit : v(n) < 0.0 ? -friction[f].limit : 0.0;
+      z.segment((nj_ + static_cast<int>(f)) * (2 * K_ + 1), 2 * K_ + 1) = forward * slip;
     }
   }
   const Eigen::VectorXd z_start = z;

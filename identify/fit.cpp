@@ -81,13 +81,17 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   const Eigen::MatrixXd Y = x2 * B, Ydot = v2 * B;
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const joints::Joint& j = joints[i];
-    const Eigen::VectorXd y = Y.col(static_cast<Eigen::Index>(i)),
-                          ydot = Ydot.col(static_cast<Eigen::Index>(i));
+    const Eigen::VectorXd y = Y.col(static_cast<Eigen::Index>(i));
+    Eigen::VectorXd ydot = Ydot.col(static_cast<Eigen::Index>(i));
+    // A rate within 1e-9 of its largest value is rest (a stuck friction joint: the integrator's
+    // rounding leaves ±1e-15 m/s there, whose sign would be noise).
+    const double vmax = ydot.cwiseAbs().maxCoeff();
+    for (Eigen::Index r = 0; r < n; ++r)
+      if (std::abs(ydot(r)) <= 1e-9 * vmax) ydot(r) = 0.0;
     if (j.term_index(joints::Term::fc) >= 0 && !m.fundamental_only) {
       // While a dry-friction joint sticks (ẏ = 0) its force lies anywhere in [−fc, fc], but the
       // basis sign(ẏ) says 0: the stuck part of the record is not described by the model.
-      const double vmax = ydot.cwiseAbs().maxCoeff();
-      const double stuck = (ydot.array().abs() <= 1e-9 * vmax).cast<double>().mean();
+      const double stuck = (ydot.array() == 0.0).cast<double>().mean();
       if (stuck > 0.002)
         warnings.push_back(
             m.source + ": joint '" + j.name + "' sticks for " + percent(stuck) +

@@ -1,5 +1,6 @@
 #include "identify/sine_tests.hpp"
 
+#include "fem/parallel.hpp"
 #include "fem/time_integration.hpp"
 
 #include <fmt/format.h>
@@ -47,8 +48,8 @@ Eigen::VectorXd periodic_derivative(const Eigen::VectorXd& x, double omega, int 
     std::complex<double> X = 0.0;
     for (Eigen::Index i = 0; i < n; ++i)
       X += x(i) * std::polar(1.0, -step * static_cast<double>(i % per));
-    const std::complex<double> D =
-        std::complex<double>(0.0, static_cast<double>(k) * omega) * X * (2.0 / static_cast<double>(n));
+    const std::complex<double> D = std::complex<double>(0.0, static_cast<double>(k) * omega) * X *
+                                   (2.0 / static_cast<double>(n));
     for (Eigen::Index i = 0; i < n; ++i)
       dx(i) += (D * std::polar(1.0, step * static_cast<double>(i % per))).real();
   }
@@ -73,8 +74,8 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
       throw std::invalid_argument(
           fmt::format("simulate: expected frequencies > 0 Hz, got {}", p.frequency_hz));
     if (!(std::isfinite(p.amplitude) && p.amplitude > 0.0))
-      throw std::invalid_argument(fmt::format(
-          "simulate: expected finite amplitudes > 0 (N or N m), got {}", p.amplitude));
+      throw std::invalid_argument(
+          fmt::format("simulate: expected finite amplitudes > 0 (N or N m), got {}", p.amplitude));
   }
   std::set<std::string> names;
   for (const auto& p : plans)
@@ -85,8 +86,8 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     throw std::invalid_argument(
         fmt::format("simulate: periods: expected at least 1, got {}", o.periods));
   if (o.steps_per_period < 8)
-    throw std::invalid_argument(fmt::format(
-        "simulate: steps per period: expected at least 8, got {}", o.steps_per_period));
+    throw std::invalid_argument(
+        fmt::format("simulate: steps per period: expected at least 8, got {}", o.steps_per_period));
   const int keep = o.samples_per_period > 0 ? o.samples_per_period : o.steps_per_period;
   if (keep < 8 || o.steps_per_period % keep != 0)
     throw std::invalid_argument(fmt::format(
@@ -158,36 +159,39 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     options.output_periods = o.periods;
     options.max_periods = std::max(options.max_periods, o.periods + 2);
     options.tolerance = o.steady_tolerance;
-    for (const auto& plan : plans) {
-      const fem::SteadyState s =
-          fem::steady_state(*sub.system(), C, &forces,
-                            {force_equation, plan.amplitude, plan.frequency_hz}, outputs, options);
-      if (s.status == fem::SteadyStateStatus::newton_failed)
-        throw std::runtime_error(
-            fmt::format("time integration at {} Hz, {} N: the joints' Newton iteration failed in "
-                        "period {}",
-                        compact(plan.frequency_hz), compact(plan.amplitude), s.periods_run));
-      SimulatedTest test = make_test(plan, s.t, s.force, s.u, s.v);
-      test.comments.push_back(fmt::format(
-          "method: time (Newmark, average acceleration, {} steps per period{})",
-          o.steps_per_period,
-          stride > 1 ? fmt::format(", every {}th step recorded", stride) : std::string()));
-      const bool converged = s.status == fem::SteadyStateStatus::converged;
-      test.comments.push_back(fmt::format(
-          "periods run: {} from rest ({}; last period-to-period change {:.3g}); the record "
-          "holds the last {}",
-          s.periods_run, converged ? "steady state reached" : "NOT periodic", s.period_change,
-          o.periods));
-      if (!converged) {
-        const std::string what =
-            fmt::format("{}: not a periodic steady state after {} periods (last period-to-period "
-                        "change {:.3g})",
-                        test.record.source, s.periods_run, s.period_change);
-        test.comments.push_back("WARNING: " + what);
-        test.warnings.push_back(what);
-      }
-      out.push_back(std::move(test));
-    }
+    std::vector<std::function<SimulatedTest()>> jobs;
+    for (const auto& plan : plans)
+      jobs.push_back([&, plan] {
+        const fem::SteadyState s = fem::steady_state(
+            *sub.system(), C, &forces, {force_equation, plan.amplitude, plan.frequency_hz}, outputs,
+            options);
+        if (s.status == fem::SteadyStateStatus::newton_failed)
+          throw std::runtime_error(
+              fmt::format("time integration at {} Hz, {} N: the joints' Newton iteration failed in "
+                          "period {}",
+                          compact(plan.frequency_hz), compact(plan.amplitude), s.periods_run));
+        SimulatedTest test = make_test(plan, s.t, s.force, s.u, s.v);
+        test.comments.push_back(fmt::format(
+            "method: time (Newmark, average acceleration, {} steps per period{})",
+            o.steps_per_period,
+            stride > 1 ? fmt::format(", every {}th step recorded", stride) : std::string()));
+        const bool converged = s.status == fem::SteadyStateStatus::converged;
+        test.comments.push_back(fmt::format(
+            "periods run: {} from rest ({}; last period-to-period change {:.3g}); the record "
+            "holds the last {}",
+            s.periods_run, converged ? "steady state reached" : "NOT periodic", s.period_change,
+            o.periods));
+        if (!converged) {
+          const std::string what =
+              fmt::format("{}: not a periodic steady state after {} periods (last period-to-period "
+                          "change {:.3g})",
+                          test.record.source, s.periods_run, s.period_change);
+          test.comments.push_back("WARNING: " + what);
+          test.warnings.push_back(what);
+        }
+        return test;
+      });
+    out = fem::parallel_map(jobs);
   } else {
     double f_max = 0.0;
     for (const auto& p : plans)

@@ -98,6 +98,10 @@ std::string discovery_json(const discover::Result& r) {
   out["simulation_gap"] = number(r.simulation_gap);
   out["at_noise_level"] = r.at_noise_level;
   out["chi2_per_value"] = number(r.chi2_per_value);
+  Json by_harmonic = Json::array();
+  for (double c : r.chi2_by_harmonic)
+    by_harmonic.push_back(number(c));
+  out["chi2_by_harmonic"] = std::move(by_harmonic);
   Json start;
   start["notes"] = r.start_notes;
   start["gap"] = number(r.states.front().gap);

@@ -10,13 +10,13 @@
 #include "fem/time_integration.hpp"
 #include "frf/receptance.hpp"
 #include "identify/fit.hpp"
+#include "identify/sine_tests.hpp"
 #include "io/model_file.hpp"
 #include "io/results_json.hpp"
 
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <future>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -134,19 +134,19 @@ private:
     out["stick_slip_diagnosis"] = nlohmann::json::parse(io::identify_result_json(r));
   }
 
-  // Step 1: the substructure — assemble, all modes, damping matrix, FRF synthesis.
+  // Step 1: the substructure — assemble, all modes, FRF synthesis.
   void setup_system() {
-    system_ = fem::assemble(file_.model);
-    modes_ = fem::modal_analysis(system_, {.num_modes = 0});
-    if (modes_.status != fem::ModalStatus::success)
-      throw std::runtime_error("modal analysis failed");
-    C_ = fem::damping_matrix(system_, file_.model.damping, &modes_);
     if (file_.joints.size() != 1)
       throw std::runtime_error("the paper study expects one joint in the model file");
-    tip_ = system_.dofs.equation({file_.joints[0].node, file_.joints[0].dof});
-    synthesis_.emplace(system_, modes_, file_.model.damping, std::vector<int>{tip_});
+    substructure_.emplace(file_.substructure());
+    const fem::Assembled& system = *substructure_->system();
+    modes_ = fem::modal_analysis(system, {.num_modes = 3});
+    if (modes_.status != fem::ModalStatus::success)
+      throw std::runtime_error("modal analysis failed");
+    tip_ = system.dofs.equation({file_.joints[0].node, file_.joints[0].dof});
+    synthesis_.emplace(substructure_->synthesis({tip_}, 0.0));
     std::printf("Substructure: %d DOFs, modes %.4f Hz, %.4f Hz, %.4f Hz (modal damping %.3g)\n",
-                system_.dofs.num_equations(), modes_.frequency_hz(0), modes_.frequency_hz(1),
+                system.dofs.num_equations(), modes_.frequency_hz(0), modes_.frequency_hz(1),
                 modes_.frequency_hz(2), file_.model.damping.modal_ratio);
   }
 
@@ -160,32 +160,19 @@ private:
 
   // Step 2: "measure" every test of a case by time integration to the periodic steady state.
   std::vector<identify::Record> measure(const PaperModel& m, const Case& c) const {
-    const joints::JointForces forces({joint_of(m)}, system_.dofs);
-    const fem::NodeDof at = system_.dofs.node_dof(tip_);
-    std::vector<std::future<identify::Record>> jobs;
+    std::vector<identify::SineTestPlan> plans;
     for (const auto& [freq, amp] : c.tests)
-      jobs.push_back(std::async(std::launch::async, [&, freq = freq, amp = amp] {
-        fem::SteadyStateOptions opt;
-        opt.steps_per_period = steps_;
-        const std::array<int, 1> outputs{tip_};
-        const fem::SteadyState s =
-            fem::steady_state(system_, C_, &forces, {tip_, amp, freq}, outputs, opt);
-        if (s.status != fem::SteadyStateStatus::converged)
-          throw std::runtime_error("no steady state at " + std::to_string(freq) + " Hz");
-        identify::Record r;
-        char name[64];
-        std::snprintf(name, sizeof name, "f%gHz_F%gN", freq, amp);
-        r.source = name;
-        r.t = s.t;
-        r.excitation_hz = freq;
-        r.channels = {{identify::Quantity::force, at, s.force},
-                      {identify::Quantity::displacement, at, s.u.col(0)},
-                      {identify::Quantity::velocity, at, s.v.col(0)}};
-        return r;
-      }));
+      plans.push_back({freq, amp});
+    identify::SimulationOptions options;
+    options.steps_per_period = steps_;
+    options.periods = 4;
+    const fem::NodeDof tip = substructure_->dofs().node_dof(tip_);
     std::vector<identify::Record> records;
-    for (auto& j : jobs)
-      records.push_back(j.get());
+    for (auto& test : identify::simulate_sine_tests(*substructure_, {joint_of(m)}, tip, plans,
+                                                    options)) {
+      if (!test.warnings.empty()) throw std::runtime_error(test.warnings.front());
+      records.push_back(std::move(test.record));
+    }
     return records;
   }
 
@@ -196,7 +183,8 @@ private:
                                             std::span<const int> cols) {
       return synthesis_->receptance(w, rows, cols);
     };
-    return identify::fit(H, system_.dofs, {joint_of(m)}, records, {.harmonics = harmonics});
+    return identify::fit(H, substructure_->dofs(), {joint_of(m)}, records,
+                         {.harmonics = harmonics});
   }
 
   // Step 4: the paper's table with our values and errors.
@@ -227,9 +215,8 @@ private:
 
   io::ModelFile file_;
   int steps_;
-  fem::Assembled system_;
+  std::optional<frf::Substructure> substructure_;
   fem::Modes modes_;
-  fem::SparseMatrix C_;
   int tip_ = 0;
   std::optional<frf::ModalSynthesis> synthesis_;
   std::map<std::string, double> worst_;

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <numbers>
 #include <vector>
 
@@ -189,4 +190,81 @@ TEST(HarmonicBalance, BadOptionsThrow) {
   o.friction_width = 0.0;
   EXPECT_THROW(frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 1.0, 3.0, outputs, o),
                std::invalid_argument);
+}
+
+namespace {
+
+// A steady state of the FE model with its joints by time integration (Newmark, exact
+// stick–slip), the last `periods` periods at the tip.
+fem::SteadyState integrate(const PaperCantilever& c, const std::vector<joints::Joint>& js,
+                           double F0, double f, int steps, int periods = 1) {
+  const fem::SparseMatrix C = fem::damping_matrix(c.system, c.model.damping, &c.modes);
+  const joints::JointForces forces(js, c.system.dofs);
+  fem::SteadyStateOptions o;
+  o.steps_per_period = steps;
+  o.output_periods = periods;
+  const std::vector<int> outputs{c.eq(7)};
+  const fem::SteadyState s = fem::steady_state(c.system, C, &forces, {c.eq(7), F0, f}, outputs, o);
+  EXPECT_EQ(s.status, fem::SteadyStateStatus::converged);
+  return s;
+}
+
+} // namespace
+
+TEST(HarmonicBalance, Explore2) {
+  const PaperCantilever c;
+  const double F0 = 80, f = 2.5, w = two_pi * f;
+  const std::vector<joints::Joint> js{make("tip", 7, 0, {Term::k, Term::c, Term::fc}, {4800, 20, 3.0})};
+  const std::vector<int> outputs{c.eq(7)};
+  const auto s = integrate(c, js, F0, f, 16384);
+  const Complex T1 = harmonic(s.u.col(0), s.t, w, 1), T0 = harmonic(s.u.col(0), s.t, w, 0), T3 = harmonic(s.u.col(0), s.t, w, 3);
+  const auto s2 = integrate(c, js, F0, f, 8192);
+  std::cout << "TI 8192 vs 16384 " << std::abs(harmonic(s2.u.col(0), s2.t, w, 1) - T1) / std::abs(T1) << " X0 " << T0 << " X3/X1 " << std::abs(T3)/std::abs(T1) << "\n";
+  for (int K : {15, 31, 63, 127})
+    for (int Nt : {0, 4096}) {
+      frf::HarmonicBalanceOptions o;
+      o.harmonics = K; o.time_samples = Nt;
+      const auto hb = frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), F0, f, outputs, o);
+      std::cout << "  K " << K << " Nt " << Nt << " conv " << hb.converged << " it " << hb.iterations << " err1 " << std::abs(hb.X(1, 0) - T1) / std::abs(T1) << " err0 " << std::abs(hb.X(0,0) - T0)/std::abs(T1) << " err3 " << std::abs(hb.X(3,0) - T3)/std::abs(T1) << "\n";
+    }
+}
+
+TEST(HarmonicBalance, Explore) {
+  const PaperCantilever c;
+  {
+    const std::vector<joints::Joint> js{make("tip", 7, 0, {Term::k, Term::c, Term::k2}, {4800, 20, 5e4})};
+    const double F0 = 40, f = 3.0, w = two_pi * f;
+    const std::vector<int> outputs{c.eq(7)};
+    const auto hb = frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), F0, f, outputs);
+    for (int steps : {1024, 2048, 4096}) {
+      const auto s = integrate(c, js, F0, f, steps);
+      std::cout << "k2 steps " << steps << " periods " << s.periods_run;
+      for (int k = 0; k <= 3; ++k) {
+        const Complex T = harmonic(s.u.col(0), s.t, w, k);
+        std::cout << " | k" << k << " |X|=" << std::abs(hb.X(k, 0)) << " rel " << std::abs(T - hb.X(k, 0)) / std::abs(hb.X(k, 0));
+      }
+      std::cout << "\n";
+    }
+  }
+  for (auto [F0, f] : {std::pair{80.0, 2.5}, std::pair{80.0, 5.0}, std::pair{10.0, 3.0}, std::pair{10.0, 2.5}}) {
+    const std::vector<joints::Joint> js{make("tip", 7, 0, {Term::k, Term::c, Term::fc}, {4800, 20, 3.0})};
+    const double w = two_pi * f;
+    const std::vector<int> outputs{c.eq(7)};
+    std::vector<Complex> T1;
+    for (int steps : {2048, 4096, 8192}) {
+      const auto s = integrate(c, js, F0, f, steps);
+      int stuck = 0;
+      const double vmax = s.v.col(0).cwiseAbs().maxCoeff();
+      for (int i = 0; i < s.v.rows(); ++i) if (std::abs(s.v(i, 0)) < 1e-9 * vmax) ++stuck;
+      T1.push_back(harmonic(s.u.col(0), s.t, w, 1));
+      std::cout << "fc F0 " << F0 << " f " << f << " steps " << steps << " periods " << s.periods_run << " stuck " << double(stuck) / s.v.rows() << " |X1| " << std::abs(T1.back()) << "\n";
+    }
+    std::cout << "  TI 2048 vs 8192 " << std::abs(T1[0] - T1[2]) / std::abs(T1[2]) << " 4096 vs 8192 " << std::abs(T1[1] - T1[2]) / std::abs(T1[2]) << "\n";
+    for (int K : {7, 15, 31, 63}) {
+      frf::HarmonicBalanceOptions o;
+      o.harmonics = K;
+      const auto hb = frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), F0, f, outputs, o);
+      std::cout << "  K " << K << " conv " << hb.converged << " it " << hb.iterations << " err1 " << std::abs(hb.X(1, 0) - T1[2]) / std::abs(T1[2]) << "\n";
+    }
+  }
 }

@@ -1,0 +1,334 @@
+// Virtual sine tests: time integration against harmonic balance (two independent methods),
+// the sampling of the records, derived acceleration, measurement noise and errors.
+#include "identify/sine_tests.hpp"
+
+#include "fem/modal.hpp"
+#include "support/cantilever.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <functional>
+#include <numbers>
+#include <string>
+
+using namespace jointid;
+using namespace jointid::identify;
+using joints::Term;
+using cd = std::complex<double>;
+
+namespace {
+
+constexpr double two_pi = 2.0 * std::numbers::pi;
+const fem::NodeDof tip{7, fem::Dof::uy};
+
+joints::Joint make_joint(std::vector<Term> terms, std::vector<double> values) {
+  joints::Joint j{"tip", 7, 0, fem::Dof::uy, std::move(terms), std::move(values), {}, {}};
+  j.fixed.assign(j.terms.size(), true);
+  return j;
+}
+
+const frf::Substructure& cantilever() {
+  static const frf::Substructure s(test::paper_cantilever());
+  return s;
+}
+
+// Harmonic k of samples over whole periods starting at t(0) (DFT; phase relative to t = 0).
+cd harmonic(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double omega, int k) {
+  cd sum = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    sum += x(i) * std::polar(1.0, -k * omega * t(i));
+  return (k == 0 ? 1.0 : 2.0) / static_cast<double>(x.size()) * sum;
+}
+
+const Channel& channel(const Record& r, Quantity q, const fem::NodeDof& at) {
+  const Channel* c = r.find(q, at);
+  if (!c) throw std::logic_error("test record lacks a channel");
+  return *c;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+} // namespace
+
+TEST(SimulateSineTests, TimeIntegrationAndHarmonicBalanceAgree) {
+  // k, c, k3 at the tip; 40 N at 3 Hz (|X3| ≈ 2 % of |X1|) and 80 N at 4.5 Hz (near the joined
+  // structure's resonance). Newmark's average-acceleration rule at 1024 steps a period has a
+  // period error (ωh)²/12 = 3.1e-6, amplified near resonance by the quality factor of the
+  // joined structure (≈ 1/(2ζ), ζ ≈ 4 % with the joint's damper: ≤ 12): ≲ 4e-5 of |X1|.
+  // Measured: 2.8e-6 and 4.1e-6. The harmonic balance's truncation at 9 harmonics and its
+  // 1e-12 residual are far below that. The third harmonic is driven by the fundamental's error
+  // through the cubic and has its own period error 9 × 3.1e-6 of |X3|: measured ≤ 4e-6 |X1|.
+  // Bound for both: 4e-5 |X1|, which also bounds the largest difference of the time signals
+  // (x, and v relative to ω|X1|).
+  const std::vector<joints::Joint> js{
+      make_joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})};
+  const std::vector<SineTestPlan> plans{{3.0, 40.0}, {4.5, 80.0}};
+  SimulationOptions o;
+  o.periods = 2;
+  o.steps_per_period = 1024;
+  o.extra_outputs = {{4, fem::Dof::uy}};
+  const auto ti = simulate_sine_tests(cantilever(), js, tip, plans, o);
+  o.method = SimulationMethod::harmonic_balance;
+  const auto hb = simulate_sine_tests(cantilever(), js, tip, plans, o);
+  ASSERT_EQ(ti.size(), 2u);
+  ASSERT_EQ(hb.size(), 2u);
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    SCOPED_TRACE(sine_test_name(plans[p]));
+    EXPECT_TRUE(ti[p].warnings.empty());
+    EXPECT_TRUE(hb[p].warnings.empty());
+    const double w = two_pi * plans[p].frequency_hz;
+    const Record &a = ti[p].record, &b = hb[p].record;
+    ASSERT_EQ(a.t.size(), 2 * 1024);
+    ASSERT_EQ(b.t.size(), 2 * 1024);
+    for (const fem::NodeDof at : {tip, fem::NodeDof{4, fem::Dof::uy}}) {
+      const Eigen::VectorXd &xa = channel(a, Quantity::displacement, at).samples,
+                            &xb = channel(b, Quantity::displacement, at).samples,
+                            &va = channel(a, Quantity::velocity, at).samples,
+                            &vb = channel(b, Quantity::velocity, at).samples;
+      const cd B1 = harmonic(xb, b.t, w, 1);
+      const double scale = std::abs(B1);
+      for (int k = 0; k <= 3; ++k)
+        EXPECT_LE(std::abs(harmonic(xa, a.t, w, k) - harmonic(xb, b.t, w, k)), 4e-5 * scale)
+            << fem::to_string(at) << " harmonic " << k;
+      EXPECT_LE((xa - xb).cwiseAbs().maxCoeff(), 4e-5 * scale) << fem::to_string(at);
+      EXPECT_LE((va - vb).cwiseAbs().maxCoeff(), 4e-5 * w * scale) << fem::to_string(at);
+    }
+    // Genuinely non-linear: the third harmonic (0.4 % and 2 % of |X1|) is 50 times the bound.
+    const Eigen::VectorXd& x = channel(b, Quantity::displacement, tip).samples;
+    EXPECT_GT(std::abs(harmonic(x, b.t, w, 3)), 50 * 4e-5 * std::abs(harmonic(x, b.t, w, 1)));
+    // The force is F0 sin ωt in both.
+    for (const Record* r : {&a, &b}) {
+      const Eigen::VectorXd& f = channel(*r, Quantity::force, tip).samples;
+      for (Eigen::Index i = 0; i < f.size(); i += 37)
+        EXPECT_NEAR(f(i), plans[p].amplitude * std::sin(w * r->t(i)), 1e-9 * plans[p].amplitude);
+    }
+  }
+}
+
+TEST(SimulateSineTests, RecordLayout) {
+  // Channels: the force, then every output (joint DOFs, the force DOF, the extra ones, each
+  // once) with the quantities asked, in that order.
+  const std::vector<joints::Joint> js{make_joint({Term::k, Term::c}, {4800.0, 20.0})};
+  SimulationOptions o;
+  o.method = SimulationMethod::harmonic_balance;
+  o.periods = 3;
+  o.steps_per_period = 64;
+  o.quantities = {Quantity::velocity, Quantity::displacement};
+  o.extra_outputs = {{3, fem::Dof::uy}, tip};
+  const auto tests = simulate_sine_tests(cantilever(), js, tip, {{3.4, 80.0}}, o);
+  ASSERT_EQ(tests.size(), 1u);
+  const Record& r = tests[0].record;
+  EXPECT_EQ(r.source, "sine_f3.4Hz_F80N.csv");
+  ASSERT_TRUE(r.excitation_hz);
+  EXPECT_EQ(*r.excitation_hz, 3.4);
+  EXPECT_EQ(tests[0].plan.amplitude, 80.0);
+  std::vector<std::string> names;
+  for (const auto& c : r.channels)
+    names.push_back(c.name());
+  EXPECT_EQ(names, (std::vector<std::string>{"f@7:uy", "v@7:uy", "x@7:uy", "v@3:uy", "x@3:uy"}));
+  EXPECT_EQ(r.t.size(), 3 * 64);
+  EXPECT_FALSE(tests[0].comments.empty());
+}
+
+TEST(SimulateSineTests, SamplesPerPeriodKeepsEveryNthStep) {
+  const std::vector<joints::Joint> js{
+      make_joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})};
+  const SineTestPlan plan{3.0, 40.0};
+  SimulationOptions o;
+  o.periods = 3;
+  o.steps_per_period = 1024;
+  for (SimulationMethod method :
+       {SimulationMethod::time_integration, SimulationMethod::harmonic_balance}) {
+    o.method = method;
+    o.samples_per_period = 0;
+    const Record all = simulate_sine_tests(cantilever(), js, tip, {plan}, o)[0].record;
+    o.samples_per_period = 128;
+    const Record kept = simulate_sine_tests(cantilever(), js, tip, {plan}, o)[0].record;
+    ASSERT_EQ(all.t.size(), 3 * 1024);
+    ASSERT_EQ(kept.t.size(), 3 * 128);
+    // Spacing: 8 steps, i.e. a period over 128 samples (rounding of t only).
+    EXPECT_NEAR(kept.dt(), 1.0 / (plan.frequency_hz * 128), 1e-12 * kept.dt());
+    ASSERT_EQ(kept.channels.size(), all.channels.size());
+    // The same run, so the kept samples are the steps themselves, bit for bit.
+    for (Eigen::Index i = 0; i < kept.t.size(); ++i) {
+      ASSERT_EQ(kept.t(i), all.t(8 * i)) << i;
+      for (std::size_t c = 0; c < kept.channels.size(); ++c)
+        ASSERT_EQ(kept.channels[c].samples(i), all.channels[c].samples(8 * i))
+            << kept.channels[c].name() << " sample " << i;
+    }
+  }
+}
+
+TEST(SimulateSineTests, AccelerationIsTheDerivativeOfTheVelocity) {
+  // Harmonic balance with 9 harmonics, 64 samples a period: the sampled velocity holds
+  // harmonics ≤ 9 < 32 (no aliasing), so its derivative from its harmonics is exact up to
+  // rounding (≈ 1e-15 of max|a|); compared with Re Σ −(kω)² X_k e^{ikωt} from a separate
+  // harmonic-balance solve (residual 1e-12): 1e-9 of max|a|.
+  const std::vector<joints::Joint> js{
+      make_joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})};
+  const SineTestPlan plan{3.0, 60.0};
+  const double w = two_pi * plan.frequency_hz;
+  SimulationOptions o;
+  o.method = SimulationMethod::harmonic_balance;
+  o.periods = 2;
+  o.steps_per_period = 64;
+  o.quantities = {Quantity::displacement, Quantity::velocity, Quantity::acceleration};
+  const Record r = simulate_sine_tests(cantilever(), js, tip, {plan}, o)[0].record;
+  const Eigen::VectorXd& a = channel(r, Quantity::acceleration, tip).samples;
+
+  const int eq = cantilever().dofs().equation(tip);
+  const std::vector<int> outputs{eq};
+  const frf::ModalSynthesis H = cantilever().synthesis(outputs, 100.0);
+  const frf::HarmonicBalanceResult hb =
+      frf::harmonic_balance(H, js, cantilever().dofs(), eq, plan.amplitude, plan.frequency_hz,
+                            outputs, o.balance);
+  ASSERT_TRUE(hb.converged);
+  Eigen::VectorXd expected(r.t.size());
+  for (Eigen::Index i = 0; i < r.t.size(); ++i) {
+    expected(i) = 0.0;
+    for (int k = 1; k < hb.X.rows(); ++k)
+      expected(i) += (-(k * w) * (k * w) * hb.X(k, 0) * std::polar(1.0, k * w * r.t(i))).real();
+  }
+  const double scale = expected.cwiseAbs().maxCoeff();
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LE((a - expected).cwiseAbs().maxCoeff(), 1e-9 * scale);
+  // Not merely −ω² x: the third harmonic (9 ω² weight) makes a visible difference.
+  const Eigen::VectorXd& x = channel(r, Quantity::displacement, tip).samples;
+  EXPECT_GT((a + w * w * x).cwiseAbs().maxCoeff(), 1e-2 * scale);
+}
+
+TEST(SimulateSineTests, AddNoiseHasTheAskedLevelAndIsReproducible) {
+  const std::vector<joints::Joint> js{
+      make_joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})};
+  SimulationOptions o;
+  o.method = SimulationMethod::harmonic_balance;
+  o.periods = 8;
+  o.steps_per_period = 256;
+  const Record clean = simulate_sine_tests(cantilever(), js, tip, {{3.0, 40.0}}, o)[0].record;
+  const double level = 0.02;
+  const Eigen::Index n = clean.t.size();
+  ASSERT_EQ(n, 2048);
+
+  Record noisy = clean;
+  add_noise(noisy, level, 11);
+  // Per channel: the added noise's RMS over n = 2048 samples estimates level × RMS(channel)
+  // with a relative standard deviation 1/√(2n) = 1.6 %: 4.5 of them, 7 %. Its mean is within
+  // 4.5 σ/√n of 0.
+  for (std::size_t c = 0; c < clean.channels.size(); ++c) {
+    const Eigen::VectorXd& s = clean.channels[c].samples;
+    const double rms = std::sqrt((s.array() - s.mean()).square().mean());
+    const Eigen::VectorXd added = noisy.channels[c].samples - s;
+    const double sigma = level * rms;
+    EXPECT_NEAR(std::sqrt(added.squaredNorm() / n) / sigma, 1.0, 0.07) << clean.channels[c].name();
+    EXPECT_LE(std::abs(added.mean()), 4.5 * sigma / std::sqrt(n)) << clean.channels[c].name();
+  }
+  EXPECT_EQ(noisy.t, clean.t);
+  // Channels get independent noise: the correlation of two channels' noise is ≈ N(0, 1/n);
+  // 4.5/√n = 0.1.
+  const Eigen::VectorXd n0 = noisy.channels[1].samples - clean.channels[1].samples,
+                        n1 = noisy.channels[2].samples - clean.channels[2].samples;
+  EXPECT_LT(std::abs(n0.dot(n1)) / (n0.norm() * n1.norm()), 0.1);
+
+  Record again = clean;
+  add_noise(again, level, 11);
+  Record other = clean;
+  add_noise(other, level, 12);
+  for (std::size_t c = 0; c < clean.channels.size(); ++c) {
+    EXPECT_EQ(again.channels[c].samples, noisy.channels[c].samples); // bit for bit
+    EXPECT_NE(other.channels[c].samples, noisy.channels[c].samples);
+  }
+  Record quiet_force = clean;
+  add_noise(quiet_force, level, 11, false);
+  ASSERT_EQ(quiet_force.channels[0].quantity, Quantity::force);
+  EXPECT_EQ(quiet_force.channels[0].samples, clean.channels[0].samples);
+  for (std::size_t c = 1; c < clean.channels.size(); ++c)
+    EXPECT_NE(quiet_force.channels[c].samples, clean.channels[c].samples);
+  Record none = clean;
+  add_noise(none, 0.0, 11);
+  for (std::size_t c = 0; c < clean.channels.size(); ++c)
+    EXPECT_EQ(none.channels[c].samples, clean.channels[c].samples);
+  EXPECT_THROW(add_noise(none, -0.01, 1), std::invalid_argument);
+  EXPECT_THROW(add_noise(none, std::nan(""), 1), std::invalid_argument);
+}
+
+TEST(SimulateSineTests, ModalSubstructureNeedsHarmonicBalance) {
+  // The cantilever given by all its modes at the tip (1 % damping, mass-normalised shapes):
+  // its receptance there equals the FE model's, so harmonic balance gives the same record
+  // (1e-9 of |X1|: both converge to a 1e-12 residual), while time integration is refused.
+  const fem::Model model = test::paper_cantilever();
+  const fem::Assembled system = fem::assemble(model);
+  const fem::Modes modes =
+      fem::modal_analysis(system, {.num_modes = 0, .engine = fem::ModalEngine::dense});
+  frf::ModalModel modal;
+  modal.dofs = {tip};
+  modal.frequencies_hz = modes.omega / two_pi;
+  modal.damping = Eigen::VectorXd::Constant(modes.num_modes(), 0.01);
+  modal.shapes = modes.phi.row(system.dofs.equation(tip)).transpose();
+  const frf::Substructure sub(modal);
+
+  const std::vector<joints::Joint> js{
+      make_joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})};
+  SimulationOptions o;
+  o.periods = 1;
+  o.steps_per_period = 64;
+  const std::string e =
+      error_of([&] { simulate_sine_tests(sub, js, tip, {{3.0, 40.0}}, o); });
+  EXPECT_NE(e.find("finite element model"), std::string::npos) << e;
+  EXPECT_NE(e.find("harmonic balance"), std::string::npos) << e;
+
+  o.method = SimulationMethod::harmonic_balance;
+  const Record a = simulate_sine_tests(sub, js, tip, {{3.0, 40.0}}, o)[0].record;
+  const Record b = simulate_sine_tests(cantilever(), js, tip, {{3.0, 40.0}}, o)[0].record;
+  const Eigen::VectorXd &xa = channel(a, Quantity::displacement, tip).samples,
+                        &xb = channel(b, Quantity::displacement, tip).samples;
+  EXPECT_LE((xa - xb).cwiseAbs().maxCoeff(), 1e-9 * xb.cwiseAbs().maxCoeff());
+}
+
+TEST(SimulateSineTests, BadPlansAndOptionsAreRefused) {
+  const std::vector<joints::Joint> js{make_joint({Term::k, Term::c}, {4800.0, 20.0})};
+  SimulationOptions o;
+  o.method = SimulationMethod::harmonic_balance;
+  o.steps_per_period = 1024;
+  auto run = [&](const std::vector<SineTestPlan>& plans) {
+    return error_of([&] { simulate_sine_tests(cantilever(), js, tip, plans, o); });
+  };
+  std::string e = run({{3.0, 80.0}, {4.0, 80.0}, {3.0, 80.0}});
+  EXPECT_NE(e.find("listed twice"), std::string::npos) << e;
+  EXPECT_NE(e.find("3 Hz"), std::string::npos) << e;
+  e = run({{0.0, 80.0}});
+  EXPECT_NE(e.find("frequencies > 0"), std::string::npos) << e;
+  e = run({{3.0, -1.0}});
+  EXPECT_NE(e.find("amplitudes > 0"), std::string::npos) << e;
+  EXPECT_NE(run({}), "");
+  o.samples_per_period = 100; // does not divide 1024
+  e = run({{3.0, 80.0}});
+  EXPECT_NE(e.find("divisor of the 1024 steps"), std::string::npos) << e;
+  EXPECT_NE(e.find("got 100"), std::string::npos) << e;
+  o.samples_per_period = 4; // divides, but too few
+  EXPECT_NE(run({{3.0, 80.0}}), "");
+  o.samples_per_period = 0;
+  o.quantities = {Quantity::force};
+  EXPECT_NE(run({{3.0, 80.0}}), "");
+  o.quantities = {};
+  EXPECT_NE(run({{3.0, 80.0}}), "");
+  o.quantities = {Quantity::displacement};
+  EXPECT_THROW(simulate_sine_tests(cantilever(), js, {9, fem::Dof::uy}, {{3.0, 80.0}}, o),
+               std::invalid_argument);
+  o.periods = 0;
+  EXPECT_NE(run({{3.0, 80.0}}), "");
+}
+
+TEST(SimulateSineTests, TestNamesUseTheShortestExactNumbers) {
+  EXPECT_EQ(sine_test_name({3.4, 80.0}), "sine_f3.4Hz_F80N.csv");
+  EXPECT_EQ(sine_test_name({0.1 + 0.2, 12.5}), "sine_f0.30000000000000004Hz_F12.5N.csv");
+  EXPECT_NE(sine_test_name({3.0, 80.0}), sine_test_name({3.0000000000000004, 80.0}));
+}
