@@ -181,8 +181,13 @@ public:
     if (fitted) {
       start_fit = identify(joints, simulator(1.0), all_tests());
       joints = start_fit.identified(joints);
+    }
+    state = evaluate(joints, simulator(1.0));
+    state.fit = start_fit;
+    if (fitted) {
+      state = refine(state, simulator(1.0));
       std::string values;
-      for (const auto& je : start_fit.joints)
+      for (const auto& je : state.fit.joints)
         for (const auto& te : je.terms)
           if (!te.fixed)
             values += fmt::format("{}{} of '{}' = {} {}", values.empty() ? "" : ", ",
@@ -190,15 +195,12 @@ public:
                                   joints::term_unit(te.term));
       out.start_notes.push_back(fmt::format(
           "No value was given for {}: the starting terms were identified from all {} tests "
-          "(harmonics {}): {}.",
+          "(equation error with harmonics {}, then output error): {}.",
           join(missing), tests_.size(), join_harmonics(), values));
     } else {
       out.start_notes.push_back("Every starting term has a value in the model file; those values "
                                 "are the starting model.");
     }
-    state = evaluate(joints, simulator(1.0));
-    state.fit = start_fit;
-    if (fitted) state = refine(state, simulator(1.0));
     if (!state.converged)
       out.warnings.push_back("the harmonic balance did not converge for every test with the "
                              "starting model");
@@ -1177,7 +1179,8 @@ private:
     // Which channel disagrees most.
     std::map<std::string, std::pair<double, double>> per_channel; // error², measured²
     double even = 0.0, even_noise = 0.0;
-    std::string even_where;
+    std::string even_where, even_test;
+    std::set<int> even_tests; // tests with a second harmonic 5 × beyond the noise
     for (const auto& e : entries_) {
       const auto& m = tests_[e.test];
       const std::string ch = std::string(1, identify::quantity_letter(m.measured_as[e.response])) +
@@ -1192,7 +1195,8 @@ private:
         const double ratio = std::abs(err) / std::max(x1, 1e-300);
         const double noise = e.variance > 0.0 ? std::sqrt(e.variance) / std::max(x1, 1e-300) : 0.0;
         if (ratio - 3.0 * noise > even - 3.0 * even_noise)
-          even = ratio, even_noise = noise, even_where = ch;
+          even = ratio, even_noise = noise, even_where = ch, even_test = m.source;
+        if (ratio > 5.0 * noise && (noise > 0.0 || ratio > 1e-3)) even_tests.insert(e.test);
       }
     }
     for (const auto& [ch, v] : per_channel) {
@@ -1311,13 +1315,31 @@ private:
             cons_c ? "(" + cons_c->name() + ") " + pct(cons) : std::string("none")));
       }
     }
-    if (d.even_harmonics)
-      d.findings.push_back(fmt::format(
+    if (d.even_harmonics) {
+      // An asymmetric joint force (k2) makes even harmonics in every test that moves it; a
+      // symmetric system's response can also lose its symmetry in a few tests (a bifurcation).
+      double k2_share = 0.0;
+      for (const auto& c : ranking)
+        if (c.term == joints::Term::k2 && std::isfinite(c.explained))
+          k2_share = std::max(k2_share, c.explained);
+      const std::string seen = fmt::format(
           "Even harmonics: the measured response at {} holds a second harmonic of {} of its "
-          "fundamental that the model does not produce{}: an asymmetric force (k2).",
-          even_where, pct(even),
-          noise_known_ ? fmt::format(" (noise {})", pct(even_noise)) : std::string()));
-    else if (any_harmonics)
+          "fundamental in {}{} that the model does not produce{}",
+          even_where, pct(even), even_test,
+          even_tests.size() > 1 ? fmt::format(" (and {} other tests)", even_tests.size() - 1)
+                                : std::string(),
+          noise_known_ ? fmt::format(" (noise {})", pct(even_noise)) : std::string());
+      d.asymmetric = k2_share >= 0.5 || even_tests.size() * 2 > tests_.size();
+      if (d.asymmetric)
+        d.findings.push_back(seen + fmt::format(": an asymmetric force (k2 explains {}).",
+                                                pct(std::max(k2_share, 0.0))));
+      else
+        d.findings.push_back(
+            seen + fmt::format(": confined to {} of {} tests, it is not what an asymmetric joint "
+                               "force would give (k2 explains {}); a symmetric system's response "
+                               "can lose its symmetry at some frequencies and levels.",
+                               even_tests.size(), tests_.size(), pct(std::max(k2_share, 0.0))));
+    } else if (any_harmonics)
       d.findings.push_back("No even harmonics beyond the noise: the missing force is symmetric.");
     else
       d.findings.push_back("The tables give the fundamental only: harmonics cannot be judged.");

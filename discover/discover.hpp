@@ -145,6 +145,9 @@ struct Diagnosis {
   double conservative_explains = 0.0, dissipative_explains = 0.0;
   bool even_harmonics = false;     ///< an unexplained 2nd harmonic, 5 × above the noise
   double even_content = 0.0;       ///< largest |X_meas − X_sim| at k = 2 over |X_1|
+  /// The even harmonics point to an asymmetric joint force: k2 explains half the gap or more,
+  /// or they appear in most tests (not in a few, as a symmetric system's lost symmetry would).
+  bool asymmetric = false;
   std::vector<std::string> findings; ///< the diagnosis as sentences
 };
 

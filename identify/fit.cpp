@@ -276,6 +276,16 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     warnings.push_back(std::to_string(tables) +
                        " test(s) from stepped-sine tables give harmonic 1 only; their other "
                        "harmonics were not used");
+  bool nonlinear = false;
+  for (const auto& j : joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t)
+      nonlinear = nonlinear || (!joints::is_linear(j.terms[t]) && !j.fixed[t]);
+  if (tables > 0 && nonlinear)
+    warnings.push_back(
+        "stepped-sine tables give the fundamental only: the joints' basis functions are "
+        "evaluated on the fundamental's sinusoid (a describing function), which neglects the "
+        "response's own higher harmonics; non-linear terms may be biased by about their share "
+        "(jointid discover identifies them by output error through the harmonic balance)");
   return fit(H, dofs, joints, tests, o, std::move(warnings));
 }
 

@@ -151,7 +151,7 @@ std::string model_text(const discover::State& s) {
 
 std::string short_name(const discover::Candidate& c) {
   if (c.refit) return "refit";
-  if (!c.term) return "damping x";
+  if (!c.term) return "damping scale";
   return fmt::format("{}@{}", joints::term_name(*c.term), c.joint);
 }
 
@@ -285,32 +285,47 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
 
   // The candidates of every step.
   md += "## Candidates\n\n";
-  md += "Share of the squared gap each candidate explains when added (all non-fixed terms "
-        "identified again, every test re-simulated); a candidate may be added only if it is "
-        "admissible and lowers the information criterion and the cross-validated gap.\n\n";
-  std::vector<std::pair<std::string, const std::vector<discover::Candidate>*>> rankings;
+  md += "The gap after adding each candidate (every non-fixed term identified again, every test "
+        "re-simulated; equation-error estimates, the best few refined by output error), best first "
+        "by the information criterion; the dashed line is the gap before the step. A candidate may be added only if it is admissible, lowers the "
+        "information criterion, explains at least 5 % of the squared gap and lowers the "
+        "cross-validated gap. Candidates that could not be simulated (e.g. negative friction) "
+        "are in the table only.\n\n";
+  struct Ranking {
+    std::string title;
+    const std::vector<discover::Candidate>* candidates;
+    double gap_now;
+  };
+  std::vector<Ranking> rankings;
   for (std::size_t i = 0; i < r.steps.size(); ++i)
     rankings.push_back({fmt::format("Step {} (added {})", i + 1, r.steps[i].added.name()),
-                        &r.steps[i].ranking});
+                        &r.steps[i].ranking, r.steps[i].gap_before});
   if (!r.last_ranking.empty())
     rankings.push_back({fmt::format("Step {} (nothing added)", r.steps.size() + 1),
-                        &r.last_ranking});
+                        &r.last_ranking, r.gap.back()});
   for (std::size_t i = 0; i < rankings.size(); ++i) {
-    const auto& [title, ranking] = rankings[i];
+    const auto& [title, ranking, gap_now] = rankings[i];
     Chart c;
-    c.title = title;
-    c.y_label = "share of the gap explained (%)";
-    c.legend = false;
-    Series bars;
+    c.title = title + ": the gap after adding each candidate";
+    c.y_label = "gap";
+    c.log_y = true;
+    Series bars, now;
     bars.style = Series::Style::bars;
+    bars.label = "with the candidate";
+    now.style = Series::Style::dashed;
+    now.label = fmt::format("now ({})", g4(gap_now));
+    now.color = {214, 39, 40};
     for (const auto& cand : *ranking) {
-      if (!std::isfinite(cand.explained)) continue;
+      if (!std::isfinite(cand.gap) || !(cand.gap > 0.0)) continue;
       c.x_categories.push_back(short_name(cand));
       bars.x.push_back(static_cast<double>(c.x_categories.size()));
-      bars.y.push_back(100.0 * std::max(0.0, cand.explained));
+      bars.y.push_back(cand.gap);
     }
-    if (!bars.x.empty()) {
+    if (!bars.x.empty() && gap_now > 0.0) {
+      now.x = {0.5, static_cast<double>(c.x_categories.size()) + 0.5};
+      now.y = {gap_now, gap_now};
       c.series.push_back(bars);
+      c.series.push_back(now);
       md += "### " + title + "\n\n" + plot(fmt::format("candidates_{}.png", i + 1),
                                            Figure{1200, 500, 1, {c}});
     }

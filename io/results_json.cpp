@@ -143,6 +143,7 @@ std::string discovery_json(const discover::Result& r) {
   diag["dissipative_explains"] = number(d.dissipative_explains);
   diag["even_harmonics"] = d.even_harmonics;
   diag["even_content"] = number(d.even_content);
+  diag["asymmetric"] = d.asymmetric;
   diag["findings"] = d.findings;
   out["diagnosis"] = std::move(diag);
   Json model;

@@ -4,5 +4,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-bash scripts/build.sh
+# Explicit: another script may have left the options off in the cache.
+bash scripts/build.sh -DJOINTID_BUILD_TESTS=ON -DJOINTID_BUILD_BENCH=ON
 ctest --test-dir build --output-on-failure -j "$(nproc)"
