@@ -5,6 +5,7 @@
 #include "fem/time_integration.hpp"
 #include "frf/receptance.hpp"
 #include "identify/fit.hpp"
+#include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
 
 #include <benchmark/benchmark.h>
@@ -35,17 +36,12 @@ const Setup& setup() {
 }
 
 identify::Record record(const Setup& s, double f) {
-  const joints::JointForces forces({s.joint}, s.system.dofs);
-  const std::array<int, 1> out{s.tip};
-  const fem::SteadyState ss = fem::steady_state(s.system, s.C, &forces, {s.tip, 80.0, f}, out);
-  identify::Record r;
-  r.source = "bench";
-  r.t = ss.t;
-  r.excitation_hz = f;
-  r.channels = {{identify::Quantity::force, {7, fem::Dof::uy}, ss.force},
-                {identify::Quantity::displacement, {7, fem::Dof::uy}, ss.u.col(0)},
-                {identify::Quantity::velocity, {7, fem::Dof::uy}, ss.v.col(0)}};
-  return r;
+  identify::SimulationOptions o;
+  o.periods = 4;
+  return identify::simulate_sine_tests(frf::Substructure(s.model), {s.joint}, {7, fem::Dof::uy},
+                                       {{f, 80.0}}, o)
+      .front()
+      .record;
 }
 
 void BM_Assembly(benchmark::State& state) {

@@ -60,8 +60,7 @@ void check_output_file(const fs::path& file) {
 }
 
 void check_harmonics(const std::vector<int>& harmonics, int lowest) {
-  if (harmonics.empty())
-    throw io::Error("--harmonics: expected at least one harmonic, e.g. 1,2,3");
+  if (harmonics.empty()) throw io::Error("--harmonics: expected at least one harmonic, e.g. 1,2,3");
   std::set<int> seen;
   for (int k : harmonics) {
     if (k < lowest || k > 50)
@@ -97,8 +96,8 @@ identify::Quantity parse_quantity(const std::string& text) {
 // with the test they come from.
 frf::ModalSynthesis synthesis_for(const frf::Substructure& sub,
                                   const std::vector<joints::Joint>& joints,
-                                  const std::vector<identify::Measurement>& tests,
-                                  double f_max_hz, std::vector<std::string>& notes) {
+                                  const std::vector<identify::Measurement>& tests, double f_max_hz,
+                                  std::vector<std::string>& notes) {
   std::vector<int> dofs = joints::joint_dof_set(joints, sub.dofs());
   auto add = [&](const fem::NodeDof& at) {
     if (sub.dofs().state(at) != fem::DofMap::State::free) return;
@@ -165,8 +164,8 @@ void simulate(const SimulateOptions& o) {
     for (double a : o.amplitudes) {
       plans.push_back({f, a});
       if (!names.insert(identify::sine_test_name(plans.back())).second)
-        throw io::Error(fmt::format("--freq, --amplitude: the test at {} Hz, {} N is listed twice",
-                                    f, a));
+        throw io::Error(
+            fmt::format("--freq, --amplitude: the test at {} Hz, {} N is listed twice", f, a));
     }
   options.method = o.method == "time" ? identify::SimulationMethod::time_integration
                                       : identify::SimulationMethod::harmonic_balance;
@@ -198,38 +197,15 @@ void simulate(const SimulateOptions& o) {
   // 4. Write.
   std::vector<std::pair<fs::path, std::string>> outputs;
   if (o.table) {
-    io::SteppedSineTable table;
     std::vector<std::string> comments{"jointid simulate", "model: " + o.model.string(),
                                       "one sine test a row: fundamentals of the records"};
-    if (!tests.empty())
-      for (std::size_t c = 3; c < tests.front().comments.size(); ++c)
-        if (tests.front().comments[c].rfind("joint ", 0) == 0 ||
-            tests.front().comments[c].rfind("method", 0) == 0 ||
-            tests.front().comments[c].rfind("noise", 0) == 0)
-          comments.push_back(tests.front().comments[c]);
-    table.values.resize(static_cast<Eigen::Index>(tests.size()),
-                        static_cast<Eigen::Index>(tests.front().record.channels.size()));
-    for (const auto& c : tests.front().record.channels)
-      table.channels.push_back(c.name());
-    for (std::size_t i = 0; i < tests.size(); ++i) {
-      const identify::Record& r = tests[i].record;
-      const identify::Measurement m = identify::measure(r, {.harmonics = 1});
-      table.freq_hz.push_back(m.frequency_hz);
-      const double omega = 2.0 * std::numbers::pi * m.frequency_hz;
-      for (std::size_t c = 0; c < r.channels.size(); ++c) {
-        const auto& ch = r.channels[c];
-        std::complex<double> value;
-        if (ch.quantity == identify::Quantity::force) {
-          value = m.F(1, m.force_index(ch.at));
-        } else {
-          const int power = ch.quantity == identify::Quantity::displacement ? 0
-                            : ch.quantity == identify::Quantity::velocity   ? 1
-                                                                            : 2;
-          value = m.X(1, m.response_index(ch.at)) * std::pow(std::complex<double>(0.0, omega), power);
-        }
-        table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) = value;
-      }
-    }
+    for (const auto& c : tests.front().comments) // how they were made, as in the records
+      if (c.rfind("joint ", 0) == 0 || c.rfind("method", 0) == 0 || c.rfind("noise", 0) == 0)
+        comments.push_back(c);
+    std::vector<identify::Record> records;
+    for (const auto& t : tests)
+      records.push_back(t.record);
+    const io::SteppedSineTable table = io::stepped_sine_table(records);
     outputs.push_back({o.output_dir / "stepped_sine.csv", io::stepped_sine_csv(table, comments)});
   } else {
     for (const auto& t : tests)
@@ -266,8 +242,7 @@ void identify(const IdentifyOptions& o) {
                                                 std::span<const int> cols) {
     return synthesis.receptance(omega, rows, cols);
   };
-  const identify::FitResult result =
-      identify::fit(H, sub.dofs(), file.joints, measured, options);
+  const identify::FitResult result = identify::fit(H, sub.dofs(), file.joints, measured, options);
 
   io::write_json(o.output, io::identify_result_json(result, notes));
 
@@ -321,8 +296,7 @@ void discover(const DiscoverOptions& o) {
   if (file.joints.empty())
     throw io::Error(o.model.string() + ": no [[joints]]: discovery starts from the joints' terms");
   const std::vector<identify::SineTest> tests = io::read_tests(o.records);
-  const std::vector<identify::Measurement> measured =
-      identify::measure(tests, {.harmonics = K});
+  const std::vector<identify::Measurement> measured = identify::measure(tests, {.harmonics = K});
   const frf::Substructure sub = file.substructure();
   const discover::Result result = discover::discover(sub, file.joints, measured, options);
 

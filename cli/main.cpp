@@ -114,8 +114,7 @@ int main(int argc, char** argv) {
   auto* identify = app.add_subcommand(
       "identify", "Identify the joints' terms from measured records; writes JSON");
   identify->add_option("MODEL", ident.model, "Model file (TOML)")->required();
-  identify
-      ->add_option("TESTS", ident.records, "Measurement records or stepped-sine tables (CSV)")
+  identify->add_option("TESTS", ident.records, "Measurement records or stepped-sine tables (CSV)")
       ->required();
   identify->add_option("-o,--output", ident.output, "Result file (JSON)")->required();
   identify
@@ -130,8 +129,7 @@ int main(int argc, char** argv) {
                   "effect, add it and show the gap shrink; writes DIR/discovery.json and "
                   "DIR/report.md with plots");
   discover->add_option("MODEL", disc.model, "Model file (TOML): the starting model")->required();
-  discover
-      ->add_option("TESTS", disc.records, "Measurement records or stepped-sine tables (CSV)")
+  discover->add_option("TESTS", disc.records, "Measurement records or stepped-sine tables (CSV)")
       ->required();
   discover->add_option("-o,--output", disc.output_dir, "Output directory (created if missing)")
       ->required();

@@ -30,9 +30,9 @@
 /// The admissible candidate with the lowest criterion is added; the loop stops when the gap is
 /// at the noise level (χ²/N within 3 standard deviations of 1), when no candidate is admissible,
 /// or after max_steps. (At the noise level: χ²/N within 3 standard deviations of 1, overall and
-/// for every compared harmonic on its own.) χ² weighs each value by the variance of its noise plus that of the
-/// simulation's own error, estimated at every step by solving the current model again with
-/// twice the harmonics (the harmonic balance of dry friction converges slowly).
+/// for every compared harmonic on its own.) χ² weighs each value by the variance of its noise plus
+/// that of the simulation's own error, estimated at every step by solving the current model again
+/// with twice the harmonics (the harmonic balance of dry friction converges slowly).
 #include "frf/harmonic_balance.hpp"
 #include "frf/substructure.hpp"
 #include "identify/fit.hpp"
@@ -91,7 +91,7 @@ struct State {
   double damping_scale = 1.0; ///< on the substructure's damping
   int parameters = 0;         ///< identified coefficients (and the damping scale)
   double gap = 0.0;
-  double chi2 = 0.0;          ///< Σ |e|² / (E|δX|²/2) when the noise is known, else NaN
+  double chi2 = 0.0; ///< Σ |e|² / (E|δX|²/2) when the noise is known, else NaN
   double criterion = 0.0;
   bool converged = true;
   std::vector<Eigen::MatrixXcd> X; ///< per test: simulated harmonics 0 … K at its responses
@@ -112,9 +112,9 @@ struct Comparison {
   std::string test, channel;
   double frequency_hz = 0.0, force = 0.0;
   std::complex<double> measured, simulated; ///< X_1, m or rad
-  double amplitude_error = 0.0;            ///< |X_sim| / |X_meas| − 1
-  double phase_error_deg = 0.0;            ///< arg(X_sim / X_meas)
-  double harmonics_measured = 0.0;         ///< sqrt(Σ_{k≥2} |X_k|²) / |X_1|, measured
+  double amplitude_error = 0.0;             ///< |X_sim| / |X_meas| − 1
+  double phase_error_deg = 0.0;             ///< arg(X_sim / X_meas)
+  double harmonics_measured = 0.0;          ///< sqrt(Σ_{k≥2} |X_k|²) / |X_1|, measured
   double harmonics_simulated = 0.0;
 };
 
@@ -124,10 +124,10 @@ struct Comparison {
 /// down as well where that finds another branch (a jump: hardening or softening joints).
 struct ResponseCurve {
   bool over_frequency = true;
-  bool descending = false;   ///< swept down (kept only where it differs from the sweep up)
-  double level = 0.0;        ///< force amplitude of the sweep over frequency (N or N·m)
-  double frequency_hz = 0.0; ///< frequency of the sweep over level
-  std::vector<double> x;     ///< frequencies (Hz) or force levels
+  bool descending = false;           ///< swept down (kept only where it differs from the sweep up)
+  double level = 0.0;                ///< force amplitude of the sweep over frequency (N or N·m)
+  double frequency_hz = 0.0;         ///< frequency of the sweep over level
+  std::vector<double> x;             ///< frequencies (Hz) or force levels
   std::vector<std::string> channels; ///< as the comparisons name them ("x@7:uy")
   std::vector<std::vector<std::complex<double>>> X1; ///< per channel, per point: X_1 (m or rad)
   std::vector<bool> converged;                       ///< per point
@@ -143,8 +143,8 @@ struct Diagnosis {
   double channel_error = 0.0;      ///< its relative error, ‖e‖/‖X_meas‖ over the tests
   std::string nature;              ///< "conservative", "dissipative", or empty
   double conservative_explains = 0.0, dissipative_explains = 0.0;
-  bool even_harmonics = false;     ///< an unexplained 2nd harmonic, 5 × above the noise
-  double even_content = 0.0;       ///< largest |X_meas − X_sim| at k = 2 over |X_1|
+  bool even_harmonics = false; ///< an unexplained 2nd harmonic, 5 × above the noise
+  double even_content = 0.0;   ///< largest |X_meas − X_sim| at k = 2 over |X_1|
   /// The even harmonics point to an asymmetric joint force: k2 explains half the gap or more,
   /// or they appear in most tests (not in a few, as a symmetric system's lost symmetry would).
   bool asymmetric = false;

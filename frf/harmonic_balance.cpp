@@ -50,7 +50,7 @@ struct Equations {
   std::vector<Friction> friction;
   // Per sample n: ∂y_n/∂z and ∂ẏ_n/∂z of one joint (Nt × (2K+1)), and the forward transform
   // from samples to packed harmonics ((2K+1) × Nt).
-  const Eigen::MatrixXd& dy, &dv, &forward;
+  const Eigen::MatrixXd &dy, &dv, &forward;
   // cos(pθ_n) and sin(pθ_n), p = 0 … 2K, for the harmonics of sample weights (Nt × (2K+1)).
   const Eigen::MatrixXd &cos2, &sin2;
   double omega;
@@ -347,8 +347,9 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
     const double c = std::max(std::abs(Hyy_[1](j, j)), 1e-300);
     friction.push_back({j, limit, 1.0 / (omega_ * c), c});
   }
-  const Equations P{K_,    nj_, Nt_, Hyy_,   HyF_F, joints, exact ? 0.0 : options_.friction_width,
-                    friction, dy, dv, forward, cos2_, sin2_, omega_};
+  const Equations P{
+      K_,       nj_, Nt_, Hyy_,    HyF_F, joints, exact ? 0.0 : options_.friction_width,
+      friction, dy,  dv,  forward, cos2_, sin2_,  omega_};
 
   HarmonicBalanceResult out;
   out.frequency_hz = frequency_hz_;
@@ -413,8 +414,8 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
     z = z_start / steps;
     out.converged = true;
     for (int s = 1; s <= steps && out.converged; ++s)
-      out.converged = newton(P, z, static_cast<double>(s) / steps, options_, out.iterations,
-                             out.residual);
+      out.converged =
+          newton(P, z, static_cast<double>(s) / steps, options_, out.iterations, out.residual);
   }
   out.Y = P.unpack(z, nj_);
   out.G = P.forces(z, nullptr);

@@ -80,8 +80,7 @@ using joints::joint_dof_set;
 /// std::invalid_argument naming the test and the missing or misplaced channel. Adds a warning
 /// when a dry-friction joint sticks in the record.
 TestSpectrum spectrum(const Measurement& measurement, const fem::DofMap& dofs,
-                      const std::vector<joints::Joint>& joints,
-                      std::vector<std::string>& warnings);
+                      const std::vector<joints::Joint>& joints, std::vector<std::string>& warnings);
 
 /// Identifies the non-fixed terms of every joint from the tests. Throws std::invalid_argument
 /// when there are fewer equations than unknowns or the unknowns are not separable. Tests from

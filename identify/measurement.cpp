@@ -63,9 +63,9 @@ Eigen::VectorXcd differentiate(const Eigen::VectorXcd& X, double omega, int powe
 // The samples of one channel's data over the analysed span (whole periods), with the span's
 // noise estimate: either the synchronous average of the periods or the trimmed record.
 struct Span {
-  Eigen::VectorXd t;      // analysed times (one period when averaged)
-  int samples = 0;        // samples of the record behind the span (n)
-  int periods = 1;        // periods averaged
+  Eigen::VectorXd t; // analysed times (one period when averaged)
+  int samples = 0;   // samples of the record behind the span (n)
+  int periods = 1;   // periods averaged
   bool averaged = false;
   int dense_harmonics = 0; // harmonics a many-harmonic fit can resolve here
 };
@@ -238,12 +238,15 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
     const Eigen::VectorXd t = r.t.head(n), x = best[big]->samples.head(n);
     const int half = whole_period_samples(t.head(n / 2), m.frequency_hz);
     if (half > 0) {
-      const Eigen::VectorXcd a = fit_harmonics(t.head(half), Eigen::VectorXd(x.head(half)), omega, 1);
-      const Eigen::VectorXcd b = fit_harmonics(t.tail(half), Eigen::VectorXd(x.tail(half)), omega, 1);
+      const Eigen::VectorXcd a =
+          fit_harmonics(t.head(half), Eigen::VectorXd(x.head(half)), omega, 1);
+      const Eigen::VectorXcd b =
+          fit_harmonics(t.tail(half), Eigen::VectorXd(x.tail(half)), omega, 1);
       const double size = std::max(std::abs(b(1)), 1e-300);
       const double change = std::abs(a(1) - b(1)) / size;
       const double sigma = m.channel_noise[big];
-      const double allowance = std::isfinite(sigma) ? 4.0 * 2.0 * sigma / std::sqrt(half) / size : 0.0;
+      const double allowance =
+          std::isfinite(sigma) ? 4.0 * 2.0 * sigma / std::sqrt(half) / size : 0.0;
       if (change > o.steady_tolerance + allowance)
         m.warnings.push_back(r.source + ": not a steady state (first and last half differ by " +
                              percent(change) + ")");

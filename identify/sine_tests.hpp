@@ -25,9 +25,9 @@ enum class SimulationMethod { time_integration, harmonic_balance };
 
 struct SimulationOptions {
   SimulationMethod method = SimulationMethod::time_integration;
-  int periods = 8;              ///< periods in each record
-  int steps_per_period = 2048;  ///< time steps per period (time integration; samples for hb)
-  int samples_per_period = 0;   ///< samples kept per period; 0: every step. Must divide steps.
+  int periods = 8;             ///< periods in each record
+  int steps_per_period = 2048; ///< time steps per period (time integration; samples for hb)
+  int samples_per_period = 0;  ///< samples kept per period; 0: every step. Must divide steps.
   /// Response channels written at every output DOF: any of displacement, velocity,
   /// acceleration (acceleration: the derivative of the velocity from its harmonics).
   std::vector<Quantity> quantities{Quantity::displacement, Quantity::velocity};

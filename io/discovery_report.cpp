@@ -44,7 +44,8 @@ Chart response_chart(const std::vector<discover::Comparison>& list,
   for (const auto& c : list)
     if (c.channel == channel) rows.push_back(&c);
   const bool over_frequency = curves.empty() || curves.front().over_frequency;
-  const bool by_force = std::all_of(rows.begin(), rows.end(), [](auto* c) { return c->force > 0.0; });
+  const bool by_force =
+      std::all_of(rows.begin(), rows.end(), [](auto* c) { return c->force > 0.0; });
   Chart chart;
   chart.title = title;
   chart.x_label = over_frequency ? "excitation frequency (Hz)" : "force amplitude (N)";
@@ -145,7 +146,8 @@ std::string model_text(const discover::State& s) {
       terms += (terms.empty() ? "" : " + ") + std::string(joints::term_name(t));
     text += fmt::format("{}'{}': {}", text.empty() ? "" : "; ", j.name, terms);
   }
-  if (s.damping_scale != 1.0) text += fmt::format("; substructure damping ×{}", g4(s.damping_scale));
+  if (s.damping_scale != 1.0)
+    text += fmt::format("; substructure damping ×{}", g4(s.damping_scale));
   return text;
 }
 
@@ -184,9 +186,8 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   md += "The **gap** is `sqrt(Σ|X_meas − X_sim|² / Σ|X_meas|²)` over every test, response channel "
         "and compared harmonic (all as displacements); the **noise level** is the gap a perfect "
         "model would leave, from the noise the records themselves show.\n\n";
-  md += fmt::format("**Result.** {}\n\n", r.diagnosis.findings.empty()
-                                               ? std::string()
-                                               : r.diagnosis.findings.back());
+  md += fmt::format("**Result.** {}\n\n",
+                    r.diagnosis.findings.empty() ? std::string() : r.diagnosis.findings.back());
 
   md += "## Diagnosis\n\n";
   for (std::size_t i = 0; i + 1 < r.diagnosis.findings.size(); ++i)
@@ -204,10 +205,10 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
           "|\n|---|---|---|---|---|---|---|---|\n";
     for (std::size_t i = 0; i < r.steps.size(); ++i) {
       const auto& s = r.steps[i];
-      md += fmt::format("| {} | {} | {} | {} | [{}, {}] | {} | {} | {} |\n", i + 1, s.added.name(),
-                        s.added.effect(), g4(s.added.value), g4(s.added.ci_low),
-                        g4(s.added.ci_high), g4(s.gap_before), g4(s.gap_after),
-                        pct(s.added.explained));
+      md +=
+          fmt::format("| {} | {} | {} | {} | [{}, {}] | {} | {} | {} |\n", i + 1, s.added.name(),
+                      s.added.effect(), g4(s.added.value), g4(s.added.ci_low), g4(s.added.ci_high),
+                      g4(s.gap_before), g4(s.gap_after), pct(s.added.explained));
     }
     md += "\n";
   }
@@ -272,12 +273,12 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
             response_chart(after, r.curves.front(), ch, "Starting model (nothing added)"));
         continue;
       }
-      f.charts.push_back(response_chart(before, r.curves[i], ch,
-                                        fmt::format("Before step {}: {}", i + 1,
-                                                    model_text(r.states[i]))));
-      f.charts.push_back(response_chart(after, r.curves[i + 1], ch,
-                                        fmt::format("After step {} (+ {})", i + 1,
-                                                    r.steps[i].added.name())));
+      f.charts.push_back(
+          response_chart(before, r.curves[i], ch,
+                         fmt::format("Before step {}: {}", i + 1, model_text(r.states[i]))));
+      f.charts.push_back(
+          response_chart(after, r.curves[i + 1], ch,
+                         fmt::format("After step {} (+ {})", i + 1, r.steps[i].added.name())));
     }
     md += none ? "" : fmt::format("### Step {}: {}\n\n", i + 1, r.steps[i].finding);
     md += plot(fmt::format("response_{}.png", i + 1), f);
@@ -287,7 +288,8 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   md += "## Candidates\n\n";
   md += "The gap after adding each candidate (every non-fixed term identified again, every test "
         "re-simulated; equation-error estimates, the best few refined by output error), best first "
-        "by the information criterion; the dashed line is the gap before the step. A candidate may be added only if it is admissible, lowers the "
+        "by the information criterion; the dashed line is the gap before the step. A candidate may "
+        "be added only if it is admissible, lowers the "
         "information criterion, explains at least 5 % of the squared gap and lowers the "
         "cross-validated gap. Candidates that could not be simulated (e.g. negative friction) "
         "are in the table only.\n\n";
@@ -301,8 +303,8 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     rankings.push_back({fmt::format("Step {} (added {})", i + 1, r.steps[i].added.name()),
                         &r.steps[i].ranking, r.steps[i].gap_before});
   if (!r.last_ranking.empty())
-    rankings.push_back({fmt::format("Step {} (nothing added)", r.steps.size() + 1),
-                        &r.last_ranking, r.gap.back()});
+    rankings.push_back({fmt::format("Step {} (nothing added)", r.steps.size() + 1), &r.last_ranking,
+                        r.gap.back()});
   for (std::size_t i = 0; i < rankings.size(); ++i) {
     const auto& [title, ranking, gap_now] = rankings[i];
     Chart c;
@@ -326,8 +328,8 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
       now.y = {gap_now, gap_now};
       c.series.push_back(bars);
       c.series.push_back(now);
-      md += "### " + title + "\n\n" + plot(fmt::format("candidates_{}.png", i + 1),
-                                           Figure{1200, 500, 1, {c}});
+      md += "### " + title + "\n\n" +
+            plot(fmt::format("candidates_{}.png", i + 1), Figure{1200, 500, 1, {c}});
     }
     md += "| candidate | effect | value | 95 % interval | gap | explained | verdict |\n"
           "|---|---|---|---|---|---|---|\n";

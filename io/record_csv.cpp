@@ -1,5 +1,6 @@
 #include "io/record_csv.hpp"
 
+#include "identify/harmonics.hpp"
 #include "io/files.hpp"
 
 #include <fmt/format.h>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
@@ -371,16 +373,48 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
   return table;
 }
 
+SteppedSineTable stepped_sine_table(const std::vector<identify::Record>& records) {
+  SteppedSineTable table;
+  if (records.empty()) return table;
+  for (const auto& c : records.front().channels)
+    table.channels.push_back(c.name());
+  table.values.resize(static_cast<Eigen::Index>(records.size()),
+                      static_cast<Eigen::Index>(table.channels.size()));
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const identify::Record& r = records[i];
+    std::vector<std::string> names;
+    for (const auto& c : r.channels)
+      names.push_back(c.name());
+    if (names != table.channels)
+      throw Error(fmt::format("{}: its channels differ from those of {}; a stepped-sine table "
+                              "needs the same channels in every test",
+                              r.source, records.front().source));
+    const double f = r.excitation_hz
+                         ? *r.excitation_hz
+                         : identify::estimate_frequency(
+                               r.t, r.all(identify::Quantity::force).empty()
+                                        ? r.channels.front().samples
+                                        : r.all(identify::Quantity::force).front()->samples);
+    const int n = identify::whole_period_samples(r.t, f);
+    if (n == 0) throw Error(fmt::format("{}: shorter than one period of {} Hz", r.source, f));
+    table.freq_hz.push_back(f);
+    for (std::size_t c = 0; c < r.channels.size(); ++c)
+      table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) =
+          identify::fit_harmonics(Eigen::VectorXd(r.t.head(n)),
+                                  Eigen::VectorXd(r.channels[c].samples.head(n)),
+                                  2.0 * std::numbers::pi * f, 1)(1);
+  }
+  return table;
+}
+
 std::string stepped_sine_csv(const SteppedSineTable& table,
                              const std::vector<std::string>& comments) {
   const auto rows = static_cast<Eigen::Index>(table.freq_hz.size());
   if (table.values.rows() != rows ||
       table.values.cols() != static_cast<Eigen::Index>(table.channels.size()))
     throw Error(fmt::format("stepped-sine table: {} × {} values for {} tests and {} channels",
-                            table.values.rows(), table.values.cols(), rows,
-                            table.channels.size()));
-  if (!table.values.allFinite())
-    throw Error("stepped-sine table: NaN or infinite values");
+                            table.values.rows(), table.values.cols(), rows, table.channels.size()));
+  if (!table.values.allFinite()) throw Error("stepped-sine table: NaN or infinite values");
   std::string out;
   auto inserter = std::back_inserter(out);
   for (const auto& comment : comments)
@@ -411,9 +445,9 @@ std::vector<identify::SineTest> stepped_sine_tests(const SteppedSineTable& table
     row.source = fmt::format("{}:{}", path.string(), i < table.lines.size() ? table.lines[i] : 0);
     row.frequency_hz = table.freq_hz[i];
     for (std::size_t c = 0; c < channels.size(); ++c)
-      row.channels.push_back({channels[c].quantity, channels[c].at,
-                              table.values(static_cast<Eigen::Index>(i),
-                                           static_cast<Eigen::Index>(c))});
+      row.channels.push_back(
+          {channels[c].quantity, channels[c].at,
+           table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c))});
     tests.emplace_back(std::move(row));
   }
   return tests;

@@ -52,6 +52,12 @@ struct SteppedSineTable {
 /// Reads a stepped-sine table; throws io::Error naming file, line and column as read_record.
 SteppedSineTable read_stepped_sine(const std::filesystem::path& path);
 
+/// The fundamentals of sine-test records as a stepped-sine table: each channel's complex
+/// amplitude at its record's excitation frequency (a least-squares fit over the record's whole
+/// periods), one row per record. The records must have the same channels in the same order;
+/// throws io::Error naming the first that differs, or one shorter than a period.
+SteppedSineTable stepped_sine_table(const std::vector<identify::Record>& records);
+
 /// The CSV text of a stepped-sine table: each comment as `# ...` lines, the header and one row
 /// per test, every number in its shortest form that reads back bit-exactly. Throws io::Error
 /// if the sizes disagree or a value is not finite.

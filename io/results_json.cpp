@@ -23,7 +23,7 @@ std::string text(const Json& json) {
 Json candidate_json(const discover::Candidate& c) {
   Json j;
   j["joint"] = c.joint;
-  j["term"] = c.refit ? std::string("refit")
+  j["term"] = c.refit  ? std::string("refit")
               : c.term ? std::string(joints::term_name(*c.term))
                        : std::string("damping_scale");
   j["effect"] = c.effect();
@@ -105,9 +105,9 @@ std::string discovery_json(const discover::Result& r) {
   Json start;
   start["notes"] = r.start_notes;
   start["gap"] = number(r.states.front().gap);
-  start["joints"] = joints_json(r.states.front().joints,
-                                r.states.front().fit.joints.empty() ? nullptr
-                                                                    : &r.states.front().fit);
+  start["joints"] =
+      joints_json(r.states.front().joints,
+                  r.states.front().fit.joints.empty() ? nullptr : &r.states.front().fit);
   out["start"] = std::move(start);
   Json steps = Json::array();
   for (const auto& s : r.steps) {

@@ -1,7 +1,7 @@
 #pragma once
 /// JSON results (DESIGN.md's contract): identification results and mode lists.
-#include "fem/modal.hpp"
 #include "discover/discover.hpp"
+#include "fem/modal.hpp"
 #include "identify/fit.hpp"
 
 #include <filesystem>

@@ -24,16 +24,18 @@ constexpr std::array<TermInfo, 7> table{{
      [](double y, double) { return y * y; }, [](double y, double) { return 2.0 * y; }, zero,
      Nature::conservative, 2, true, false},
     {Term::k3, "k3", "cubic stiffness", "N/m^3", "N m/rad^3",
-     [](double y, double) { return y * y * y; }, [](double y, double) { return 3.0 * y * y; },
-     zero, Nature::conservative, 3, false, false},
+     [](double y, double) { return y * y * y; }, [](double y, double) { return 3.0 * y * y; }, zero,
+     Nature::conservative, 3, false, false},
     {Term::c2, "c2", "velocity-squared damping", "N s^2/m^2", "N m s^2/rad^2",
      [](double, double v) { return v * std::abs(v); }, zero,
      [](double, double v) { return 2.0 * std::abs(v); }, Nature::dissipative, 2, false, false},
     {Term::c3, "c3", "cubic damping", "N s^3/m^3", "N m s^3/rad^3",
-     [](double, double v) { return v * v * v; }, zero,
-     [](double, double v) { return 3.0 * v * v; }, Nature::dissipative, 3, false, false},
+     [](double, double v) { return v * v * v; }, zero, [](double, double v) { return 3.0 * v * v; },
+     Nature::dissipative, 3, false, false},
     {Term::fc, "fc", "Coulomb friction", "N", "N m",
-     [](double, double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; }, zero, zero,
+     [](double, double v) { return v > 0.0   ? 1.0
+                                   : v < 0.0 ? -1.0
+                                             : 0.0; }, zero, zero,
      Nature::dissipative, 0, false, true},
 }};
 

@@ -168,8 +168,8 @@ private:
     options.periods = 4;
     const fem::NodeDof tip = substructure_->dofs().node_dof(tip_);
     std::vector<identify::Record> records;
-    for (auto& test : identify::simulate_sine_tests(*substructure_, {joint_of(m)}, tip, plans,
-                                                    options)) {
+    for (auto& test :
+         identify::simulate_sine_tests(*substructure_, {joint_of(m)}, tip, plans, options)) {
       if (!test.warnings.empty()) throw std::runtime_error(test.warnings.front());
       records.push_back(std::move(test.record));
     }

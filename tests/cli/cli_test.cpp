@@ -369,11 +369,11 @@ TEST_F(CliTest, DiscoverNamesAHiddenCubicStiffnessAndWritesItsReport) {
   const fs::path data = dir() / "discover_data", out = dir() / "discover_out";
   const fs::path start = dir() / "linear.toml";
   test::write_text(start, linear_start_toml());
-  const Outcome sim = jointid({"simulate", model().string(), "--force", "7:uy", "--freq",
-                               "2,3,4,5", "--amplitude", "10,80", "--steps-per-period", "512",
-                               "--samples-per-period", "128", "--noise", "0.01", "-o",
-                               data.string()},
-                              dir());
+  const Outcome sim =
+      jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "2,3,4,5", "--amplitude",
+               "10,80", "--steps-per-period", "512", "--samples-per-period", "128", "--noise",
+               "0.01", "-o", data.string()},
+              dir());
   ASSERT_EQ(sim.status, 0) << sim.err;
   std::vector<std::string> args{"discover", start.string()};
   for (const auto& e : fs::directory_iterator(data))
@@ -438,9 +438,9 @@ TEST_F(CliTest, SimulateWritesASteppedSineTableThatIdentifyReads) {
 
 TEST_F(CliTest, NoiseIsSeededAndAFileGivenTwiceIsRefused) {
   auto run_noise = [&](const std::string& seed, const fs::path& out) {
-    return jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3",
-                    "--amplitude", "10", "--steps-per-period", "64", "--periods", "2",
-                    "--noise", "0.02", "--seed", seed, "-o", out.string()},
+    return jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3", "--amplitude",
+                    "10", "--steps-per-period", "64", "--periods", "2", "--noise", "0.02", "--seed",
+                    seed, "-o", out.string()},
                    dir());
   };
   ASSERT_EQ(run_noise("7", dir() / "n1").status, 0);
@@ -452,11 +452,11 @@ TEST_F(CliTest, NoiseIsSeededAndAFileGivenTwiceIsRefused) {
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
   EXPECT_NE(a.find("noise: white Gaussian, RMS 0.02"), std::string::npos);
-  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3",
-                                 "--amplitude", "10", "--noise", "1.5", "-o",
-                                 (dir() / "n5").string()},
-                                dir()),
-                        "--noise");
+  expect_one_line_error(
+      jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3", "--amplitude", "10",
+               "--noise", "1.5", "-o", (dir() / "n5").string()},
+              dir()),
+      "--noise");
   // The same record twice would count twice: refused, by identify and discover alike.
   const std::string rec = (dir() / "n1/sine_f3Hz_F10N.csv").string();
   expect_one_line_error(
@@ -473,18 +473,16 @@ TEST_F(CliTest, DiscoverChecksItsOptionsBeforeReading) {
   ASSERT_EQ(simulate_.status, 0) << simulate_.err;
   const std::string rec = record_files()[0];
   const fs::path out = dir() / "never_discover";
-  expect_one_line_error(jointid({"discover", model().string(), rec, "--harmonics", "0", "-o",
-                                 out.string()},
-                                dir()),
-                        "--harmonics");
-  expect_one_line_error(jointid({"discover", model().string(), rec, "--hb-harmonics", "2", "-o",
-                                 out.string()},
-                                dir()),
-                        "--hb-harmonics");
-  expect_one_line_error(jointid({"discover", model().string(), rec, "--terms", "k4", "-o",
-                                 out.string()},
-                                dir()),
-                        "--terms");
+  expect_one_line_error(
+      jointid({"discover", model().string(), rec, "--harmonics", "0", "-o", out.string()}, dir()),
+      "--harmonics");
+  expect_one_line_error(
+      jointid({"discover", model().string(), rec, "--hb-harmonics", "2", "-o", out.string()},
+              dir()),
+      "--hb-harmonics");
+  expect_one_line_error(
+      jointid({"discover", model().string(), rec, "--terms", "k4", "-o", out.string()}, dir()),
+      "--terms");
   EXPECT_FALSE(fs::exists(out));
 }
 

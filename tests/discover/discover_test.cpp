@@ -29,8 +29,8 @@ using joints::Term;
 
 joints::Joint joint(std::string name, int node, std::vector<Term> terms,
                     std::vector<double> values) {
-  joints::Joint j{std::move(name), node, 0, fem::Dof::uy, std::move(terms), std::move(values),
-                  {}, {}};
+  joints::Joint j{std::move(name),   node, 0, fem::Dof::uy, std::move(terms),
+                  std::move(values), {},   {}};
   j.fixed.assign(j.terms.size(), false);
   return j;
 }
@@ -65,8 +65,8 @@ std::vector<identify::Measurement> measure(const Data& d, int harmonics = 3) {
   o.samples_per_period = 256;
   o.periods = 8;
   o.quantities = d.channels;
-  std::vector<identify::SimulatedTest> tests =
-      identify::simulate_sine_tests(frf::Substructure(d.model), d.truth, {7, fem::Dof::uy}, plans, o);
+  std::vector<identify::SimulatedTest> tests = identify::simulate_sine_tests(
+      frf::Substructure(d.model), d.truth, {7, fem::Dof::uy}, plans, o);
   std::vector<identify::Measurement> out;
   for (std::size_t i = 0; i < tests.size(); ++i) {
     EXPECT_TRUE(tests[i].warnings.empty()) << tests[i].warnings.front();
@@ -180,9 +180,9 @@ TEST_P(HiddenTerm, IsNamedIdentifiedAndTheGapFallsToTheNoise) {
   ASSERT_TRUE(r.diagnosis.level_dependent.has_value());
   EXPECT_TRUE(*r.diagnosis.level_dependent);
   EXPECT_EQ(r.diagnosis.joint, "tip");
-  EXPECT_EQ(r.diagnosis.nature,
-            joints::term_info(h.term).nature == joints::Nature::conservative ? "conservative"
-                                                                             : "dissipative");
+  EXPECT_EQ(r.diagnosis.nature, joints::term_info(h.term).nature == joints::Nature::conservative
+                                    ? "conservative"
+                                    : "dissipative");
   EXPECT_EQ(r.diagnosis.asymmetric, joints::term_info(h.term).even);
   if (h.term == Term::k2) {
     EXPECT_TRUE(r.diagnosis.even_harmonics);
@@ -192,14 +192,15 @@ TEST_P(HiddenTerm, IsNamedIdentifiedAndTheGapFallsToTheNoise) {
 // Values that matter at these levels and stay stable; friction at levels where it mostly slides
 // (its basis sign(ẏ) does not describe a stuck joint, and its harmonic balance converges slowly
 // with the harmonics: 2 % on fc).
-INSTANTIATE_TEST_SUITE_P(
-    AtTheTip, HiddenTerm,
-    ::testing::Values(Hidden{Term::k3, 1.6e8, {10.0, 40.0, 80.0}, 0.005},
-                      Hidden{Term::c2, 500.0, {10.0, 40.0, 80.0}, 0.01},
-                      Hidden{Term::c3, 500.0, {10.0, 40.0, 80.0}, 0.01},
-                      Hidden{Term::fc, 3.0, {20.0, 50.0, 100.0}, 0.02},
-                      Hidden{Term::k2, 5e4, {10.0, 40.0, 80.0}, 0.01}),
-    [](const auto& info) { return std::string(joints::term_name(info.param.term)); });
+INSTANTIATE_TEST_SUITE_P(AtTheTip, HiddenTerm,
+                         ::testing::Values(Hidden{Term::k3, 1.6e8, {10.0, 40.0, 80.0}, 0.005},
+                                           Hidden{Term::c2, 500.0, {10.0, 40.0, 80.0}, 0.01},
+                                           Hidden{Term::c3, 500.0, {10.0, 40.0, 80.0}, 0.01},
+                                           Hidden{Term::fc, 3.0, {20.0, 50.0, 100.0}, 0.02},
+                                           Hidden{Term::k2, 5e4, {10.0, 40.0, 80.0}, 0.01}),
+                         [](const auto& info) {
+                           return std::string(joints::term_name(info.param.term));
+                         });
 
 TEST(Discover, NothingHiddenAddsNothing) {
   Data d;
@@ -340,8 +341,8 @@ TEST(Discover, OnAOneModeModalModelWithDriftingLevels) {
   // the noise level; discovery must add the two effects that explain a real share, and stop.
   const fem::Model fe = test::paper_cantilever();
   std::vector<identify::Measurement> tests;
-  const std::vector<std::pair<double, double>> levels{{5.0, 4830.0}, {20.0, 4790.0},
-                                                      {50.0, 4815.0}, {100.0, 4780.0}};
+  const std::vector<std::pair<double, double>> levels{
+      {5.0, 4830.0}, {20.0, 4790.0}, {50.0, 4815.0}, {100.0, 4780.0}};
   for (const auto& [level, k] : levels) {
     Data d;
     d.truth = {joint("tip", 7, {Term::k, Term::c, Term::k3, Term::fc}, {k, 20.0, 1.6e8, 3.0})};

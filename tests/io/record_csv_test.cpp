@@ -313,5 +313,160 @@ TEST_F(RecordCsvTest, SteppedSineTableErrors) {
   expect_table_error(test::replaced(table_csv, "-4e-3", "inf"), 4, "infinite");
 }
 
+TEST_F(RecordCsvTest, SteppedSineTableRoundTripIsBitExact) {
+  SteppedSineTable t;
+  t.freq_hz = {3.0, 0.1 + 0.2, 17.123456789012345};
+  t.channels = {"f@7:uy", "v@7:uy", "a@3:rz"};
+  t.values.resize(3, 3);
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (Eigen::Index i = 0; i < 3; ++i)
+    for (Eigen::Index c = 0; c < 3; ++c)
+      t.values(i, c) = {uniform(random) * std::exp(20.0 * uniform(random)), uniform(random) / 3.0};
+  t.values(1, 1) = {-0.0, std::numeric_limits<double>::denorm_min()};
+  const std::string text = stepped_sine_csv(t, {"stepped sine", "two comments"});
+  EXPECT_EQ(text.rfind("# stepped sine\n# two comments\nfreq_hz,f@7:uy.re,f@7:uy.im,v@7:uy.re,"
+                       "v@7:uy.im,a@3:rz.re,a@3:rz.im\n",
+                       0),
+            0u)
+      << text;
+  const auto path = write(text, "table.csv");
+  const SteppedSineTable back = read_stepped_sine(path);
+  EXPECT_EQ(back.channels, t.channels);
+  ASSERT_EQ(back.freq_hz.size(), 3u);
+  ASSERT_EQ(back.values.rows(), 3);
+  ASSERT_EQ(back.values.cols(), 3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(same_bits(back.freq_hz[i], t.freq_hz[i])) << i;
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      const auto e = static_cast<Eigen::Index>(i);
+      EXPECT_TRUE(same_bits(back.values(e, c).real(), t.values(e, c).real())) << i << "," << c;
+      EXPECT_TRUE(same_bits(back.values(e, c).imag(), t.values(e, c).imag())) << i << "," << c;
+    }
+  }
+  // Rows are lines 4, 5, 6 (two comments and the header first); each test names its line.
+  EXPECT_EQ(back.lines, (std::vector<int>{4, 5, 6}));
+  const std::vector<identify::SineTest> tests = stepped_sine_tests(back, path);
+  ASSERT_EQ(tests.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& row = std::get<identify::Phasors>(tests[i]);
+    EXPECT_EQ(row.source, path.string() + ":" + std::to_string(4 + i));
+    EXPECT_EQ(row.frequency_hz, t.freq_hz[i]);
+    ASSERT_EQ(row.channels.size(), 3u);
+    EXPECT_EQ(row.channels[0].quantity, Quantity::force);
+    EXPECT_EQ(row.channels[1].quantity, Quantity::velocity);
+    EXPECT_EQ(row.channels[2].quantity, Quantity::acceleration);
+    EXPECT_EQ(row.channels[2].at, (fem::NodeDof{3, fem::Dof::rz}));
+    EXPECT_EQ(row.channels[1].value, t.values(static_cast<Eigen::Index>(i), 1));
+  }
+}
+
+TEST_F(RecordCsvTest, SteppedSineWriterRefusesWhatTheReaderWouldRefuse) {
+  SteppedSineTable t;
+  t.freq_hz = {3.0, 4.0};
+  t.channels = {"f@7:uy", "x@7:uy"};
+  t.values = Eigen::MatrixXcd::Ones(2, 2);
+  EXPECT_NO_THROW(stepped_sine_csv(t));
+  SteppedSineTable bad = t;
+  bad.values = Eigen::MatrixXcd::Ones(3, 2); // 3 rows for 2 frequencies
+  EXPECT_THROW(stepped_sine_csv(bad), Error);
+  bad = t;
+  bad.channels.pop_back();
+  EXPECT_THROW(stepped_sine_csv(bad), Error);
+  bad = t;
+  bad.values(1, 1) = {std::numeric_limits<double>::quiet_NaN(), 0.0};
+  EXPECT_THROW(stepped_sine_csv(bad), Error);
+  bad = t;
+  bad.freq_hz[0] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(stepped_sine_csv(bad), Error);
+}
+
+TEST_F(RecordCsvTest, ReadTestsTellsRecordsFromTables) {
+  const auto record = write(good_csv, "record.csv");
+  const auto table = write(table_csv, "table.csv");
+  const std::vector<identify::SineTest> tests = read_tests({table, record});
+  ASSERT_EQ(tests.size(), 3u); // two rows, then one record, in the order given
+  const auto* first = std::get_if<identify::Phasors>(&tests[0]);
+  const auto* second = std::get_if<identify::Phasors>(&tests[1]);
+  const auto* third = std::get_if<identify::Record>(&tests[2]);
+  ASSERT_NE(first, nullptr);
+  ASSERT_NE(second, nullptr);
+  ASSERT_NE(third, nullptr);
+  EXPECT_EQ(first->source, table.string() + ":3");
+  EXPECT_EQ(second->source, table.string() + ":4");
+  EXPECT_EQ(second->frequency_hz, 3.5);
+  EXPECT_EQ(second->channels[1].value, std::complex<double>(-4e-3, -5e-4));
+  EXPECT_EQ(third->source, record.string());
+  EXPECT_EQ(*third->excitation_hz, 2.0);
+  EXPECT_EQ(third->t.size(), 5);
+}
+
+TEST_F(RecordCsvTest, ReadTestsRefusesAFileGivenTwice) {
+  const auto a = write(good_csv, "a.csv");
+  const auto b = write(table_csv, "b.csv");
+  auto error_of = [](const std::vector<std::filesystem::path>& paths) {
+    try {
+      read_tests(paths);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string e = error_of({a, b, a});
+  EXPECT_NE(e.find(a.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("given twice"), std::string::npos) << e;
+  // Another spelling of the same file: through "." and "..", and relative to the directory.
+  const std::filesystem::path other = dir.path() / "." / "sub" / ".." / "b.csv";
+  std::filesystem::create_directories(dir.path() / "sub");
+  e = error_of({b, other});
+  EXPECT_NE(e.find("given twice"), std::string::npos) << e;
+  EXPECT_NE(e.find(other.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("also as " + b.string()), std::string::npos) << e;
+  // Two different files with the same content are two tests.
+  const auto copy = write(good_csv, "copy.csv");
+  EXPECT_EQ(error_of({a, copy}), "");
+}
+
+TEST_F(RecordCsvTest, ReadTestsNamesAnUnknownFirstColumn) {
+  const auto path = write("# neither kind\n\nfrequency,f@7:uy.re,f@7:uy.im\n3.0,0.0,-1.0\n",
+                          "odd.csv");
+  try {
+    read_tests({path});
+    FAIL() << "expected io::Error";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("odd.csv:3:"), std::string::npos) << message;
+    EXPECT_NE(message.find("'t'"), std::string::npos) << message;
+    EXPECT_NE(message.find("'freq_hz'"), std::string::npos) << message;
+    EXPECT_NE(message.find("\"frequency\""), std::string::npos) << message;
+  }
+  EXPECT_THROW(read_tests({dir / "missing.csv"}), Error);
+}
+
+TEST_F(RecordCsvTest, ByteOrderMarkIsAccepted) {
+  const std::string bom = "\xEF\xBB\xBF";
+  // A record whose first line is a comment, and one whose first line is the header.
+  const identify::Record r = read_record(write(bom + good_csv, "bom_record.csv"));
+  EXPECT_EQ(*r.excitation_hz, 2.0);
+  EXPECT_EQ(r.channels.size(), 2u);
+  const std::string bare = good_csv.substr(good_csv.find("t,f@7"));
+  const identify::Record header_first = read_record(write(bom + bare, "bom_header.csv"));
+  EXPECT_EQ(header_first.channels[0].name(), "f@7:uy");
+  EXPECT_EQ(header_first.t.size(), 5);
+  const SteppedSineTable t = read_stepped_sine(write(bom + table_csv, "bom_table.csv"));
+  EXPECT_EQ(t.freq_hz.size(), 2u);
+  const std::string table_bare = table_csv.substr(table_csv.find("freq_hz"));
+  const auto table_path = write(bom + table_bare, "bom_table_header.csv");
+  EXPECT_EQ(read_stepped_sine(table_path).channels[0], "f@7:uy");
+  // read_tests tells the kinds apart behind the mark too; line numbers are unchanged.
+  const auto tests = read_tests({dir / "bom_header.csv", table_path});
+  ASSERT_EQ(tests.size(), 3u);
+  EXPECT_TRUE(std::holds_alternative<identify::Record>(tests[0]));
+  EXPECT_EQ(identify::source_of(tests[1]), table_path.string() + ":2");
+  // Only at the very start: elsewhere the mark is part of a field.
+  EXPECT_THROW(read_record(write(test::replaced(good_csv, "t,f@7", bom + "t,f@7"), "late.csv")),
+               Error);
+}
+
 } // namespace
 } // namespace jointid::io

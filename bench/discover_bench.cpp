@@ -1,0 +1,122 @@
+// Times model discovery on the paper's cantilever (21 sine tests: 2–5 Hz × 3 levels, made by time
+// integration with 1 % noise) with a hidden cubic stiffness, and with a hidden cubic stiffness
+// and Coulomb friction; and one steady-state point by harmonic balance against time
+// integration. Results: docs/benchmarks.md.
+#include "discover/discover.hpp"
+#include "fem/time_integration.hpp"
+#include "identify/sine_tests.hpp"
+#include "support/cantilever.hpp"
+
+#include <benchmark/benchmark.h>
+
+using namespace jointid;
+using joints::Term;
+
+namespace {
+
+joints::Joint joint(std::vector<Term> terms, std::vector<double> values) {
+  joints::Joint j{"tip", 7, 0, fem::Dof::uy, std::move(terms), std::move(values), {}, {}};
+  j.fixed.assign(j.terms.size(), false);
+  return j;
+}
+
+std::vector<identify::Measurement> tests(const frf::Substructure& sub, const joints::Joint& truth,
+                                         const std::vector<double>& levels) {
+  std::vector<identify::SineTestPlan> plans;
+  for (double f : {2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0})
+    for (double a : levels)
+      plans.push_back({f, a});
+  identify::SimulationOptions o;
+  o.steps_per_period = 1024;
+  o.samples_per_period = 256;
+  std::vector<identify::Measurement> out;
+  int seed = 1;
+  for (auto& t : identify::simulate_sine_tests(sub, {truth}, {7, fem::Dof::uy}, plans, o)) {
+    identify::add_noise(t.record, 0.01, seed++);
+    out.push_back(identify::measure(t.record, {.harmonics = 3}));
+  }
+  return out;
+}
+
+struct Data {
+  frf::Substructure sub{test::paper_cantilever()};
+  std::vector<identify::Measurement> k3 =
+      tests(sub, joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8}), {10.0, 40.0, 80.0});
+  std::vector<identify::Measurement> k3fc =
+      tests(sub, joint({Term::k, Term::c, Term::k3, Term::fc}, {4800.0, 20.0, 1.6e8, 3.0}),
+            {20.0, 50.0, 100.0});
+  joints::Joint start = [] {
+    joints::Joint j = joint({Term::k, Term::c}, {0.0, 0.0});
+    j.given.assign(2, false);
+    return j;
+  }();
+};
+
+const Data& data() {
+  static const Data d;
+  return d;
+}
+
+// state.range(0): points of the report's response curves (0: none).
+void BM_DiscoverHiddenCubicStiffness(benchmark::State& state) {
+  const Data& d = data();
+  discover::Options o;
+  o.curve_points = static_cast<int>(state.range(0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(discover::discover(d.sub, {d.start}, d.k3, o));
+}
+
+void BM_DiscoverHiddenCubicStiffnessAndFriction(benchmark::State& state) {
+  const Data& d = data();
+  discover::Options o;
+  o.curve_points = static_cast<int>(state.range(0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(discover::discover(d.sub, {d.start}, d.k3fc, o));
+}
+
+// One steady state at 4 Hz, 80 N (near the joined structure's first mode) with the joint k + c
+// + k3 (range 0) or k + c + k3 + fc (range 1).
+joints::Joint point_joint(int friction) {
+  return friction ? joint({Term::k, Term::c, Term::k3, Term::fc}, {4800.0, 20.0, 1.6e8, 3.0})
+                  : joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8});
+}
+
+void BM_SteadyStateHarmonicBalance(benchmark::State& state) {
+  const Data& d = data();
+  const int tip = d.sub.dofs().equation({7, fem::Dof::uy});
+  const frf::ModalSynthesis H = d.sub.synthesis({tip}, 0.0);
+  const std::vector<joints::Joint> j{point_joint(static_cast<int>(state.range(0)))};
+  const frf::HarmonicBalance hb(H, j, d.sub.dofs(), {tip}, {tip}, 4.0, {.harmonics = 15});
+  for (auto _ : state)
+    benchmark::DoNotOptimize(hb.solve(j, frf::sine_force(80.0)));
+}
+
+void BM_SteadyStateTimeIntegration(benchmark::State& state) {
+  const Data& d = data();
+  const int tip = d.sub.dofs().equation({7, fem::Dof::uy});
+  const fem::SparseMatrix C = d.sub.damping_matrix();
+  const joints::JointForces forces({point_joint(static_cast<int>(state.range(0)))}, d.sub.dofs());
+  const std::array<int, 1> out{tip};
+  fem::SteadyStateOptions o;
+  o.steps_per_period = 1024;
+  o.output_periods = 1;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        fem::steady_state(*d.sub.system(), C, &forces, {tip, 80.0, 4.0}, out, o));
+}
+
+} // namespace
+
+BENCHMARK(BM_DiscoverHiddenCubicStiffness)
+    ->Arg(0)
+    ->Arg(30)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+BENCHMARK(BM_DiscoverHiddenCubicStiffnessAndFriction)
+    ->Arg(0)
+    ->Arg(30)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+BENCHMARK(BM_SteadyStateHarmonicBalance)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SteadyStateTimeIntegration)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
