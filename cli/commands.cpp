@@ -91,25 +91,6 @@ identify::Quantity parse_quantity(const std::string& text) {
   throw io::Error(fmt::format("--channels: expected x, v or a, got \"{}\"", text));
 }
 
-// The receptance of the substructure over the joints' DOFs and the tests' force (and other)
-// DOFs, valid up to `f_max_hz`. DOFs the model lacks are left out here: the library names them
-// with the test they come from.
-frf::ModalSynthesis synthesis_for(const frf::Substructure& sub,
-                                  const std::vector<joints::Joint>& joints,
-                                  const std::vector<identify::Measurement>& tests, double f_max_hz,
-                                  std::vector<std::string>& notes) {
-  std::vector<int> dofs = joints::joint_dof_set(joints, sub.dofs());
-  auto add = [&](const fem::NodeDof& at) {
-    if (sub.dofs().state(at) != fem::DofMap::State::free) return;
-    const int e = sub.dofs().equation(at);
-    if (std::find(dofs.begin(), dofs.end(), e) == dofs.end()) dofs.push_back(e);
-  };
-  for (const auto& m : tests)
-    for (const auto& at : m.force_at)
-      add(at);
-  return sub.synthesis(dofs, f_max_hz, &notes);
-}
-
 } // namespace
 
 void simulate(const SimulateOptions& o) {
@@ -230,21 +211,9 @@ void identify(const IdentifyOptions& o) {
   options.harmonics = o.harmonics;
   const std::vector<identify::Measurement> measured =
       identify::measure(tests, identify::measure_options(options));
-  const frf::Substructure sub = file.substructure();
-  double f_max = 0.0;
-  for (const auto& m : measured)
-    f_max = std::max(f_max, m.frequency_hz);
-  const int max_harmonic = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
-  std::vector<std::string> notes;
-  const frf::ModalSynthesis synthesis =
-      synthesis_for(sub, file.joints, measured, 4.0 * max_harmonic * f_max, notes);
-  const identify::ReceptanceFn H = [&synthesis](double omega, std::span<const int> rows,
-                                                std::span<const int> cols) {
-    return synthesis.receptance(omega, rows, cols);
-  };
-  const identify::FitResult result = identify::fit(H, sub.dofs(), file.joints, measured, options);
-
-  io::write_json(o.output, io::identify_result_json(result, notes));
+  const identify::FitResult result =
+      identify::fit(file.substructure(), file.joints, measured, options);
+  io::write_json(o.output, io::identify_result_json(result));
 
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
              "95 % interval");
@@ -260,8 +229,6 @@ void identify(const IdentifyOptions& o) {
              result.residual_relative);
   fmt::print("wrote {}\n", o.output.string());
   for (const auto& w : result.warnings)
-    warn(w);
-  for (const auto& w : notes)
     warn(w);
 }
 

@@ -20,7 +20,6 @@
 #include <numeric>
 #include <set>
 #include <stdexcept>
-#include <thread>
 
 namespace jointid::discover {
 
@@ -103,7 +102,7 @@ public:
       response_eq_.push_back(std::move(responses));
       f_max = std::max(f_max, m.frequency_hz);
     }
-    f_max_ = f_max * o.balance.harmonics;
+    f_max_ = frf::synthesis_band_hz(f_max, 2 * o.balance.harmonics); // refined: twice K
     // The force that drives each re-simulation: the measured harmonics, except those that are
     // noise (a force harmonic within 5 standard deviations of 0 is taken as 0): driven through
     // a resonance, noise alone would give the model responses the structure never had.
@@ -163,6 +162,7 @@ public:
     Result out;
     out.tests = static_cast<int>(tests_.size());
     out.compared_values = values_;
+    out.min_explained = o_.min_explained;
     out.noise_gap = noise_known_ ? noise_gap_ : -1.0;
     out.warnings = notes_;
     for (const auto& m : tests_)
@@ -208,8 +208,9 @@ public:
     bool values_fitted = fitted;
 
     // 2. Add what explains the disagreement, while something significant is left.
+    double simulation_gap = -1.0; // of `state`, once estimated
     for (int step = 0; step < o_.max_steps; ++step) {
-      double simulation_gap = estimate_simulation_error(state);
+      simulation_gap = estimate_simulation_error(state);
       // Where the simulation's own error matters (dry friction), identify again with it in the
       // weights: values that fit the harmonic balance's error at a few tests (a stuck friction
       // joint) would misfit all the others.
@@ -246,7 +247,12 @@ public:
             jobs.push_back(
                 [&, name = j.name, t] { return consider_term(state, current, name, t); });
       if (o_.substructure_damping) jobs.push_back([&] { return consider_damping(state); });
-      std::vector<Outcome> outcomes = run_parallel(jobs);
+      if (jobs.empty()) {
+        out.stop_reason = "no candidate is left to try: every joint already has every term "
+                          "asked for, and the substructure's damping is not tried";
+        break;
+      }
+      std::vector<Outcome> outcomes = fem::parallel_map(jobs);
       std::vector<Candidate> ranking;
       std::vector<State> states;
       for (auto& [c, s] : outcomes) {
@@ -270,13 +276,13 @@ public:
         std::vector<std::function<State()>> refinements;
         for (std::size_t i : finalists)
           refinements.push_back([&, i] {
-            const auto sim = make_simulator(states[i].damping_scale, false);
+            if (states[i].damping_scale == current.scale) return refine(states[i], current);
+            const auto sim = make_simulator(states[i].damping_scale, false); // the damping scale
             return refine(states[i], *sim);
           });
-        std::vector<State> refined = run_parallel(refinements);
+        std::vector<State> refined = fem::parallel_map(refinements);
         for (std::size_t f = 0; f < finalists.size(); ++f) {
           const std::size_t i = finalists[f];
-          if (!refined[f].converged) continue;
           states[i] = std::move(refined[f]);
           judge(ranking[i], states[i]);
         }
@@ -301,16 +307,16 @@ public:
       if (step == 0) out.diagnosis = diagnose(state, ranking);
 
       std::optional<std::size_t> chosen;
-      double cv_now = -1.0;
+      std::optional<double> cv_now; // < 0: the folds cannot be identified
       for (std::size_t i : order) {
         Candidate& c = ranking[i];
         if (!c.rejected.empty()) continue;
-        if (cv_now < 0.0) cv_now = cross_validated(state.joints, state.damping_scale);
+        if (!cv_now) cv_now = cross_validated(state.joints, state.damping_scale);
         c.cv_gap = cross_validated(states[i].joints, states[i].damping_scale);
-        if (cv_now >= 0.0 && c.cv_gap >= 0.0 && !(c.cv_gap < cv_now)) {
+        if (*cv_now >= 0.0 && c.cv_gap >= 0.0 && !(c.cv_gap < *cv_now)) {
           c.rejected = fmt::format("does not predict held-out tests better (cross-validated "
                                    "gap {} vs {} now)",
-                                   number(c.cv_gap), number(cv_now));
+                                   number(c.cv_gap), number(*cv_now));
           continue;
         }
         chosen = i;
@@ -329,20 +335,19 @@ public:
       }
       s.added = ranking[*chosen];
       s.gap_before = state.gap;
-      s.cv_before = cv_now;
+      s.cv_before = cv_now.value_or(-1.0);
       s.cv_after = s.added.cv_gap;
       state = std::move(states[*chosen]);
+      simulation_gap = -1.0;
       s.gap_after = state.gap;
       s.finding = finding(s);
       values_fitted = true;
       out.steps.push_back(std::move(s));
       out.states.push_back(state);
-      if (step + 1 == o_.max_steps)
-        out.stop_reason = fmt::format("stopped after the maximum of {} steps", o_.max_steps);
     }
     if (out.stop_reason.empty())
       out.stop_reason = fmt::format("stopped after the maximum of {} steps", o_.max_steps);
-    out.simulation_gap = estimate_simulation_error(state);
+    out.simulation_gap = simulation_gap >= 0.0 ? simulation_gap : estimate_simulation_error(state);
     out.states.back() = state;
     if (noise_known_) out.noise_gap = noise_gap_;
     for (const auto& s : out.states) {
@@ -363,11 +368,6 @@ public:
   }
 
 private:
-  template <class T>
-  static std::vector<T> run_parallel(const std::vector<std::function<T()>>& jobs) {
-    return fem::parallel_map(jobs);
-  }
-
   int equation(const identify::Measurement& m, const std::string& what, const fem::NodeDof& at) {
     try {
       return dofs_.equation(at);
@@ -410,14 +410,13 @@ private:
                               tests_[i].frequency_hz, options);
     return s;
   }
-  // The same, kept for reuse (not for concurrent use: the candidates of a step share one made
-  // before they run).
+  // The same, kept for reuse: never evicted (a run makes a few: the model's damping, and each
+  // damping scale that was added or cross-validated), so references stay valid. Not for
+  // concurrent use: the candidates of a step share one made before they run.
   const Simulator& simulator(double scale, bool refined = false) {
     const int harmonics = o_.balance.harmonics * (refined ? 2 : 1);
     for (const auto& s : simulators_)
       if (s->scale == scale && s->harmonics == harmonics) return *s;
-    // Keep the model's own damping and the latest few scales.
-    if (simulators_.size() > 4) simulators_.erase(simulators_.begin() + 1);
     simulators_.push_back(make_simulator(scale, refined));
     return *simulators_.back();
   }
@@ -557,7 +556,7 @@ private:
     };
     for (int iteration = 0; iteration < 12; ++iteration) {
       J.setConstant(nan);
-      if (!jacobian()) return start;
+      if (!jacobian()) break; // keep what was reached
       const Eigen::MatrixXd A = J.transpose() * J;
       const Eigen::VectorXd g = J.transpose() * r;
       bool accepted = false;
@@ -582,41 +581,43 @@ private:
       }
       if (!accepted || gain < 1e-5) break; // a 0.001 % smaller misfit is no longer worth a step
     }
-    // Uncertainty at the optimum.
     J.setConstant(nan);
-    if (!jacobian()) return current;
+    // The fit of the values reached: intervals from the Jacobian there, or NaN (undetermined)
+    // when it cannot be formed or there is no redundancy.
     const int dof = values_ - static_cast<int>(p);
-    identify::FitResult fit = begin.fit;
-    if (dof > 0) {
+    const bool determined = jacobian() && dof > 0;
+    Eigen::MatrixXd C = Eigen::MatrixXd::Constant(p, p, nan);
+    double tq = nan;
+    if (determined) {
       double s2 = cost / dof;
       if (noise_known_) s2 = std::max(s2, 1.0);
-      const Eigen::MatrixXd C =
-          s2 * (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
-      const double tq = identify::student_t_quantile(0.975, dof);
-      std::size_t q = 0;
-      fit.joints.clear();
-      for (std::size_t j = 0; j < current.joints.size(); ++j) {
-        identify::JointEstimate je{current.joints[j].name, {}};
-        for (std::size_t t = 0; t < current.joints[j].terms.size(); ++t) {
-          identify::TermEstimate te;
-          te.term = current.joints[j].terms[t];
-          te.value = current.joints[j].values[t];
-          te.fixed = current.joints[j].fixed[t];
-          if (!te.fixed) {
-            te.std = std::sqrt(
-                std::max(C(static_cast<Eigen::Index>(q), static_cast<Eigen::Index>(q)), 0.0));
-            ++q;
-          }
-          te.ci_low = te.value - tq * te.std;
-          te.ci_high = te.value + tq * te.std;
-          je.terms.push_back(te);
-        }
-        fit.joints.push_back(std::move(je));
-      }
-      fit.equations = values_;
-      fit.unknowns = static_cast<int>(p);
-      fit.residual_relative = current.gap;
+      C = s2 * (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+      tq = identify::student_t_quantile(0.975, dof);
     }
+    identify::FitResult fit = begin.fit;
+    std::size_t q = 0;
+    fit.joints.clear();
+    for (std::size_t j = 0; j < current.joints.size(); ++j) {
+      identify::JointEstimate je{current.joints[j].name, {}};
+      for (std::size_t t = 0; t < current.joints[j].terms.size(); ++t) {
+        identify::TermEstimate te;
+        te.term = current.joints[j].terms[t];
+        te.value = current.joints[j].values[t];
+        te.fixed = current.joints[j].fixed[t];
+        if (!te.fixed) {
+          const auto qi = static_cast<Eigen::Index>(q++);
+          te.std = std::isfinite(C(qi, qi)) ? std::sqrt(std::max(C(qi, qi), 0.0)) : nan;
+        }
+        te.ci_low = te.value - tq * te.std;
+        te.ci_high = te.value + tq * te.std;
+        if (te.fixed) te.ci_low = te.ci_high = te.value;
+        je.terms.push_back(te);
+      }
+      fit.joints.push_back(std::move(je));
+    }
+    fit.equations = values_;
+    fit.unknowns = static_cast<int>(p);
+    fit.residual_relative = current.gap;
     current.fit = std::move(fit);
     return current;
   }
@@ -680,7 +681,15 @@ private:
     for (std::size_t i = 0; i < tests_.size(); ++i) {
       Eigen::MatrixXcd reference;
       double factor = 1.0;
-      if (i < exact.size() && exact[i].size() > 0) {
+      // Time integration from rest may settle on another branch than the measured one (a jump):
+      // a difference beyond 5 % of a fundamental is a different solution, not the harmonic
+      // balance's error, and the refined harmonic balance is the reference there.
+      bool same_branch = i < exact.size() && exact[i].size() > 0;
+      if (same_branch)
+        for (Eigen::Index j = 0; j < exact[i].cols(); ++j)
+          same_branch = same_branch &&
+                        std::abs(exact[i](1, j) - s.X[i](1, j)) <= 0.05 * std::abs(s.X[i](1, j));
+      if (same_branch) {
         reference = exact[i];
       } else {
         Eigen::MatrixXcd start = Eigen::MatrixXcd::Zero(fine.harmonics + 1, layout_.size());
@@ -742,7 +751,10 @@ private:
     for (std::size_t i = 0; i < tests_.size(); ++i)
       jobs.push_back([&, i]() -> Eigen::MatrixXcd {
         const auto& m = tests_[i];
+        // One force, a pure sine: what the integrator's load can be.
         if (force_eq_[i].size() != 1) return {};
+        for (Eigen::Index k = 0; k < drive_[i].rows(); ++k)
+          if (k != 1 && std::abs(drive_[i](k, 0)) > 0.0) return {};
         const Complex F1 = drive_[i](1, 0);
         fem::SteadyStateOptions o;
         o.steps_per_period = 1024;
@@ -759,7 +771,7 @@ private:
           X.row(k) *= std::pow(turn, k);
         return X;
       });
-    return run_parallel(jobs);
+    return fem::parallel_map(jobs);
   }
 
   // Test i's steady state: from the measured deformation first, else from the linear response
@@ -963,9 +975,7 @@ private:
     c.ci_low = std::exp(u - 1.96 * sigma_u);
     c.ci_high = std::exp(u + 1.96 * sigma_u);
     fill(c, st);
-    if (c.rejected.empty() && std::isfinite(sigma_u) && c.ci_low <= 1.0 && c.ci_high >= 1.0)
-      c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 1",
-                               number(c.ci_low), number(c.ci_high));
+    if (c.rejected.empty()) c.rejected = interval_problem(c);
     return {std::move(c), std::move(st)};
   }
 
@@ -976,12 +986,18 @@ private:
     if (c.term) take_fit(c, s.fit, c.joint, *c.term);
     fill(c, s);
     if (c.rejected.empty()) c.rejected = physical_problem(s.joints);
-    if (c.rejected.empty() && c.term && c.ci_low <= 0.0 && c.ci_high >= 0.0)
-      c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 0",
-                               number(c.ci_low), number(c.ci_high));
-    if (c.rejected.empty() && !c.term && !c.refit && c.ci_low <= 1.0 && c.ci_high >= 1.0)
-      c.rejected = fmt::format("not significant: its 95 % interval [{}, {}] holds 1",
-                               number(c.ci_low), number(c.ci_high));
+    if (c.rejected.empty() && !c.refit) c.rejected = interval_problem(c);
+  }
+
+  // An addition must be determined: its 95 % interval known and clear of 0 (a term) or of 1
+  // (the damping scale).
+  static std::string interval_problem(const Candidate& c) {
+    const double none = c.term ? 0.0 : 1.0;
+    if (!std::isfinite(c.ci_low) || !std::isfinite(c.ci_high))
+      return "not determined: its 95 % interval could not be estimated";
+    if (c.ci_low > none || c.ci_high < none) return {};
+    return fmt::format("not significant: its 95 % interval [{}, {}] holds {}", number(c.ci_low),
+                       number(c.ci_high), none);
   }
 
   void fill(Candidate& c, const State& s) const {
@@ -1028,7 +1044,7 @@ private:
         return S;
       });
     double S = 0.0;
-    for (double part : run_parallel(jobs)) {
+    for (double part : fem::parallel_map(jobs)) {
       if (part < 0.0) return -1.0;
       S += part;
     }
@@ -1130,7 +1146,7 @@ private:
         }
         return c;
       });
-    std::vector<ResponseCurve> both = run_parallel(jobs);
+    std::vector<ResponseCurve> both = fem::parallel_map(jobs);
     for (std::size_t g = 0; g < both.size(); g += 2) {
       const ResponseCurve& up = both[g];
       ResponseCurve& down = both[g + 1];
@@ -1209,13 +1225,14 @@ private:
     d.even_harmonics = any_harmonics && even > 5.0 * even_noise && (noise_known_ || even > 1e-3);
 
     // Best admissible-looking candidates of each family (by how much of the gap they explain).
+    // The best of a family by the criterion (the rule that adds terms), and its share.
     auto best = [&](auto&& keep) {
-      double share = 0.0;
       const Candidate* who = nullptr;
       for (const auto& c : ranking)
-        if (c.converged && std::isfinite(c.gap) && keep(c) && c.explained > share)
-          share = c.explained, who = &c;
-      return std::pair{share, who};
+        if (c.converged && std::isfinite(c.criterion) && keep(c) &&
+            (!who || c.criterion < who->criterion))
+          who = &c;
+      return std::pair{who ? std::max(who->explained, 0.0) : 0.0, who};
     };
     const auto [lin, lin_c] = best([](const Candidate& c) { return c.linear(); });
     const auto [non, non_c] = best([](const Candidate& c) { return !c.linear(); });

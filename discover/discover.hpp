@@ -10,29 +10,33 @@
 ///
 ///     gap = sqrt( Σ |X_meas − X_sim|² / Σ |X_meas|² )       (sums over tests, channels, k)
 ///
-/// The noise gap is what a perfect model would leave, sqrt(Σ E|δX|² / Σ |X_meas|²), with
-/// E|δX|² the noise variance of each measured harmonic that identify::measure estimates from
-/// the record itself; it is unknown for stepped-sine tables. "Explains p % of the gap" means
-/// the squared gap falls by p %.
+/// The noise level is what a perfect model would leave: the same formula with the variance of
+/// each measured harmonic (identify::measure estimates it from the record itself) plus that of
+/// the measured force's noise propagated through the model; it is unknown for stepped-sine
+/// tables. The simulation's own error is measured at every step: against time integration with
+/// exact stick–slip where the model has dry friction and the substructure is a finite element
+/// model (the harmonic balance of a discontinuous force converges slowly), else against the
+/// harmonic balance with twice the harmonics. χ² weighs each compared value by the sum of these
+/// variances. "Explains p % of the gap" means the squared gap falls by p %.
 ///
-/// **The loop.** Terms without values are identified first (with all tests). Then, while the
-/// gap is above the noise level, every candidate — each term of the library at each joint that
-/// lacks it, and a scale factor on the substructure's damping (a linear model error) — is added
-/// in turn, every non-fixed term is identified again (identify::fit, the equation-error least
-/// squares of METHOD.md), and all tests are re-simulated. A candidate may be added only if
+/// **The loop.** Terms without values are identified first (with all tests: equation error,
+/// then output error). Then, while the gap is above the noise level, every candidate — each term
+/// of the library at each joint that lacks it, and a scale factor on the substructure's damping
+/// (a linear model error) — is added in turn, every non-fixed term identified again by equation
+/// error (identify::fit, METHOD.md), all tests re-simulated; the best `finalists` by the
+/// criterion are identified again by output error (Levenberg–Marquardt on the weighted
+/// re-simulation residual). A candidate may be added only if
 ///  1. every re-simulation converged and its value is physical (no negative damping),
-///  2. its 95 % interval excludes 0,
+///  2. its 95 % interval is known and excludes 0 (the damping scale: 1),
 ///  3. it lowers the Bayesian information criterion — with known noise χ² + p ln N, else
 ///     N ln(S/N) + p ln N (S the squared gap, N real compared values, p identified
-///     parameters) — so an extra term must buy more than ln N in χ², and
+///     parameters) — so an extra term must buy more than ln N in χ²,
 ///  4. it explains at least min_explained (5 %) of the squared gap, and
-///  5. it predicts held-out tests better: the leave-one-test-out cross-validated gap falls.
-/// The admissible candidate with the lowest criterion is added; the loop stops when the gap is
-/// at the noise level (χ²/N within 3 standard deviations of 1), when no candidate is admissible,
-/// or after max_steps. (At the noise level: χ²/N within 3 standard deviations of 1, overall and
-/// for every compared harmonic on its own.) χ² weighs each value by the variance of its noise plus
-/// that of the simulation's own error, estimated at every step by solving the current model again
-/// with twice the harmonics (the harmonic balance of dry friction converges slowly).
+///  5. it predicts held-out tests better: the cross-validated gap (leave one test out, or
+///     `folds` folds above 30 tests) falls.
+/// The admissible candidate with the lowest criterion is added. The loop stops at the noise
+/// level — χ²/N at most 3 standard deviations (3 √(2/N)) above 1, overall and for every compared
+/// harmonic on its own — when no candidate is admissible, or after max_steps.
 #include "frf/harmonic_balance.hpp"
 #include "frf/substructure.hpp"
 #include "identify/fit.hpp"
@@ -58,7 +62,7 @@ struct Options {
   /// An addition must explain at least this share of the squared gap: below it, what it fits is
   /// as likely the simulation's or the measurement's own systematic error as a joint effect.
   double min_explained = 0.05;
-  /// Leave-one-test-out cross-validation above this many tests uses this many folds instead.
+  /// Cross-validation leaves one test out up to 30 tests, and uses this many folds above.
   int folds = 10;
   /// Candidates refined by output error at each step (the best by the equation-error screen).
   int finalists = 3;
@@ -153,6 +157,7 @@ struct Diagnosis {
 
 struct Result {
   int tests = 0, compared_values = 0;
+  double min_explained = 0.0;           ///< Options::min_explained of the run
   std::vector<std::string> start_notes; ///< what was identified to start
   std::vector<State> states;            ///< [0] the start, [i] after step i
   std::vector<Step> steps;

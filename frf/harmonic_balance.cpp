@@ -215,7 +215,17 @@ bool newton(const Equations& P, Eigen::VectorXd& z, double load, const HarmonicB
     ++iterations;
     res_norm = r.norm() / std::max(P.norm(z), 1e-300);
     if (res_norm < o.tolerance) return true;
-    const Eigen::VectorXd step = J.partialPivLu().solve(-r);
+    // A friction joint stuck for the whole period leaves its mean position and mean force a
+    // one-parameter family: J is singular. Take the least-norm step there.
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
+    Eigen::VectorXd step;
+    if (lu.isInvertible()) {
+      step = lu.solve(-r);
+    } else {
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(J);
+      cod.setThreshold(1e-13);
+      step = cod.solve(-r);
+    }
     double t = 1.0;
     bool improved = false;
     for (int ls = 0; ls < 30; ++ls, t *= 0.5) {

@@ -13,6 +13,13 @@
 
 namespace jointid::frf {
 
+/// The band of modes a synthesis needs for excitation up to f_max_hz with harmonics 0 … K: the
+/// modes below twice the highest harmonic's frequency, the residual flexibility standing in for
+/// those above (used for finite element models above the dense limit).
+inline double synthesis_band_hz(double f_max_hz, int harmonics) {
+  return 2.0 * harmonics * f_max_hz;
+}
+
 class Substructure {
 public:
   /// Validates and assembles (throws std::invalid_argument for an invalid model).

@@ -252,6 +252,34 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   return out;
 }
 
+FitResult fit(const frf::Substructure& sub, const std::vector<joints::Joint>& joints,
+              const std::vector<Measurement>& measurements, const FitOptions& o) {
+  if (measurements.empty()) throw std::invalid_argument("identify: no tests");
+  if (o.harmonics.empty()) throw std::invalid_argument("identify: no harmonics asked");
+  // DOFs the model lacks are left out here: spectrum() names them with their test.
+  std::vector<int> dofs = joint_dof_set(joints, sub.dofs());
+  double f_max = 0.0;
+  for (const auto& m : measurements) {
+    f_max = std::max(f_max, m.frequency_hz);
+    for (const auto& at : m.force_at)
+      if (sub.dofs().state(at) == fem::DofMap::State::free) {
+        const int e = sub.dofs().equation(at);
+        if (std::find(dofs.begin(), dofs.end(), e) == dofs.end()) dofs.push_back(e);
+      }
+  }
+  const int K = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
+  std::vector<std::string> notes;
+  const frf::ModalSynthesis synthesis =
+      sub.synthesis(dofs, frf::synthesis_band_hz(f_max, K), &notes);
+  const ReceptanceFn H = [&synthesis](double omega, std::span<const int> rows,
+                                      std::span<const int> cols) {
+    return synthesis.receptance(omega, rows, cols);
+  };
+  FitResult result = fit(H, sub.dofs(), joints, measurements, o);
+  result.warnings.insert(result.warnings.end(), notes.begin(), notes.end());
+  return result;
+}
+
 MeasureOptions measure_options(const FitOptions& o) {
   MeasureOptions m;
   m.harmonics = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));

@@ -8,6 +8,7 @@
 /// columns of Q scaled to unit norm, and solved by SVD.
 #include "fem/dof_map.hpp"
 #include "frf/receptance.hpp"
+#include "frf/substructure.hpp"
 #include "identify/measurement.hpp"
 #include "identify/record.hpp"
 #include "joints/joint.hpp"
@@ -100,6 +101,13 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
               const std::vector<joints::Joint>& joints, const std::vector<Record>& records,
               const FitOptions& options = {});
+
+/// The whole pipeline for a substructure: its receptance over the joints' DOFs and the tests'
+/// force DOFs, for the tests' frequencies and the harmonics asked (frf::Substructure::synthesis),
+/// then fit(). What the synthesis leaves out (modes without residual flexibility) is added to
+/// the result's warnings.
+FitResult fit(const frf::Substructure& substructure, const std::vector<joints::Joint>& joints,
+              const std::vector<Measurement>& measurements, const FitOptions& options = {});
 
 /// The options measure() needs for a fit with these options.
 MeasureOptions measure_options(const FitOptions& options);

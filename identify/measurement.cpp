@@ -132,8 +132,9 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
     fail("harmonic " + std::to_string(K) + " (" + std::to_string(K * m.frequency_hz) +
          " Hz) is at or above the Nyquist frequency of the sampling (" + std::to_string(nyquist) +
          " Hz): sample faster, or ask fewer harmonics");
-  if (n < 2 * (K + 1) * 4)
-    fail("too few samples per period to resolve harmonic " + std::to_string(K));
+  if (n < 2 * K + 1)
+    fail("its whole periods hold " + std::to_string(n) +
+         " samples, too few to fit harmonics 0 to " + std::to_string(K));
 
   // The span analysed: the synchronous average of the periods when a period holds a whole
   // number of samples, else the whole periods as they are.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -36,24 +37,26 @@ std::string describe(const joints::Joint& j) {
   return text;
 }
 
-// The derivative of a periodic signal sampled uniformly over whole periods, from its
-// harmonics below the Nyquist frequency.
+// The derivative of a periodic signal sampled uniformly over whole periods, from the harmonics
+// of its period (below the Nyquist frequency).
 Eigen::VectorXd periodic_derivative(const Eigen::VectorXd& x, double omega, int periods) {
   const auto n = x.size();
   const auto per = n / periods; // samples per period
-  const auto K = (per - 1) / 2;
-  Eigen::VectorXd dx = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 1; k <= K; ++k) {
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(per);
+  for (int p = 0; p < periods; ++p)
+    mean += x.segment(p * per, per) / periods;
+  Eigen::VectorXd dx = Eigen::VectorXd::Zero(per);
+  for (Eigen::Index k = 1; k <= (per - 1) / 2; ++k) {
     const double step = two_pi * static_cast<double>(k) / static_cast<double>(per);
     std::complex<double> X = 0.0;
-    for (Eigen::Index i = 0; i < n; ++i)
-      X += x(i) * std::polar(1.0, -step * static_cast<double>(i % per));
+    for (Eigen::Index i = 0; i < per; ++i)
+      X += mean(i) * std::polar(1.0, -step * static_cast<double>(i));
     const std::complex<double> D = std::complex<double>(0.0, static_cast<double>(k) * omega) * X *
-                                   (2.0 / static_cast<double>(n));
-    for (Eigen::Index i = 0; i < n; ++i)
-      dx(i) += (D * std::polar(1.0, step * static_cast<double>(i % per))).real();
+                                   (2.0 / static_cast<double>(per));
+    for (Eigen::Index i = 0; i < per; ++i)
+      dx(i) += (D * std::polar(1.0, step * static_cast<double>(i))).real();
   }
-  return dx;
+  return dx.replicate(periods, 1);
 }
 
 } // namespace
@@ -198,22 +201,45 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
       f_max = std::max(f_max, p.frequency_hz);
     std::vector<std::string> notes;
     const frf::ModalSynthesis synthesis =
-        sub.synthesis(outputs, 4.0 * o.balance.harmonics * f_max, &notes);
-    for (const auto& plan : plans) {
-      const frf::HarmonicBalanceResult hb =
-          frf::harmonic_balance(synthesis, joints, dofs, force_equation, plan.amplitude,
-                                plan.frequency_hz, outputs, o.balance);
+        sub.synthesis(outputs, frf::synthesis_band_hz(f_max, o.balance.harmonics), &notes);
+    // Each force level swept up in frequency, every solution the next one's start (a hardening
+    // joint's response has a fold that a solve from the linear response can miss).
+    std::vector<std::size_t> order(plans.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+      order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return std::pair(plans[a].amplitude, plans[a].frequency_hz) <
+             std::pair(plans[b].amplitude, plans[b].frequency_hz);
+    });
+    std::vector<std::optional<SimulatedTest>> done(plans.size());
+    std::optional<Eigen::MatrixXcd> previous;
+    double previous_amplitude = -1.0;
+    for (std::size_t i : order) {
+      const SineTestPlan& plan = plans[i];
+      if (plan.amplitude != previous_amplitude) previous.reset();
+      previous_amplitude = plan.amplitude;
+      const frf::HarmonicBalance problem(synthesis, joints, dofs, {force_equation}, outputs,
+                                         plan.frequency_hz, o.balance);
+      const Eigen::MatrixXcd F = frf::sine_force(plan.amplitude);
+      frf::HarmonicBalanceResult hb = problem.solve(joints, F, previous ? &*previous : nullptr);
+      if (!hb.converged && previous) hb = problem.solve(joints, F);
+      if (!hb.converged)
+        throw std::runtime_error(fmt::format(
+            "harmonic balance at {} Hz, {} N: no periodic solution found (relative residual "
+            "{:.3g} after {} iterations); simulate this test by time integration",
+            compact(plan.frequency_hz), compact(plan.amplitude), hb.residual, hb.iterations));
+      previous = hb.Y;
       const int samples = o.periods * o.steps_per_period;
       const double h = 1.0 / (plan.frequency_hz * o.steps_per_period);
       const double omega = two_pi * plan.frequency_hz;
       Eigen::VectorXd t(samples), force(samples);
       Eigen::MatrixXd u(samples, nout), v(samples, nout);
-      for (int i = 0; i < samples; ++i) {
-        t(i) = i * h;
-        force(i) = plan.amplitude * std::sin(omega * t(i));
+      for (int n = 0; n < samples; ++n) {
+        t(n) = n * h;
+        force(n) = plan.amplitude * std::sin(omega * t(n));
         for (Eigen::Index j = 0; j < nout; ++j) {
-          u(i, j) = hb.displacement(static_cast<int>(j), t(i));
-          v(i, j) = hb.velocity(static_cast<int>(j), t(i));
+          u(n, j) = hb.displacement(static_cast<int>(j), t(n));
+          v(n, j) = hb.velocity(static_cast<int>(j), t(n));
         }
       }
       SimulatedTest test = make_test(plan, t, force, u, v);
@@ -222,19 +248,14 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
           synthesis.has_residual() ? "; modal synthesis with residual flexibility" : ""));
       for (const auto& note : notes)
         test.comments.push_back(note);
-      test.comments.push_back(fmt::format(
-          "harmonic balance: {} after {} iterations (relative residual {:.3g}); {} "
-          "periods sampled from the harmonics",
-          hb.converged ? "converged" : "NOT converged", hb.iterations, hb.residual, o.periods));
-      if (!hb.converged) {
-        const std::string what =
-            fmt::format("{}: the harmonic balance did not converge (relative residual {:.3g})",
-                        test.record.source, hb.residual);
-        test.comments.push_back("WARNING: " + what);
-        test.warnings.push_back(what);
-      }
-      out.push_back(std::move(test));
+      test.comments.push_back(fmt::format("harmonic balance: converged after {} iterations "
+                                          "(relative residual {:.3g}); {} periods sampled from "
+                                          "the harmonics",
+                                          hb.iterations, hb.residual, o.periods));
+      done[i] = std::move(test);
     }
+    for (auto& t : done)
+      out.push_back(std::move(*t));
   }
   return out;
 }

@@ -185,7 +185,8 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   md += fmt::format("; {} real values compared.\n\n", r.compared_values);
   md += "The **gap** is `sqrt(Σ|X_meas − X_sim|² / Σ|X_meas|²)` over every test, response channel "
         "and compared harmonic (all as displacements); the **noise level** is the gap a perfect "
-        "model would leave, from the noise the records themselves show.\n\n";
+        "model would leave, from the noise the records themselves show (the response's, and "
+        "the force's propagated through the model).\n\n";
   md += fmt::format("**Result.** {}\n\n",
                     r.diagnosis.findings.empty() ? std::string() : r.diagnosis.findings.back());
 
@@ -286,13 +287,14 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
 
   // The candidates of every step.
   md += "## Candidates\n\n";
-  md += "The gap after adding each candidate (every non-fixed term identified again, every test "
-        "re-simulated; equation-error estimates, the best few refined by output error), best first "
-        "by the information criterion; the dashed line is the gap before the step. A candidate may "
-        "be added only if it is admissible, lowers the "
-        "information criterion, explains at least 5 % of the squared gap and lowers the "
-        "cross-validated gap. Candidates that could not be simulated (e.g. negative friction) "
-        "are in the table only.\n\n";
+  md += fmt::format(
+      "The gap after adding each candidate (every non-fixed term identified again, every test "
+      "re-simulated; equation-error estimates, the best few refined by output error), best "
+      "first by the information criterion; the dashed line is the gap before the step. A "
+      "candidate may be added only if it is admissible, lowers the information criterion, "
+      "explains at least {} of the squared gap and lowers the cross-validated gap. Candidates "
+      "that could not be simulated (e.g. negative friction) are in the table only.\n\n",
+      pct(r.min_explained));
   struct Ranking {
     std::string title;
     const std::vector<discover::Candidate>* candidates;

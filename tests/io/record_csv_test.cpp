@@ -428,8 +428,8 @@ TEST_F(RecordCsvTest, ReadTestsRefusesAFileGivenTwice) {
 }
 
 TEST_F(RecordCsvTest, ReadTestsNamesAnUnknownFirstColumn) {
-  const auto path = write("# neither kind\n\nfrequency,f@7:uy.re,f@7:uy.im\n3.0,0.0,-1.0\n",
-                          "odd.csv");
+  const auto path =
+      write("# neither kind\n\nfrequency,f@7:uy.re,f@7:uy.im\n3.0,0.0,-1.0\n", "odd.csv");
   try {
     read_tests({path});
     FAIL() << "expected io::Error";
@@ -466,6 +466,85 @@ TEST_F(RecordCsvTest, ByteOrderMarkIsAccepted) {
   // Only at the very start: elsewhere the mark is part of a field.
   EXPECT_THROW(read_record(write(test::replaced(good_csv, "t,f@7", bom + "t,f@7"), "late.csv")),
                Error);
+}
+
+// A record at f Hz: force 80 sin ωt + f3 cos 3ωt, x = 1e-3 + Re(X1 e^{iωt}) + Re(X3 e^{3iωt})
+// and its velocity, `periods` periods of 200 samples.
+identify::Record harmonic_record(double f, std::complex<double> X1, int periods, bool excitation,
+                                 double f3) {
+  const std::complex<double> X3 = 0.05 * X1 * std::polar(1.0, 0.8);
+  const double w = 2.0 * std::numbers::pi * f;
+  identify::Record r;
+  r.source = "sine_" + std::to_string(f) + ".csv";
+  if (excitation) r.excitation_hz = f;
+  const int n = 200 * periods;
+  r.t.resize(n);
+  Eigen::VectorXd force(n), x(n), v(n);
+  for (int i = 0; i < n; ++i) {
+    const double t = i / (200.0 * f);
+    r.t(i) = t;
+    const std::complex<double> e1 = std::polar(1.0, w * t), e3 = std::polar(1.0, 3.0 * w * t);
+    force(i) = 80.0 * std::sin(w * t) + f3 * std::cos(3.0 * w * t);
+    x(i) = 1e-3 + (X1 * e1).real() + (X3 * e3).real();
+    v(i) = (std::complex<double>(0.0, w) * X1 * e1).real() +
+           (std::complex<double>(0.0, 3.0 * w) * X3 * e3).real();
+  }
+  r.channels.push_back({Quantity::force, {7, fem::Dof::uy}, force});
+  r.channels.push_back({Quantity::displacement, {7, fem::Dof::uy}, x});
+  r.channels.push_back({Quantity::velocity, {7, fem::Dof::uy}, v});
+  return r;
+}
+
+TEST_F(RecordCsvTest, SteppedSineTableFromRecordsHoldsTheFundamentals) {
+  // Whole periods, uniform sampling: the fundamental's fit is orthogonal to the mean and the
+  // third harmonic, so the table holds the known fundamentals to rounding (1e-12 relative).
+  // Without an excitation_hz the frequency is estimated from the force, here a pure sine (to
+  // ≈ 1e-8 relative; 1e-6 asserted as in the harmonics tests), which turns the phase by at most
+  // 2π · 3 periods · 1e-6: 1e-4 relative asserted on the values. (With a 5 % third harmonic
+  // in the force of this 3-period record the estimate is off by 5e-5: not tested here.)
+  const std::complex<double> X1a = std::polar(4e-3, 0.3), X1b = std::polar(9e-3, -2.0);
+  const std::vector<identify::Record> records{harmonic_record(2.5, X1a, 4, true, 4.0),
+                                              harmonic_record(3.7, X1b, 3, false, 0.0)};
+  const SteppedSineTable t = stepped_sine_table(records);
+  EXPECT_EQ(t.channels, (std::vector<std::string>{"f@7:uy", "x@7:uy", "v@7:uy"}));
+  ASSERT_EQ(t.freq_hz.size(), 2u);
+  EXPECT_EQ(t.freq_hz[0], 2.5);
+  EXPECT_NEAR(t.freq_hz[1], 3.7, 1e-6 * 3.7);
+  const double tol[2] = {1e-12, 1e-4};
+  const std::complex<double> X1[2] = {X1a, X1b};
+  for (Eigen::Index i = 0; i < 2; ++i) {
+    const double w = 2.0 * std::numbers::pi * (i == 0 ? 2.5 : 3.7);
+    EXPECT_LE(std::abs(t.values(i, 0) - std::complex<double>(0.0, -80.0)), tol[i] * 80.0) << i;
+    EXPECT_LE(std::abs(t.values(i, 1) - X1[i]), tol[i] * std::abs(X1[i])) << i;
+    EXPECT_LE(std::abs(t.values(i, 2) - std::complex<double>(0.0, w) * X1[i]),
+              tol[i] * w * std::abs(X1[i]))
+        << i;
+  }
+  // Through the file and back, the rows measure to what the records measure.
+  const auto path = write(stepped_sine_csv(t), "from_records.csv");
+  const auto tests = read_tests({path});
+  ASSERT_EQ(tests.size(), 2u);
+  const identify::Measurement row = identify::measure(tests[0]);
+  const identify::Measurement rec = identify::measure(records[0]);
+  EXPECT_LE(std::abs(row.X(1, 0) - rec.X(1, 0)), 1e-12 * std::abs(X1a));
+  EXPECT_LE(std::abs(row.F(1, 0) - rec.F(1, 0)), 1e-12 * 80.0);
+
+  // Channels must match; a record must hold a period.
+  std::vector<identify::Record> mixed = records;
+  mixed[1].channels.pop_back();
+  try {
+    stepped_sine_table(mixed);
+    FAIL() << "differing channels accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(mixed[1].source), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("channels differ"), std::string::npos) << e.what();
+  }
+  identify::Record short_record = records[0];
+  short_record.t.conservativeResize(100); // half a period
+  for (auto& c : short_record.channels)
+    c.samples.conservativeResize(100);
+  EXPECT_THROW(stepped_sine_table({short_record}), Error);
+  EXPECT_TRUE(stepped_sine_table({}).freq_hz.empty());
 }
 
 } // namespace
