@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <iostream>
 #include <numbers>
 #include <vector>
 
@@ -23,7 +22,8 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 
 joints::Joint make(std::string name, int node, int node_b, std::vector<Term> terms,
                    std::vector<double> values) {
-  joints::Joint j{std::move(name), node, node_b, Dof::uy, std::move(terms), std::move(values), {}, {}};
+  joints::Joint j{std::move(name),   node, node_b, Dof::uy, std::move(terms),
+                  std::move(values), {},   {}};
   j.fixed.assign(j.terms.size(), true);
   return j;
 }
@@ -233,7 +233,7 @@ TEST(HarmonicBalance, EvenTermAgreesWithTimeIntegration) {
   ASSERT_GT(std::abs(hb.X(2, 0)), 0.01 * std::abs(hb.X(1, 0)));
   // The mean is a static deflection against the joint: the joint pulls towards −y (k2 > 0).
   EXPECT_LT(hb.X(0, 0).real(), 0.0);
-  EXPECT_EQ(hb.Y(0, 0), hb.X(0, 0));
+  EXPECT_NEAR(hb.Y(0, 0).real(), hb.X(0, 0).real(), 1e-12 * std::abs(hb.X(1, 0)));
 
   const fem::SteadyState fine = integrate(c, js, F0, f, 2048);
   const fem::SteadyState finer = integrate(c, js, F0, f, 4096);
@@ -274,10 +274,11 @@ TEST(HarmonicBalance, ExactFrictionConvergesTowardsTimeIntegration) {
   struct Case {
     double F0, f, bound15, bound31;
     bool falls;
+    double bound_tanh;
   };
-  for (const Case& t : {Case{80.0, 5.0, 3.5e-4, 1.5e-4, true},
-                        Case{80.0, 2.5, 2.5e-4, 2.8e-4, false},
-                        Case{10.0, 3.0, 3e-2, 1.7e-2, true}}) {
+  for (const Case& t :
+       {Case{80.0, 5.0, 3.5e-4, 1.5e-4, true, 4e-4}, Case{80.0, 2.5, 2.5e-4, 2.8e-4, false, 1e-3},
+        Case{10.0, 3.0, 3e-2, 1.7e-2, true, 1.3e-2}}) {
     SCOPED_TRACE(std::to_string(t.F0) + " N at " + std::to_string(t.f) + " Hz");
     const double w = two_pi * t.f;
     const fem::SteadyState s = integrate(c, js, t.F0, t.f, 4096);
@@ -297,21 +298,20 @@ TEST(HarmonicBalance, ExactFrictionConvergesTowardsTimeIntegration) {
       EXPECT_LE(std::abs(friction1), 4.0 * 3.0 / std::numbers::pi * (1.0 + 1e-9));
       EXPECT_GT(std::abs(friction1), 0.5 * 4.0 * 3.0 / std::numbers::pi);
     }
-    std::cout << t.F0 << " " << t.f << " " << error[0] << " " << error[1] << "\n";
-    for (int K : {15, 31}) {
-      frf::HarmonicBalanceOptions o;
-      o.harmonics = K;
-      o.exact_friction = false;
-      for (double width : {1e-4, 1e-3, 1e-2}) {
-        o.friction_width = width;
-        const frf::HarmonicBalanceResult hb =
-            frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), t.F0, t.f, outputs, o);
-        std::cout << "   tanh K " << K << " width " << width << " conv " << hb.converged << " it " << hb.iterations << " err " << std::abs(hb.X(1, 0) - T1) / std::abs(T1) << "\n";
-      }
-    }
     EXPECT_LT(error[0], t.bound15);
     EXPECT_LT(error[1], t.bound31);
-    if (t.falls) EXPECT_LT(error[1], 0.75 * error[0]);
+    if (t.falls) {
+      EXPECT_LT(error[1], 0.75 * error[0]);
+    }
+    // Regularised friction (exact_friction = false, tanh(ẏ/1e-4 m/s)) still converges, with an
+    // error of the same kind (measured at K = 15: 2.6e-4, 6.2e-4, 7.9e-3; bounds 1.6 × that).
+    frf::HarmonicBalanceOptions o;
+    o.harmonics = 15;
+    o.exact_friction = false;
+    const frf::HarmonicBalanceResult hb =
+        frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), t.F0, t.f, outputs, o);
+    ASSERT_TRUE(hb.converged);
+    EXPECT_LT(std::abs(hb.X(1, 0) - T1) / std::abs(T1), t.bound_tanh);
   }
 }
 
@@ -374,36 +374,43 @@ TEST(HarmonicBalance, ProblemIsReusableForManyValuesAndLevels) {
   }
 }
 
-TEST(HarmonicBalance, RegularisedFrictionStillWorks) {
-  // exact_friction = false: sign(ẏ) ≈ tanh(ẏ/width), width 1e-4 m/s against a velocity
-  // amplitude ≈ 0.5 m/s at 80 N, 5 Hz (always sliding): the regularisation changes the force
-  // only while |ẏ| ≲ 3 width, ≈ 2e-4 of the period, so the result stays within the harmonic
-  // balance's own truncation error (2.1e-4 at K = 15, above) of the exact-friction solution:
-  // 5e-4 asserted. A wide regularisation (0.1 m/s) is a different, softer law: it must differ.
+TEST(HarmonicBalance, RegularisedFrictionFollowsItsLaw) {
+  // exact_friction = false: the joint force is k y + c ẏ + fc tanh(ẏ/width). With a wide
+  // width (0.1 m/s against a velocity amplitude ≈ 0.5 m/s) the law is smooth, its harmonics
+  // decay exponentially, and the 256-sample AFT is exact to rounding; so the solution's force
+  // harmonics G must equal those of the law evaluated independently on the solution's own
+  // motion, finely sampled (4096 samples): 1e-10 of |G1|. (Accuracy against time integration
+  // with the narrow default width is asserted above.)
   const PaperCantilever c;
+  const double fc = 3.0, width = 0.1, f = 5.0, w = two_pi * f;
   const std::vector<joints::Joint> js{
-      make("tip", 7, 0, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, 3.0})};
+      make("tip", 7, 0, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, fc})};
   const std::vector<int> outputs{c.eq(7)};
   frf::HarmonicBalanceOptions o;
   o.harmonics = 15;
-  const frf::HarmonicBalanceResult exact =
-      frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0, 5.0, outputs, o);
   o.exact_friction = false;
-  const frf::HarmonicBalanceResult smooth =
-      frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0, 5.0, outputs, o);
-  o.friction_width = 0.1;
-  const frf::HarmonicBalanceResult wide =
-      frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0, 5.0, outputs, o);
-  ASSERT_TRUE(exact.converged);
-  ASSERT_TRUE(smooth.converged);
-  ASSERT_TRUE(wide.converged);
-  const double X1 = std::abs(exact.X(1, 0));
-  std::cout << std::abs(smooth.X(1, 0) - exact.X(1, 0)) / X1 << " " << std::abs(wide.X(1, 0) - exact.X(1, 0)) / X1 << "\n";
-  EXPECT_LT(std::abs(smooth.X(1, 0) - exact.X(1, 0)), 5e-4 * X1);
-  EXPECT_GT(std::abs(wide.X(1, 0) - exact.X(1, 0)), 1e-2 * X1);
-  // A negative fc is not checked when regularised (it is just a negative coefficient).
+  o.friction_width = width;
+  const frf::HarmonicBalanceResult hb =
+      frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0, f, outputs, o);
+  ASSERT_TRUE(hb.converged);
+  const int N = 4096;
+  Eigen::VectorXd t(N), g(N);
+  for (int n = 0; n < N; ++n) {
+    t(n) = n / (f * N);
+    const double y = hb.displacement(0, t(n)), v = hb.velocity(0, t(n));
+    g(n) = 4800.0 * y + 20.0 * v + fc * std::tanh(v / width);
+  }
+  for (int k = 0; k <= 15; ++k)
+    EXPECT_LE(std::abs(harmonic(g, t, w, k) - hb.G(k, 0)), 1e-10 * std::abs(hb.G(1, 0)))
+        << "harmonic " << k;
+  // Odd law: no even harmonics.
+  EXPECT_LE(std::abs(hb.G(2, 0)), 1e-10 * std::abs(hb.G(1, 0)));
+  // A negative fc is only refused when friction is exact (regularised, it is a coefficient).
   std::vector<joints::Joint> negative = js;
   negative[0].values[2] = -1.0;
-  o.friction_width = 1e-4;
-  EXPECT_NO_THROW(frf::harmonic_balance(c.H, negative, c.system.dofs, c.eq(7), 80.0, 5.0, outputs, o));
+  EXPECT_NO_THROW(
+      frf::harmonic_balance(c.H, negative, c.system.dofs, c.eq(7), 80.0, f, outputs, o));
+  o.exact_friction = true;
+  EXPECT_THROW(frf::harmonic_balance(c.H, negative, c.system.dofs, c.eq(7), 80.0, f, outputs, o),
+               std::invalid_argument);
 }

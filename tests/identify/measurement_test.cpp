@@ -136,7 +136,8 @@ TEST(Measure, DisplacementVelocityOrAccelerationGiveTheSameDisplacementHarmonics
 }
 
 TEST(Measure, DisplacementIsPreferredToVelocityAndAcceleration) {
-  Record r = make_record(256, 2, {Quantity::acceleration, Quantity::velocity, Quantity::displacement});
+  Record r =
+      make_record(256, 2, {Quantity::acceleration, Quantity::velocity, Quantity::displacement});
   // Spoil the velocity and acceleration: the displacement channel must be the one used for X.
   r.channels[1].samples *= 3.0;
   r.channels[2].samples *= 3.0;
@@ -154,8 +155,7 @@ TEST(Measure, NoiseVarianceAndHarmonicVarianceAgreeWithMonteCarlo) {
   // estimates σ² without bias with (8 − 1)·256 = 1792 degrees of freedom.
   const int per = 256, periods = 8, n = per * periods, M = 1000;
   const double sx = 1e-5, sv = 2e-4, sf = 0.2;
-  const Record clean =
-      make_record(per, periods, {Quantity::displacement, Quantity::velocity});
+  const Record clean = make_record(per, periods, {Quantity::displacement, Quantity::velocity});
   std::mt19937_64 rng(2024);
   std::normal_distribution<double> normal;
   std::vector<Eigen::VectorXcd> X(M), F(M);
@@ -227,6 +227,41 @@ TEST(Measure, NoiseVarianceAndHarmonicVarianceAgreeWithMonteCarlo) {
   }
 }
 
+TEST(Measure, VarianceOfADisplacementDerivedFromVelocity) {
+  // Velocity only, with white noise σ_v: X_k = V_k/(ikω), so E|δX_k|² = 4σ_v²/n/(kω)²; the mean
+  // displacement is unknown (its variance NaN). Monte Carlo over M = 400 records: the sample
+  // variance of X_k is a χ² with 2(M − 1) degrees of freedom, relative standard deviation
+  // 1/√(M − 1) = 5 %: 4.5 of them, 23 % (a gain 1/(kω) instead of 1/(kω)² is off by ×ω² ≈ 250).
+  const int per = 256, periods = 8, n = per * periods, M = 400;
+  const double sv = 2e-4;
+  const Record clean = make_record(per, periods, {Quantity::velocity});
+  std::mt19937_64 rng(77);
+  std::normal_distribution<double> normal(0.0, sv);
+  std::vector<Eigen::VectorXcd> X(M);
+  for (int s = 0; s < M; ++s) {
+    Record r = clean;
+    for (int i = 0; i < n; ++i)
+      r.channels[1].samples(i) += normal(rng);
+    const Measurement m = measure(r, {.harmonics = 3});
+    X[s] = m.X.col(0);
+    EXPECT_TRUE(std::isnan(m.X_variance(0, 0)));
+    for (int k = 1; k <= 3; ++k)
+      ASSERT_NEAR(m.X_variance(k, 0),
+                  4.0 * m.channel_noise[0] * m.channel_noise[0] / n / std::pow(k * omega, 2),
+                  1e-12 * m.X_variance(k, 0));
+  }
+  for (int k = 1; k <= 3; ++k) {
+    cd mean = 0.0;
+    for (const auto& x : X)
+      mean += x(k) / static_cast<double>(M);
+    double v = 0.0;
+    for (const auto& x : X)
+      v += std::norm(x(k) - mean) / (M - 1);
+    const double analytic = 4.0 * sv * sv / n / std::pow(k * omega, 2);
+    EXPECT_NEAR(v / analytic, 1.0, 4.5 / std::sqrt(M - 1.0)) << k;
+  }
+}
+
 TEST(Measure, PeriodsAreAveragedOnlyForAWholeNumberOfSamplesPerPeriod) {
   const Measurement whole = measure(make_record(256, 8, {Quantity::displacement}));
   EXPECT_EQ(whole.periods_averaged, 8);
@@ -260,14 +295,14 @@ TEST(Measure, ResidualNoiseEstimateWithoutAveraging) {
 TEST(Measure, SteppedSineRowsConvertVelocityAndAcceleration) {
   const double f = 3.2, w = two_pi * f;
   const cd F(0.0, -40.0), Xa = std::polar(2e-3, -0.4), Xb = std::polar(5e-4, 1.1),
-           Xc = std::polar(7e-3, 2.9);
+                          Xc = std::polar(7e-3, 2.9);
   Phasors row;
   row.source = "table.csv:5";
   row.frequency_hz = f;
   row.channels = {{Quantity::force, tip, F},
-                  {Quantity::velocity, tip, cd(0.0, w) * Xa},          // V = iω X
-                  {Quantity::acceleration, mid, -w * w * Xb},           // A = (iω)² X
-                  {Quantity::acceleration, root, -w * w * Xc * 10.0},   // overridden by x below
+                  {Quantity::velocity, tip, cd(0.0, w) * Xa},         // V = iω X
+                  {Quantity::acceleration, mid, -w * w * Xb},         // A = (iω)² X
+                  {Quantity::acceleration, root, -w * w * Xc * 10.0}, // overridden by x below
                   {Quantity::displacement, root, Xc}};
   const Measurement m = measure(row, {.harmonics = 3});
   EXPECT_TRUE(m.fundamental_only);
@@ -277,9 +312,8 @@ TEST(Measure, SteppedSineRowsConvertVelocityAndAcceleration) {
     EXPECT_FALSE(m.has_harmonic(k)) << k;
   EXPECT_TRUE(m.has_harmonic(1));
   ASSERT_EQ(m.response_at, (std::vector<fem::NodeDof>{tip, mid, root}));
-  EXPECT_EQ(m.measured_as,
-            (std::vector<Quantity>{Quantity::velocity, Quantity::acceleration,
-                                   Quantity::displacement}));
+  EXPECT_EQ(m.measured_as, (std::vector<Quantity>{Quantity::velocity, Quantity::acceleration,
+                                                  Quantity::displacement}));
   // One complex division each: rounding only.
   const std::array<cd, 3> expected{Xa, Xb, Xc};
   for (int j = 0; j < 3; ++j) {
@@ -395,10 +429,11 @@ TEST(Measure, SteadyStateWarningIgnoresNoiseButNotGrowth) {
 }
 
 TEST(Measure, ManyTests) {
-  const std::vector<SineTest> tests{make_record(256, 2, {Quantity::displacement}),
-                                    Phasors{"t.csv:2", 3.0,
-                                            {{Quantity::force, tip, cd(0.0, -1.0)},
-                                             {Quantity::displacement, tip, cd(1e-3)}}}};
+  const std::vector<SineTest> tests{
+      make_record(256, 2, {Quantity::displacement}),
+      Phasors{"t.csv:2",
+              3.0,
+              {{Quantity::force, tip, cd(0.0, -1.0)}, {Quantity::displacement, tip, cd(1e-3)}}}};
   EXPECT_EQ(source_of(tests[0]), "synthetic.csv");
   EXPECT_EQ(source_of(tests[1]), "t.csv:2");
   const std::vector<Measurement> m = measure(tests, {.harmonics = 2});

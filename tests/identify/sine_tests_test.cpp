@@ -188,9 +188,8 @@ TEST(SimulateSineTests, AccelerationIsTheDerivativeOfTheVelocity) {
   const int eq = cantilever().dofs().equation(tip);
   const std::vector<int> outputs{eq};
   const frf::ModalSynthesis H = cantilever().synthesis(outputs, 100.0);
-  const frf::HarmonicBalanceResult hb =
-      frf::harmonic_balance(H, js, cantilever().dofs(), eq, plan.amplitude, plan.frequency_hz,
-                            outputs, o.balance);
+  const frf::HarmonicBalanceResult hb = frf::harmonic_balance(
+      H, js, cantilever().dofs(), eq, plan.amplitude, plan.frequency_hz, outputs, o.balance);
   ASSERT_TRUE(hb.converged);
   Eigen::VectorXd expected(r.t.size());
   for (Eigen::Index i = 0; i < r.t.size(); ++i) {
@@ -280,8 +279,7 @@ TEST(SimulateSineTests, ModalSubstructureNeedsHarmonicBalance) {
   SimulationOptions o;
   o.periods = 1;
   o.steps_per_period = 64;
-  const std::string e =
-      error_of([&] { simulate_sine_tests(sub, js, tip, {{3.0, 40.0}}, o); });
+  const std::string e = error_of([&] { simulate_sine_tests(sub, js, tip, {{3.0, 40.0}}, o); });
   EXPECT_NE(e.find("finite element model"), std::string::npos) << e;
   EXPECT_NE(e.find("harmonic balance"), std::string::npos) << e;
 
