@@ -278,38 +278,6 @@ void write_record(const std::filesystem::path& path, const identify::Record& rec
   write_file_atomically(path, record_csv(record, comments));
 }
 
-void check_record_channels(const identify::Record& record, const fem::DofMap& dofs,
-                           const std::vector<joints::Joint>& joints) {
-  auto fail = [&](const std::string& what) { throw Error(record.source + ": " + what); };
-  auto header = [&] {
-    std::string names = "t";
-    for (const auto& c : record.channels)
-      names += fmt::format(",{}", c.name());
-    return names;
-  };
-  const auto forces = record.all(identify::Quantity::force);
-  if (forces.empty())
-    fail("no force channel (expected a column such as f@7:uy; the header is " + header() + ")");
-  for (const identify::Channel* f : forces) {
-    try {
-      dofs.equation(f->at);
-    } catch (const std::invalid_argument& e) {
-      fail("channel " + f->name() + ": " + e.what() +
-           " (a force must act on a free DOF of the model)");
-    }
-  }
-  for (const auto& j : joints) {
-    for (int node : {j.node, j.node_b}) {
-      if (node == 0) continue;
-      const fem::NodeDof at{node, j.dof};
-      if (!record.find(identify::Quantity::displacement, at))
-        fail("no channel x@" + fem::to_string(at) + " for joint '" + j.name +
-             "' (identification needs the displacement at every joint DOF; the header is " +
-             header() + ")");
-    }
-  }
-}
-
 SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
   const CsvText csv = scan(path, "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im");
   const auto names = split_fields(csv.header.text);

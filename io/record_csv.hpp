@@ -35,12 +35,6 @@ std::string record_csv(const identify::Record& record,
 void write_record(const std::filesystem::path& path, const identify::Record& record,
                   const std::vector<std::string>& comments = {});
 
-/// Checks that a record holds what identification with these joints needs: a force channel
-/// at a free DOF of the model and a displacement channel at every joint DOF. Throws io::Error
-/// naming the record's file and the missing or misplaced channel.
-void check_record_channels(const identify::Record& record, const fem::DofMap& dofs,
-                           const std::vector<joints::Joint>& joints);
-
 /// Many sine tests reduced to their fundamentals.
 struct SteppedSineTable {
   std::vector<double> freq_hz;       ///< one per test, Hz

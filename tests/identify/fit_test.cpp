@@ -34,7 +34,6 @@ protected:
     model = test::paper_cantilever();
     system = fem::assemble(model);
     modes = fem::modal_analysis(system, {.num_modes = 0});
-    C = fem::damping_matrix(system, model.damping, &modes);
     std::vector<int> all(system.dofs.num_equations());
     for (int i = 0; i < system.dofs.num_equations(); ++i)
       all[i] = i;
@@ -45,75 +44,38 @@ protected:
   }
   int eq(int node) const { return system.dofs.equation({node, fem::Dof::uy}); }
 
-  // A steady-state record by time integration, channels at the joint DOFs and the force DOF.
+  // A steady-state record by time integration (the library's virtual sine test): force, x and v
+  // at the joint DOFs and the force DOF.
   identify::Record time_record(const std::vector<joints::Joint>& js, int force_node, double f,
                                double amp, int steps = 1024) const {
-    const joints::JointForces forces(js, system.dofs);
-    std::vector<int> out;
-    for (int n : record_nodes(js, force_node))
-      out.push_back(eq(n));
-    fem::SteadyStateOptions o;
+    identify::SimulationOptions o;
     o.steps_per_period = steps;
-    const fem::SteadyState s =
-        fem::steady_state(system, C, &forces, {eq(force_node), amp, f}, out, o);
-    EXPECT_EQ(s.status, fem::SteadyStateStatus::converged);
-    identify::Record r;
-    r.source = "ti_" + std::to_string(f);
-    r.t = s.t;
-    r.excitation_hz = f;
-    r.channels.push_back({identify::Quantity::force, {force_node, fem::Dof::uy}, s.force});
-    const auto nodes = record_nodes(js, force_node);
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      r.channels.push_back(
-          {identify::Quantity::displacement, {nodes[i], fem::Dof::uy}, s.u.col(i)});
-      r.channels.push_back({identify::Quantity::velocity, {nodes[i], fem::Dof::uy}, s.v.col(i)});
-    }
-    return r;
+    o.periods = 4;
+    return simulated(js, force_node, f, amp, o);
   }
 
   // The same record from harmonic balance (15 harmonics), sampled 512 times a period.
   identify::Record hb_record(const std::vector<joints::Joint>& js, int force_node, double f,
                              double amp) const {
-    const auto nodes = record_nodes(js, force_node);
-    std::vector<int> out;
-    for (int n : nodes)
-      out.push_back(eq(n));
-    const frf::HarmonicBalanceResult hb = frf::harmonic_balance(
-        *synthesis, js, system.dofs, eq(force_node), amp, f, out, {.harmonics = 15});
-    EXPECT_TRUE(hb.converged);
-    const int N = 512, periods = 2;
-    identify::Record r;
-    r.source = "hb_" + std::to_string(f);
-    r.excitation_hz = f;
-    r.t.resize(N * periods);
-    Eigen::VectorXd force(N * periods);
-    for (int i = 0; i < N * periods; ++i)
-      r.t(i) = i / (f * N), force(i) = amp * std::sin(two_pi * f * r.t(i));
-    r.channels.push_back({identify::Quantity::force, {force_node, fem::Dof::uy}, force});
-    for (std::size_t j = 0; j < nodes.size(); ++j) {
-      Eigen::VectorXd x(N * periods), v(N * periods);
-      for (int i = 0; i < N * periods; ++i)
-        x(i) = hb.displacement(j, r.t(i)), v(i) = hb.velocity(j, r.t(i));
-      r.channels.push_back({identify::Quantity::displacement, {nodes[j], fem::Dof::uy}, x});
-      r.channels.push_back({identify::Quantity::velocity, {nodes[j], fem::Dof::uy}, v});
-    }
-    return r;
+    identify::SimulationOptions o;
+    o.method = identify::SimulationMethod::harmonic_balance;
+    o.steps_per_period = 512;
+    o.periods = 2;
+    o.balance.harmonics = 15;
+    return simulated(js, force_node, f, amp, o);
   }
 
-  static std::vector<int> record_nodes(const std::vector<joints::Joint>& js, int force_node) {
-    std::vector<int> nodes{force_node};
-    auto add = [&](int n) {
-      if (n != 0 && std::find(nodes.begin(), nodes.end(), n) == nodes.end()) nodes.push_back(n);
-    };
-    for (const auto& j : js)
-      add(j.node), add(j.node_b);
-    return nodes;
+  identify::Record simulated(const std::vector<joints::Joint>& js, int force_node, double f,
+                             double amp, const identify::SimulationOptions& o) const {
+    auto tests = identify::simulate_sine_tests(frf::Substructure(model), js,
+                                               {force_node, fem::Dof::uy}, {{f, amp}}, o);
+    EXPECT_TRUE(tests.front().warnings.empty());
+    return std::move(tests.front().record);
   }
 
   fem::Model model;
   fem::Assembled system;
   fem::Modes modes;
-  fem::SparseMatrix C;
   std::optional<frf::ModalSynthesis> synthesis;
   identify::ReceptanceFn H;
 };
