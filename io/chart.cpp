@@ -1,6 +1,7 @@
 #include "io/chart.hpp"
 
 #include "io/vtk_display.hpp"
+#include "io/vtk_render.hpp"
 
 #include <vtkAxis.h>
 #include <vtkBrush.h>
@@ -145,25 +146,6 @@ void check_figure(const Figure& figure) {
 
 // ---------------------------------------------------------------------------------------------
 // Drawing
-
-class ErrorCatcher : public vtkCommand {
-public:
-  static ErrorCatcher* New() { return new ErrorCatcher; }
-  void Execute(vtkObject*, unsigned long, void* data) override {
-    message = data != nullptr ? static_cast<const char*>(data) : "unknown VTK error";
-  }
-  std::string message;
-};
-
-/// The message of a VTK error without its "ERROR: In file, line n" header and object address.
-std::string vtk_message(const std::string& text) {
-  std::string s = text;
-  const std::size_t start = s.find("): ");
-  if (start != std::string::npos) s = s.substr(start + 3);
-  while (!s.empty() && (s.back() == '\n' || s.back() == ' '))
-    s.pop_back();
-  return s;
-}
 
 /// Font sizes (pixels) of one chart panel, from its size.
 struct Fonts {
@@ -475,8 +457,6 @@ void render_figure(const fs::path& png, const Figure& figure) {
   window->SetOffScreenRendering(1);
   window->SetSize(figure.width, figure.height);
   window->SetMultiSamples(0);
-  vtkNew<ErrorCatcher> render_errors;
-  window->AddObserver(vtkCommand::ErrorEvent, render_errors);
 
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1.0, 1.0, 1.0);
@@ -500,41 +480,14 @@ void render_figure(const fs::path& png, const Figure& figure) {
     build_chart(scene, figure.charts[static_cast<std::size_t>(i)], rect);
   }
 
-  window->Render();
-  if (!render_errors->message.empty())
-    throw std::runtime_error("cannot render " + png.string() + ": " +
-                             vtk_message(render_errors->message));
-
-  // The picture, written next to the target and renamed: a failure never leaves half a file.
-  vtkNew<vtkWindowToImageFilter> capture;
-  capture->SetInput(window);
-  capture->SetInputBufferTypeToRGB();
-  capture->ReadFrontBufferOff();
-  capture->Update();
-  const fs::path tmp =
-      png.string() + ".tmp-" + std::to_string(std::random_device{}() % 1000000) + ".png";
-  vtkNew<vtkPNGWriter> writer;
-  vtkNew<ErrorCatcher> write_errors;
-  writer->AddObserver(vtkCommand::ErrorEvent, write_errors);
-  writer->SetFileName(tmp.c_str());
-  writer->SetInputConnection(capture->GetOutputPort());
-  writer->Write();
-  std::error_code ec;
-  if (!write_errors->message.empty() || !fs::is_regular_file(tmp, ec)) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error(
-        "cannot write " + png.string() + ": " +
-        (write_errors->message.empty() ? "PNG writer failed" : vtk_message(write_errors->message)));
-  }
-  fs::rename(tmp, png, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw std::runtime_error("cannot write " + png.string() + ": " + ec.message());
-  }
+  detail::render_to_png(window, png);
 }
 
 } // namespace
+
+std::array<int, 3> palette_color(std::size_t i) {
+  return palette[i % palette.size()];
+}
 
 void write_chart_png(const fs::path& png, const Figure& figure) {
   check_figure(figure);

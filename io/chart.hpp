@@ -41,6 +41,9 @@ struct Figure {
 /// values on a logarithmic axis (naming the chart and series).
 void write_chart_png(const std::filesystem::path& png, const Figure& figure);
 
+/// The i-th colour of the palette series get by default (Tableau 10, cycling), RGB 0–255.
+std::array<int, 3> palette_color(std::size_t i);
+
 /// True when a picture can be rendered here (an X display could be opened), else false and
 /// `why` says what is missing.
 bool can_render_charts(std::string* why = nullptr);

@@ -16,17 +16,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::array<std::array<int, 3>, 10> palette{{{31, 119, 180},
-                                                      {255, 127, 14},
-                                                      {44, 160, 44},
-                                                      {214, 39, 40},
-                                                      {148, 103, 189},
-                                                      {140, 86, 75},
-                                                      {227, 119, 194},
-                                                      {127, 127, 127},
-                                                      {188, 189, 34},
-                                                      {23, 190, 207}}};
-
 std::string g4(double v) {
   return std::isfinite(v) ? fmt::format("{:.4g}", v) : std::string("—");
 }
@@ -86,7 +75,7 @@ Chart response_chart(const std::vector<discover::Comparison>& list,
     measured.style = Series::Style::points;
     measured.width = 2.5;
     model.style = Series::Style::line;
-    measured.color = model.color = palette[g % palette.size()];
+    measured.color = model.color = palette_color(g);
     std::vector<std::pair<double, double>> pts;
     for (const auto* c : rows) {
       if (!up.empty() && nearest(*c) != g) continue;

@@ -1,6 +1,7 @@
 #include "io/vtk_output.hpp"
 
 #include "io/vtk_display.hpp"
+#include "io/vtk_render.hpp"
 
 #include <vtkActor.h>
 #include <vtkActor2D.h>
@@ -122,24 +123,6 @@ std::string frequency_text(double f_hz) {
 // VTK data sets and writers
 
 /// Records the last error a VTK object reports, instead of VTK printing it.
-class ErrorCatcher : public vtkCommand {
-public:
-  static ErrorCatcher* New() { return new ErrorCatcher; }
-  void Execute(vtkObject*, unsigned long, void* data) override {
-    message = data != nullptr ? static_cast<const char*>(data) : "unknown VTK error";
-  }
-  std::string message;
-};
-
-/// The message of a VTK error without its "ERROR: In file, line n" header and object address.
-std::string vtk_message(const std::string& text) {
-  std::string s = text;
-  const std::size_t start = s.find("): ");
-  if (start != std::string::npos) s = s.substr(start + 3);
-  while (!s.empty() && (s.back() == '\n' || s.back() == ' '))
-    s.pop_back();
-  return s;
-}
 
 vtkSmartPointer<vtkPoints> make_points(const Eigen::Matrix3Xd& x) {
   auto points = vtkSmartPointer<vtkPoints>::New();
@@ -185,7 +168,7 @@ vtkSmartPointer<vtkDoubleArray> vector_array(const std::string& name,
 
 void write_grid(vtkUnstructuredGrid* grid, const fs::path& path, bool binary) {
   vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  vtkNew<ErrorCatcher> errors;
+  vtkNew<detail::ErrorCatcher> errors;
   writer->AddObserver(vtkCommand::ErrorEvent, errors);
   writer->SetFileName(path.c_str());
   writer->SetInputData(grid);
@@ -200,7 +183,7 @@ void write_grid(vtkUnstructuredGrid* grid, const fs::path& path, bool binary) {
   if (writer->Write() != 1 || !errors->message.empty())
     throw std::runtime_error(
         "cannot write " + path.string() + ": " +
-        (errors->message.empty() ? "VTK writer failed" : vtk_message(errors->message)));
+        (errors->message.empty() ? "VTK writer failed" : detail::vtk_message(errors->message)));
 }
 
 void write_pvd(const fs::path& path, const std::vector<std::pair<double, std::string>>& frames) {
@@ -624,8 +607,6 @@ void render_modes_png(const fs::path& png, const fem::Model& model, const fem::D
   window->SetOffScreenRendering(1);
   window->SetSize(options.width, options.height);
   window->SetMultiSamples(0);
-  vtkNew<ErrorCatcher> render_errors;
-  window->AddObserver(vtkCommand::ErrorEvent, render_errors);
   vtkNew<vtkRenderer> background; // white behind everything, also where the grid has no panel
   background->SetBackground(1.0, 1.0, 1.0);
   window->AddRenderer(background);
@@ -661,38 +642,7 @@ void render_modes_png(const fs::path& png, const fem::Model& model, const fem::D
     window->AddRenderer(title);
   }
 
-  window->Render();
-  if (!render_errors->message.empty())
-    throw std::runtime_error("cannot render " + png.string() + ": " +
-                             vtk_message(render_errors->message));
-
-  // 4. The picture, written next to the target and renamed: a failure never leaves half a file.
-  vtkNew<vtkWindowToImageFilter> capture;
-  capture->SetInput(window);
-  capture->SetInputBufferTypeToRGB();
-  capture->ReadFrontBufferOff();
-  capture->Update();
-  const fs::path tmp =
-      png.string() + ".tmp-" + std::to_string(std::random_device{}() % 1000000) + ".png";
-  vtkNew<vtkPNGWriter> writer;
-  vtkNew<ErrorCatcher> write_errors;
-  writer->AddObserver(vtkCommand::ErrorEvent, write_errors);
-  writer->SetFileName(tmp.c_str());
-  writer->SetInputConnection(capture->GetOutputPort());
-  writer->Write();
-  std::error_code ec;
-  if (!write_errors->message.empty() || !fs::is_regular_file(tmp, ec)) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error(
-        "cannot write " + png.string() + ": " +
-        (write_errors->message.empty() ? "PNG writer failed" : vtk_message(write_errors->message)));
-  }
-  fs::rename(tmp, png, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw std::runtime_error("cannot write " + png.string() + ": " + ec.message());
-  }
+  detail::render_to_png(window, png);
 }
 
 } // namespace jointid::io
