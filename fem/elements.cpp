@@ -87,6 +87,12 @@ Matrix6 frame2d_mass(double rho_A, const Eigen::Vector2d& xa, const Eigen::Vecto
   return T.transpose() * frame2d_local_mass(rho_A, (xb - xa).norm(), lumped) * T;
 }
 
+Eigen::Vector3d frame3d_default_up(const Eigen::Vector3d& xa, const Eigen::Vector3d& xb) {
+  const Eigen::Vector3d ex = (xb - xa).normalized();
+  return ex.cross(Eigen::Vector3d::UnitZ()).norm() < 1e-6 ? Eigen::Vector3d::UnitX()
+                                                          : Eigen::Vector3d::UnitZ();
+}
+
 namespace {
 
 // Rows of the 3x3 direction-cosine matrix: local x, y, z expressed in global axes.
@@ -223,9 +229,10 @@ ElementMatrices element_matrices(const Model& model, const Element& e, const Eig
     return {frame2d_stiffness(mat.E * sec.A, mat.E * sec.Iz, a, b),
             frame2d_mass(rho_A, a, b, lumped)};
   }
-  case ElementType::frame3d:
-    return {frame3d_stiffness(mat, sec, xa, xb, e.up),
-            frame3d_mass(mat, sec, xa, xb, e.up, lumped)};
+  case ElementType::frame3d: {
+    const Eigen::Vector3d up = e.up.value_or(frame3d_default_up(xa, xb));
+    return {frame3d_stiffness(mat, sec, xa, xb, up), frame3d_mass(mat, sec, xa, xb, up, lumped)};
+  }
   }
   throw std::logic_error("unknown element type");
 }

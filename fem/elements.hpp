@@ -25,6 +25,11 @@ Matrix6 frame2d_stiffness(double EA, double EI, const Eigen::Vector2d& xa,
 Matrix6 frame2d_mass(double rho_A, const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
                      bool lumped);
 
+/// The `up` vector of a frame3d element that gives none: global +z (the local y axis then points
+/// upwards in the vertical plane through the member), or global +x for a member parallel to z
+/// (within 1e-6 rad), where +z cannot serve — the rule of SAP2000 and other frame programs.
+Eigen::Vector3d frame3d_default_up(const Eigen::Vector3d& xa, const Eigen::Vector3d& xb);
+
 /// Spatial frame element (axial EA, torsion GJ, bending EIz in the local x–y plane and EIy in
 /// the local x–z plane). `up` lies in the local x–y plane. Global DOFs, 6 per node.
 Matrix12 frame3d_stiffness(const Material& material, const Section& section,

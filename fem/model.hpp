@@ -44,8 +44,9 @@ struct Element {
   ElementType type = ElementType::beam;
   int material = 0; ///< index into Model::materials
   int section = 0;  ///< index into Model::sections
-  /// 3D frames: a vector in the element's local x–y plane (fixes the section axes).
-  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  /// 3D frames: a vector in the element's local x–y plane (fixes the section axes). Not given:
+  /// fem::frame3d_default_up — global +z, or +x for a member parallel to z.
+  std::optional<Eigen::Vector3d> up = std::nullopt;
 };
 
 struct Support {

@@ -637,12 +637,12 @@ private:
       const fem::ElementType type = parse_element_type(t);
       const int material = lookup(t, "material", material_index_);
       const int section = lookup(t, "section", section_index_);
-      Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+      std::optional<Eigen::Vector3d> up; // not given: fem::frame3d_default_up
       if (const auto* n = t.get("up")) {
         if (type != fem::ElementType::frame3d)
           t.fail_at(*n, "key 'up'", "only frame3d elements have an up vector");
         up = t.to_vector3(*n, "key 'up'");
-        if (!(up.norm() > 0.0)) t.fail_at(*n, "key 'up'", "expected a non-zero vector");
+        if (!(up->norm() > 0.0)) t.fail_at(*n, "key 'up'", "expected a non-zero vector");
       }
       // The elements it covers: "all" or a list of ids.
       const toml::node& which = t.need("elements", "\"all\" or a list of element ids");

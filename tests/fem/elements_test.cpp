@@ -290,6 +290,37 @@ TEST(Frame3dElement, UpParallelToAxisThrows) {
                std::invalid_argument);
 }
 
+TEST(Frame3dElement, DefaultUpIsVerticalExceptForVerticalMembers) {
+  const Eigen::Vector3d o = Eigen::Vector3d::Zero();
+  EXPECT_EQ(fem::frame3d_default_up(o, {2.0, 1.0, 0.5}), Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(fem::frame3d_default_up(o, {0.0, 0.0, 3.0}), Eigen::Vector3d::UnitX());
+  EXPECT_EQ(fem::frame3d_default_up({1.0, 1.0, 2.0}, {1.0, 1.0, -1.0}), Eigen::Vector3d::UnitX());
+  // Tilted by 1e-3 rad: +z still fixes the section axes (|ex × z| = 1e-3 ≫ 1e-6).
+  EXPECT_EQ(fem::frame3d_default_up(o, {1e-3, 0.0, 1.0}), Eigen::Vector3d::UnitZ());
+}
+
+TEST(ElementMatrices, AVerticalFrame3dMemberWithoutUpGetsTheDefault) {
+  // A column along z, no `up`: accepted, and equal to the same column with up = +x given.
+  fem::Model m;
+  m.dimension = 3;
+  m.materials.push_back({"steel", 210e9, 7850.0, 0.3});
+  m.sections.push_back({"tube", 1e-3, 2e-6, 3e-6, 4e-6});
+  m.nodes = {{1, Eigen::Vector3d::Zero()}, {2, Eigen::Vector3d(0.0, 0.0, 3.0)}};
+  m.elements.push_back({1, 1, 2, fem::ElementType::frame3d, 0, 0, std::nullopt});
+  const auto by_default = fem::element_matrices(m, m.elements[0]);
+  m.elements[0].up = Eigen::Vector3d::UnitX();
+  const auto given = fem::element_matrices(m, m.elements[0]);
+  EXPECT_EQ((by_default.K - given.K).norm(), 0.0);
+  EXPECT_EQ((by_default.M - given.M).norm(), 0.0);
+  // With up = +x the local y axis is global x: a tip force along global x bends the column in
+  // its local x–y plane (EIz), one along y in the x–z plane (EIy). Clamped at node 1, the tip
+  // compliances are L³/(3EIz) and L³/(3EIy).
+  const Eigen::Matrix<double, 6, 6> tip = by_default.K.block<6, 6>(6, 6).inverse();
+  const double L3 = 27.0, E = 210e9;
+  EXPECT_NEAR(tip(0, 0), L3 / (3.0 * E * 2e-6), 1e-9 * L3 / (3.0 * E * 2e-6));
+  EXPECT_NEAR(tip(1, 1), L3 / (3.0 * E * 3e-6), 1e-9 * L3 / (3.0 * E * 3e-6));
+}
+
 TEST(ElementMatrices, BeamMustRunAlongPositiveX) {
   fem::Model m = test::uniform_beam(1);
   m.nodes[1].x = Eigen::Vector3d(1.0, 1.0, 0.0);

@@ -160,7 +160,7 @@ TEST_F(ModelFileTest, ReadsASpatialFrame) {
   ASSERT_EQ(m.elements.size(), 2u);
   EXPECT_EQ(m.elements[0].type, fem::ElementType::frame3d);
   EXPECT_EQ(m.elements[0].up, Eigen::Vector3d(1.0, 0.0, 0.0));
-  EXPECT_EQ(m.elements[1].up, Eigen::Vector3d::UnitZ()); // default
+  EXPECT_FALSE(m.elements[1].up.has_value()); // not given: fem::frame3d_default_up
   EXPECT_TRUE(file.joints.empty());
 }
 
@@ -592,7 +592,7 @@ TEST_F(GmshModelTest, ReadsTheTableFrame) {
   int legs = 0;
   for (const auto& e : file.model.elements) {
     EXPECT_EQ(e.type, fem::ElementType::frame3d);
-    if (e.up == Eigen::Vector3d::UnitX()) ++legs;
+    if (e.up && *e.up == Eigen::Vector3d::UnitX()) ++legs;
   }
   EXPECT_EQ(legs, 4 * 8); // four 0.75 m legs meshed at 0.1 m
   EXPECT_EQ(file.model.supports.size(), 4u);
