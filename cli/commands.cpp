@@ -227,6 +227,15 @@ void identify(const IdentifyOptions& o) {
              "relative)\n",
              result.equations, result.unknowns, result.condition_number, result.residual_rms,
              result.residual_relative);
+  fmt::print("intervals: {}{}\n",
+             result.interval_method == "residual"
+                 ? "from the residual (the records' noise is unknown or negligible)"
+                 : "from the records' noise, propagated (generalised least squares)",
+             std::isfinite(result.chi2_per_dof)
+                 ? fmt::format("; chi2 per degree of freedom {:.3g}", result.chi2_per_dof)
+                 : std::string());
+  for (const auto& sentence : result.identifiability)
+    fmt::print("not determined: {}\n", sentence);
   fmt::print("wrote {}\n", o.output.string());
   for (const auto& w : result.warnings)
     warn(w);

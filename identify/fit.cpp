@@ -3,11 +3,14 @@
 #include "identify/harmonics.hpp"
 #include "identify/statistics.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -79,6 +82,8 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   // Basis functions on the measured deformation y = x(node) − x(node_b), i.e. Y = X2 B.
   const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
   const Eigen::MatrixXd Y = x2 * B, Ydot = v2 * B;
+  s.y.resize(n, static_cast<Eigen::Index>(joints.size()));
+  s.ydot.resize(n, static_cast<Eigen::Index>(joints.size()));
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const joints::Joint& j = joints[i];
     const Eigen::VectorXd y = Y.col(static_cast<Eigen::Index>(i));
@@ -102,6 +107,35 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
       for (Eigen::Index r = 0; r < n; ++r)
         g(r, static_cast<Eigen::Index>(term)) = joints::basis(j.terms[term], y(r), ydot(r));
     s.G.push_back(fit_harmonics(m.t, g, omega, K));
+    s.y.col(static_cast<Eigen::Index>(i)) = y;
+    s.ydot.col(static_cast<Eigen::Index>(i)) = ydot;
+  }
+
+  // The noise, per analysed sample (averaging P periods divides a sample's variance by P). A
+  // scatter below 1e-8 of a channel's amplitude is not measurement noise (a simulated record's
+  // periods agree to 1e-10): the noise is then taken as unknown.
+  const double P = m.periods_averaged;
+  s.t = m.t;
+  s.derived_harmonics = m.derived_harmonics;
+  s.noise_known = !m.fundamental_only;
+  auto meaningful = [](double sigma, double amplitude) {
+    return sigma > 1e-8 * amplitude && std::isfinite(sigma);
+  };
+  for (std::size_t i = 0; i < set2.size(); ++i) {
+    const int r = m.response_index(dofs.node_dof(set2[i]));
+    const Quantity q = m.measured_as[r];
+    const int power = q == Quantity::displacement ? 0 : q == Quantity::velocity ? 1 : 2;
+    s.x_power.push_back(power);
+    s.x_variance.push_back(std::pow(m.channel_noise[r], 2) / P);
+    s.v_variance.push_back(std::pow(m.velocity_noise[r], 2) / P);
+    // The channel's own amplitude: its displacement's fundamental times (ω)^power.
+    const double amplitude = std::abs(m.X(1, r)) * std::pow(omega, power);
+    s.noise_known = s.noise_known && meaningful(m.channel_noise[r], amplitude);
+  }
+  for (std::size_t f = 0; f < m.force_noise.size(); ++f) {
+    s.f_variance.push_back(m.force_noise[f] * m.force_noise[f] / P);
+    s.noise_known =
+        s.noise_known && meaningful(m.force_noise[f], std::abs(m.F(1, static_cast<Eigen::Index>(f))));
   }
   return s;
 }
@@ -114,6 +148,273 @@ FitResult::identified(const std::vector<joints::Joint>& model_joints) const {
       out[i].values[t] = joints[i].terms[t].value;
   return out;
 }
+
+namespace {
+
+using Complex = std::complex<double>;
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// One equation of Q b = p: a real or imaginary part of the complex equation of set-2 DOF d at
+// harmonic k of a test.
+struct Row {
+  int test, k, d;
+  bool imaginary;
+};
+
+// The receptances one test's equations at harmonic k use: H22 B (set-2 DOFs × joints) and H2f.
+struct Receptances {
+  frf::CMatrix H22B, H2f;
+};
+
+// Periodic signals over a test's analysed span (whole periods, uniform) and the spectral
+// operators that derive one from another: (ikω)^q on harmonics 1 … M.
+class Spectral {
+public:
+  Spectral(const Eigen::VectorXd& t, double omega, int M) : omega_(omega), M_(M) {
+    const auto N = t.size();
+    E_.resize(N, M);
+    for (Eigen::Index n = 0; n < N; ++n)
+      for (int k = 1; k <= M; ++k)
+        E_(n, k - 1) = std::polar(1.0, k * omega * t(n));
+  }
+  // (ikω)^q u for q ≠ 0 (the derivative q = 1, integrals q < 0; the mean dropped); u itself
+  // for q = 0.
+  Eigen::VectorXd apply(const Eigen::VectorXd& u, int q) const {
+    if (q == 0) return u;
+    const auto N = static_cast<double>(u.size());
+    Eigen::VectorXcd U = (2.0 / N) * (E_.adjoint() * u.cast<Complex>());
+    for (int k = 1; k <= M_; ++k)
+      U(k - 1) *= std::pow(Complex(0.0, k * omega_), q);
+    return (E_ * U).real();
+  }
+  // Its transpose: (ikω)^q is symmetric for even q and antisymmetric for odd q on whole
+  // periods of uniform samples.
+  Eigen::VectorXd apply_transposed(const Eigen::VectorXd& u, int q) const {
+    return (q % 2 == 0 ? 1.0 : -1.0) * apply(u, q);
+  }
+  // The variance of one sample of (ikω)^q applied to white noise of unit variance.
+  double gain(int q, Eigen::Index N) const {
+    if (q == 0) return 1.0;
+    double g = 0.0;
+    for (int k = 1; k <= M_; ++k)
+      g += std::pow(k * omega_, 2.0 * q);
+    return 2.0 * g / static_cast<double>(N);
+  }
+
+private:
+  Eigen::MatrixXcd E_; // N × M: e^{ikωt_n}
+  double omega_;
+  int M_;
+};
+
+// The covariance of one test's equations (its rows of Q b − p, in order) from the measurement
+// noise, at the joint values `joints`. Each row is linear in the noise of the analysed samples
+// of every channel: through the measured displacement X2 and force F, and through the basis
+// functions evaluated on the noisy deformation (δg = ∂g/∂y δy + ∂g/∂ẏ δẏ: errors in
+// variables). Dry friction's sign(ẏ) has no derivative: a sample whose rate is within the noise
+// of zero flips with probability Φ(−|ẏ|/σ), an independent variance 4 fc² p (1 − p) per sample.
+Eigen::MatrixXd equation_covariance(const TestSpectrum& ts, const std::vector<Row>& rows,
+                                    const std::map<int, Receptances>& at_k,
+                                    const std::vector<joints::Joint>& joints,
+                                    const Eigen::MatrixXd& B) {
+  const Eigen::Index N = ts.t.size(), n2 = B.rows(), nj = B.cols();
+  const double omega = two_pi * ts.frequency_hz;
+  const int M = std::max(ts.derived_harmonics, 1);
+  const Spectral op(ts.t, omega, M);
+  // The joints' force derivatives at the samples, and the friction flip variance.
+  Eigen::MatrixXd gy = Eigen::MatrixXd::Zero(N, nj), gv = gy, flip = gy;
+  for (Eigen::Index j = 0; j < nj; ++j) {
+    const auto& J = joints[static_cast<std::size_t>(j)];
+    // Variance of a sample of the joint's rate: its DOFs' velocity noise.
+    double var_rate = 0.0;
+    for (Eigen::Index d = 0; d < n2; ++d) {
+      if (B(d, j) == 0.0) continue;
+      const auto dd = static_cast<std::size_t>(d);
+      var_rate += B(d, j) * B(d, j) *
+                  (std::isfinite(ts.v_variance[dd]) ? ts.v_variance[dd]
+                                                    : ts.x_variance[dd] * op.gain(1 - ts.x_power[dd], N));
+    }
+    for (Eigen::Index n = 0; n < N; ++n) {
+      const double y = ts.y(n, j), v = ts.ydot(n, j);
+      for (std::size_t t = 0; t < J.terms.size(); ++t) {
+        if (joints::is_dry_friction(J.terms[t])) {
+          const double pflip = var_rate > 0.0 ? 0.5 * std::erfc(std::abs(v) / std::sqrt(2.0 * var_rate)) : 0.0;
+          flip(n, j) += 4.0 * J.values[t] * J.values[t] * pflip * (1.0 - pflip);
+        } else {
+          gy(n, j) += J.values[t] * joints::basis_dy(J.terms[t], y, v);
+          gv(n, j) += J.values[t] * joints::basis_dydot(J.terms[t], y, v);
+        }
+      }
+    }
+  }
+  // Noise sources, one block of N samples each: per set-2 DOF its displacement's channel, then
+  // the separately measured velocity channels, the force channels, and the friction flips.
+  const auto nf = static_cast<Eigen::Index>(ts.f_variance.size());
+  std::vector<Eigen::Index> v_block(static_cast<std::size_t>(n2), -1);
+  Eigen::Index blocks = n2;
+  for (Eigen::Index d = 0; d < n2; ++d)
+    if (std::isfinite(ts.v_variance[static_cast<std::size_t>(d)])) v_block[static_cast<std::size_t>(d)] = blocks++;
+  const Eigen::Index f_block = blocks, flip_block = blocks + nf;
+  blocks += nf + nj;
+  Eigen::VectorXd variance(blocks * N);
+  for (Eigen::Index d = 0; d < n2; ++d) {
+    const auto dd = static_cast<std::size_t>(d);
+    variance.segment(d * N, N).setConstant(ts.x_variance[dd]);
+    if (v_block[dd] >= 0) variance.segment(v_block[dd] * N, N).setConstant(ts.v_variance[dd]);
+  }
+  for (Eigen::Index f = 0; f < nf; ++f)
+    variance.segment((f_block + f) * N, N).setConstant(ts.f_variance[static_cast<std::size_t>(f)]);
+  for (Eigen::Index j = 0; j < nj; ++j)
+    variance.segment((flip_block + j) * N, N) = flip.col(j);
+
+  const auto nr = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(nr, blocks * N);
+  for (Eigen::Index r = 0; r < nr; ++r) {
+    const Row& row = rows[static_cast<std::size_t>(r)];
+    const Receptances& R = at_k.at(row.k);
+    // a_k(n) = (c_k / N) e^{−ikωt_n}: harmonic k of a signal is a_kᵀ u.
+    Eigen::VectorXcd a(N);
+    for (Eigen::Index n = 0; n < N; ++n)
+      a(n) = (row.k == 0 ? 1.0 : 2.0) / static_cast<double>(N) *
+             std::polar(1.0, -row.k * omega * ts.t(n));
+    auto part = [&](const Eigen::VectorXcd& w) -> Eigen::VectorXd {
+      return row.imaginary ? Eigen::VectorXd(w.imag()) : Eigen::VectorXd(w.real());
+    };
+    // Functionals on the displacement and velocity used at every set-2 DOF.
+    for (Eigen::Index d = 0; d < n2; ++d) {
+      Eigen::VectorXcd on_x = Eigen::VectorXcd::Zero(N), on_v = on_x;
+      for (Eigen::Index j = 0; j < nj; ++j) {
+        if (B(d, j) == 0.0) continue;
+        const Complex h = -R.H22B(row.d, j) * B(d, j);
+        on_x += h * a.cwiseProduct(gy.col(j).cast<Complex>());
+        on_v += h * a.cwiseProduct(gv.col(j).cast<Complex>());
+      }
+      if (d == row.d) on_x -= a; // − δX2
+      // Onto the channels: x = (ikω)^−p s, and v = (ikω)^(1−p) s unless measured on its own.
+      const auto dd = static_cast<std::size_t>(d);
+      const int p = ts.x_power[dd];
+      Eigen::VectorXd on_source = op.apply_transposed(part(on_x), -p);
+      if (v_block[dd] >= 0)
+        W.block(r, v_block[dd] * N, 1, N) += part(on_v).transpose();
+      else
+        on_source += op.apply_transposed(part(on_v), 1 - p);
+      W.block(r, d * N, 1, N) += on_source.transpose();
+    }
+    for (Eigen::Index f = 0; f < nf; ++f) // + H2f δF
+      W.block(r, (f_block + f) * N, 1, N) += part(R.H2f(row.d, f) * a).transpose();
+    for (Eigen::Index j = 0; j < nj; ++j) // − H22 B δg of the flips
+      W.block(r, (flip_block + j) * N, 1, N) += part(-R.H22B(row.d, j) * a).transpose();
+  }
+  return W * variance.asDiagonal() * W.transpose();
+}
+
+// The non-fixed terms of the joints, in the order of the unknowns: (joint, term).
+std::vector<std::pair<int, int>> unknowns_of(const std::vector<joints::Joint>& joints) {
+  std::vector<std::pair<int, int>> u;
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    for (std::size_t t = 0; t < joints[i].terms.size(); ++t)
+      if (!joints[i].fixed[t]) u.push_back({static_cast<int>(i), static_cast<int>(t)});
+  return u;
+}
+
+// What the tests leave undetermined, in words. `S` (unknowns × unknowns, scaled back) gives the
+// shape of the covariance: correlations come from S Sᵀ.
+std::vector<std::string> explain_identifiability(const FitResult& result,
+                                                 const std::vector<joints::Joint>& joints,
+                                                 const std::vector<std::pair<int, int>>& unknowns,
+                                                 const std::vector<TestSpectrum>& tests,
+                                                 const Eigen::MatrixXd& B, const Eigen::VectorXd& b,
+                                                 const Eigen::MatrixXd& S, const FitOptions& o) {
+  std::vector<std::string> out;
+  const auto nu = static_cast<Eigen::Index>(unknowns.size());
+  const Eigen::MatrixXd cov = S * S.transpose();
+  auto name = [&](Eigen::Index u) {
+    const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
+    return std::string(joints::term_name(joints[i].terms[t])) + " of '" + joints[i].name + "'";
+  };
+  auto estimate = [&](Eigen::Index u) -> const TermEstimate& {
+    const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
+    return result.joints[i].terms[t];
+  };
+  // Per joint and test: the fundamental of the deformation and of each term's force b_t g_t.
+  auto force_share = [&](Eigen::Index u, std::string& where) {
+    const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
+    double best = 0.0;
+    for (const auto& test : tests) {
+      if (test.G[i].rows() < 2) continue;
+      std::complex<double> total = 0.0;
+      for (std::size_t tt = 0; tt < joints[i].terms.size(); ++tt) {
+        const double value = joints[i].fixed[tt] ? joints[i].values[tt] : 0.0;
+        total += test.G[i](1, static_cast<Eigen::Index>(tt)) * value;
+      }
+      for (Eigen::Index v = 0; v < nu; ++v)
+        if (unknowns[static_cast<std::size_t>(v)].first == i)
+          total += test.G[i](1, unknowns[static_cast<std::size_t>(v)].second) * b(v);
+      const double share = std::abs(test.G[i](1, t) * b(u)) / std::max(std::abs(total), 1e-300);
+      if (share > best) best = share, where = test.source;
+    }
+    return best;
+  };
+  auto amplitude_range = [&](int joint, bool rate) {
+    double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+    for (const auto& test : tests) {
+      const std::complex<double> Y1 =
+          (test.X2.row(1) * B.col(joint).cast<std::complex<double>>())(0);
+      const double a = std::abs(Y1) * (rate ? two_pi * test.frequency_hz : 1.0);
+      lo = std::min(lo, a), hi = std::max(hi, a);
+    }
+    return std::pair{lo, hi};
+  };
+  for (Eigen::Index u = 0; u < nu; ++u) {
+    if (estimate(u).determined) continue;
+    std::string where;
+    const double share = force_share(u, where);
+    // The most correlated other unknown.
+    Eigen::Index partner = -1;
+    double corr = 0.0;
+    for (Eigen::Index v = 0; v < nu; ++v) {
+      if (v == u) continue;
+      const double c = cov(u, v) / std::sqrt(cov(u, u) * cov(v, v));
+      if (std::abs(c) > std::abs(corr)) corr = c, partner = v;
+    }
+    const std::string relative =
+        percent(estimate(u).std / std::max(std::abs(estimate(u).value), 1e-300));
+    if (share < 0.01) {
+      out.push_back(name(u) + " is not determined (std " + relative +
+                    " of its value): at most its force is " + percent(share) +
+                    " of the joint's (in " + where +
+                    "); tests at larger amplitudes would bring it out");
+    } else if (partner >= 0 && std::abs(corr) > 0.95) {
+      const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
+      const auto [pi, pt] = unknowns[static_cast<std::size_t>(partner)];
+      const auto nature = joints::term_info(joints[i].terms[t]).nature;
+      const bool same_joint = i == pi;
+      std::string why;
+      if (same_joint && nature == joints::term_info(joints[pi].terms[pt]).nature) {
+        const bool rate = nature == joints::Nature::dissipative;
+        const auto [lo, hi] = amplitude_range(i, rate);
+        if (hi < 1.3 * lo)
+          why = fmt::format("; all tests have about the same {} amplitude at '{}' ({:.3g} to "
+                            "{:.3g} {}): vary the force level",
+                            rate ? "velocity" : "displacement", joints[i].name, lo, hi,
+                            rate ? "m/s" : "m");
+      }
+      out.push_back(fmt::format("{} and {} are not separated by these tests: their estimates "
+                                "are {:.0f} % correlated (std {} of its value){}",
+                                name(u), name(partner), 100.0 * std::abs(corr), relative, why));
+    } else {
+      out.push_back(name(u) + " is poorly determined (std " + relative +
+                    " of its value, above the " + percent(o.poorly_determined) + " asked)");
+    }
+  }
+  if (result.condition_number > 1e8)
+    out.push_back(fmt::format("the equations are ill-conditioned (condition number {:.3g}): the "
+                              "smallest singular value is {:.3g} of the largest",
+                              result.condition_number, 1.0 / result.condition_number));
+  return out;
+}
+
+} // namespace
 
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
               const std::vector<joints::Joint>& joints, const std::vector<TestSpectrum>& tests,
@@ -135,37 +436,48 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     throw std::invalid_argument("identify: every joint term is fixed; nothing to identify");
   // B: set-2 position of each joint's node (+1) and node_b (−1).
   const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
+  auto name_of = [&](int u) {
+    const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
+    return std::string(joints::term_name(joints[i].terms[t])) + " of '" + joints[i].name + "'";
+  };
 
-  std::vector<Eigen::RowVectorXd> rows;
+  // 1. The equations, row by row, and what their noise covariance needs.
+  std::vector<Eigen::RowVectorXd> q_rows;
   std::vector<double> rhs;
-  for (const auto& test : tests) {
+  std::vector<Row> rows;
+  std::vector<std::map<int, Receptances>> receptances(tests.size());
+  for (std::size_t ti = 0; ti < tests.size(); ++ti) {
+    const auto& test = tests[ti];
     for (int k : o.harmonics) {
       if (test.fundamental_only && k != 1) continue;
       if (k < 0 || k >= test.F.rows())
         throw std::invalid_argument("identify: harmonic " + std::to_string(k) + " not extracted");
       const double w = two_pi * test.frequency_hz * k;
       const frf::CMatrix H22 = H(w, set2, set2), H2f = H(w, set2, test.force_equations);
+      receptances[ti][k] = {H22 * B.cast<Complex>(), H2f};
       frf::CVector R = test.X2.row(k).transpose() - H2f * test.F.row(k).transpose();
       frf::CMatrix Qc(n2, nu);
       for (int u = 0; u < nu; ++u) {
         const auto [i, t] = unknowns[u];
-        Qc.col(u) = -H22 * B.col(i).cast<frf::Complex>() * test.G[i](k, t);
+        Qc.col(u) = -H22 * B.col(i).cast<Complex>() * test.G[i](k, t);
       }
       for (std::size_t i = 0; i < joints.size(); ++i) // known terms go to the right-hand side
         for (std::size_t t = 0; t < joints[i].terms.size(); ++t)
           if (joints[i].fixed[t])
-            R += H22 * B.col(i).cast<frf::Complex>() * test.G[i](k, t) * joints[i].values[t];
+            R += H22 * B.col(i).cast<Complex>() * test.G[i](k, t) * joints[i].values[t];
       for (int d = 0; d < n2; ++d) {
-        rows.push_back(Qc.row(d).real());
+        q_rows.push_back(Qc.row(d).real());
         rhs.push_back(R(d).real());
+        rows.push_back({static_cast<int>(ti), k, d, false});
         if (k != 0) { // the mean has no imaginary part
-          rows.push_back(Qc.row(d).imag());
+          q_rows.push_back(Qc.row(d).imag());
           rhs.push_back(R(d).imag());
+          rows.push_back({static_cast<int>(ti), k, d, true});
         }
       }
     }
   }
-  const int m = static_cast<int>(rows.size());
+  const int m = static_cast<int>(q_rows.size());
   if (m < nu)
     throw std::invalid_argument(
         "identify: " + std::to_string(m) + " equations for " + std::to_string(nu) +
@@ -173,39 +485,92 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   Eigen::MatrixXd Q(m, nu);
   Eigen::VectorXd p(m);
   for (int r = 0; r < m; ++r)
-    Q.row(r) = rows[r], p(r) = rhs[r];
-  Eigen::VectorXd scale(nu);
-  for (int u = 0; u < nu; ++u) {
-    const double norm = Q.col(u).norm();
-    if (!(norm > 0.0)) {
-      const auto [i, t] = unknowns[u];
+    Q.row(r) = q_rows[static_cast<std::size_t>(r)], p(r) = rhs[static_cast<std::size_t>(r)];
+  for (int u = 0; u < nu; ++u)
+    if (!(Q.col(u).norm() > 0.0))
+      throw std::invalid_argument("identify: term " + name_of(u) +
+                                  " has no effect in these tests (its basis function is zero)");
+
+  // 2. Least squares of the column-scaled (and, with the noise, whitened) equations by SVD.
+  struct Solution {
+    Eigen::VectorXd b, scale, sv;
+    Eigen::MatrixXd V;
+    double condition = 0.0;
+  };
+  auto solve = [&](const Eigen::MatrixXd& A, const Eigen::VectorXd& y) {
+    Solution sol;
+    sol.scale.resize(nu);
+    for (int u = 0; u < nu; ++u)
+      sol.scale(u) = 1.0 / A.col(u).norm();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A * sol.scale.asDiagonal(),
+                                                Eigen::ComputeThinU | Eigen::ComputeThinV);
+    sol.sv = svd.singularValues();
+    sol.V = svd.matrixV();
+    sol.condition = sol.sv(nu - 1) > 0.0 ? sol.sv(0) / sol.sv(nu - 1)
+                                         : std::numeric_limits<double>::infinity();
+    if (!(sol.condition < 1e13)) {
+      Eigen::Index worst;
+      svd.matrixV().col(nu - 1).cwiseAbs().maxCoeff(&worst);
       throw std::invalid_argument(
-          "identify: term '" + std::string(joints::term_name(joints[i].terms[t])) + "' of joint '" +
-          joints[i].name + "' has no effect in these tests (its basis function is zero)");
+          "identify: the unknowns cannot be separated by these tests (condition number " +
+          std::to_string(sol.condition) + "); term " + name_of(static_cast<int>(worst)) +
+          " is a combination of the others: vary frequency and force level, or drop a term");
     }
-    scale(u) = 1.0 / norm;
+    sol.b = sol.scale.asDiagonal() * svd.solve(y);
+    return sol;
+  };
+  auto with_values = [&](const Eigen::VectorXd& b) {
+    std::vector<joints::Joint> js = joints;
+    for (int u = 0; u < nu; ++u)
+      js[static_cast<std::size_t>(unknowns[u].joint)].values[static_cast<std::size_t>(unknowns[u].term)] =
+          b(u);
+    return js;
+  };
+  Solution sol = solve(Q, p);
+
+  // 3. With the noise known everywhere: generalised least squares, its covariance at the
+  //    ordinary estimate first, then once more at the weighted one.
+  const bool propagated =
+      o.propagate_noise && std::all_of(tests.begin(), tests.end(),
+                                       [](const TestSpectrum& t) { return t.noise_known; });
+  std::vector<Eigen::LLT<Eigen::MatrixXd>> whiten(tests.size());
+  std::vector<std::vector<int>> test_rows(tests.size());
+  for (int r = 0; r < m; ++r)
+    test_rows[static_cast<std::size_t>(rows[static_cast<std::size_t>(r)].test)].push_back(r);
+  Eigen::MatrixXd Qw = Q;
+  Eigen::VectorXd pw = p;
+  if (propagated) {
+    for (int pass = 0; pass < 2; ++pass) {
+      const std::vector<joints::Joint> at = with_values(sol.b);
+      for (std::size_t ti = 0; ti < tests.size(); ++ti) {
+        const auto& idx = test_rows[ti];
+        if (idx.empty()) continue;
+        std::vector<Row> these;
+        for (int r : idx)
+          these.push_back(rows[static_cast<std::size_t>(r)]);
+        Eigen::MatrixXd C = equation_covariance(tests[ti], these, receptances[ti], at, B);
+        C.diagonal().array() += 1e-12 * C.diagonal().mean() + 1e-300;
+        whiten[ti].compute(C);
+        Eigen::MatrixXd Qi(static_cast<Eigen::Index>(idx.size()), nu);
+        Eigen::VectorXd pi(static_cast<Eigen::Index>(idx.size()));
+        for (std::size_t r = 0; r < idx.size(); ++r)
+          Qi.row(static_cast<Eigen::Index>(r)) = Q.row(idx[r]), pi(static_cast<Eigen::Index>(r)) = p(idx[r]);
+        Qi = whiten[ti].matrixL().solve(Qi);
+        pi = whiten[ti].matrixL().solve(pi);
+        for (std::size_t r = 0; r < idx.size(); ++r)
+          Qw.row(idx[r]) = Qi.row(static_cast<Eigen::Index>(r)), pw(idx[r]) = pi(static_cast<Eigen::Index>(r));
+      }
+      sol = solve(Qw, pw);
+    }
   }
-  const Eigen::MatrixXd Qs = Q * scale.asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Qs, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const Eigen::VectorXd& sv = svd.singularValues();
+
   FitResult out;
   out.warnings = std::move(warnings);
   out.equations = m;
   out.unknowns = nu;
-  out.condition_number =
-      sv(nu - 1) > 0.0 ? sv(0) / sv(nu - 1) : std::numeric_limits<double>::infinity();
-  if (!(out.condition_number < 1e13)) {
-    Eigen::Index worst;
-    svd.matrixV().col(nu - 1).cwiseAbs().maxCoeff(&worst);
-    const auto [i, t] = unknowns[worst];
-    throw std::invalid_argument(
-        "identify: the unknowns cannot be separated by these tests (condition number " +
-        std::to_string(out.condition_number) + "); term '" +
-        std::string(joints::term_name(joints[i].terms[t])) + "' of joint '" + joints[i].name +
-        "' is a combination of the others: vary frequency and force level, or drop a term");
-  }
-  const Eigen::VectorXd bs = svd.solve(p);
-  const Eigen::VectorXd b = scale.asDiagonal() * bs;
+  out.condition_number = sol.condition;
+  out.singular_values.assign(sol.sv.data(), sol.sv.data() + sol.sv.size());
+  const Eigen::VectorXd& b = sol.b;
   const Eigen::VectorXd residual = Q * b - p;
   out.residual_rms = std::sqrt(residual.squaredNorm() / m);
   out.residual_relative = residual.norm() / std::max(p.norm(), 1e-300);
@@ -214,11 +579,22 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
                            std::to_string(out.condition_number) +
                            "): parameters may be poorly determined");
   const int redundancy = m - nu;
-  const double sigma2 = redundancy > 0 ? residual.squaredNorm() / redundancy
-                                       : std::numeric_limits<double>::quiet_NaN();
-  const Eigen::MatrixXd Vs = svd.matrixV() * sv.cwiseInverse().asDiagonal();
-  const double tq = redundancy > 0 ? student_t_quantile(0.975, redundancy)
-                                   : std::numeric_limits<double>::quiet_NaN();
+  // The variance factor: the weighted residual's χ² per degree of freedom, at least 1 (a misfit
+  // beyond the noise widens the intervals, never narrows them); without the noise, the plain
+  // residual variance.
+  double factor = nan;
+  if (redundancy > 0) {
+    if (propagated) {
+      out.chi2_per_dof = (Qw * b - pw).squaredNorm() / redundancy;
+      factor = std::max(1.0, out.chi2_per_dof);
+    } else {
+      out.chi2_per_dof = nan;
+      factor = residual.squaredNorm() / redundancy;
+    }
+  }
+  out.interval_method = propagated ? "propagated noise" : "residual";
+  const Eigen::MatrixXd Vs = sol.V * sol.sv.cwiseInverse().asDiagonal();
+  const double tq = redundancy > 0 ? student_t_quantile(0.975, redundancy) : nan;
   if (redundancy == 0)
     out.warnings.push_back("as many equations as unknowns: no uncertainty estimate");
 
@@ -235,10 +611,11 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
         te.ci_low = te.ci_high = te.value;
       } else {
         te.value = b(u);
-        te.std = scale(u) * std::sqrt(sigma2 * Vs.row(u).squaredNorm());
+        te.std = sol.scale(u) * std::sqrt(factor * Vs.row(u).squaredNorm());
         te.ci_low = te.value - tq * te.std;
         te.ci_high = te.value + tq * te.std;
-        if (redundancy > 0 && te.std > o.poorly_determined * std::abs(te.value))
+        te.determined = !(redundancy > 0 && te.std > o.poorly_determined * std::abs(te.value));
+        if (!te.determined)
           out.warnings.push_back(
               "joint '" + joints[i].name + "', term '" + std::string(joints::term_name(te.term)) +
               "': poorly determined (std " +
@@ -249,6 +626,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     }
     out.joints.push_back(std::move(je));
   }
+  out.identifiability = explain_identifiability(out, joints, unknowns_of(joints), tests, B, b,
+                                                sol.scale.asDiagonal() * Vs, o);
   return out;
 }
 
@@ -284,6 +663,7 @@ MeasureOptions measure_options(const FitOptions& o) {
   MeasureOptions m;
   m.harmonics = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
   m.steady_tolerance = o.steady_tolerance;
+  m.average_periods = o.average_periods;
   return m;
 }
 

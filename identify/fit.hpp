@@ -33,15 +33,26 @@ struct FitOptions {
   double steady_tolerance = 1e-3;
   /// Warn when a parameter's standard deviation exceeds this fraction of its value.
   double poorly_determined = 0.05;
+  /// Where every test's noise is known (records of two or more whole periods), propagate it:
+  /// weight the equations by the covariance the noise gives them — through the measured
+  /// response and force, and through the basis functions evaluated on the noisy deformation
+  /// (errors in variables) — and take the intervals from it (generalised least squares). Else,
+  /// or when false, the intervals come from the residual of ordinary least squares.
+  bool propagate_noise = true;
+  /// measure(): average each record's periods before the basis functions (MeasureOptions).
+  bool average_periods = true;
 };
 
 struct TermEstimate {
   joints::Term term = joints::Term::k;
   double value = 0.0;
-  double std = 0.0;    ///< standard deviation from the residual (NaN if no redundancy)
+  double std = 0.0;    ///< standard deviation (FitResult::interval_method says how)
   double ci_low = 0.0; ///< 95 % confidence interval (Student's t)
   double ci_high = 0.0;
   bool fixed = false; ///< held at the model's value, not identified
+  /// False when the tests do not determine it (std above FitOptions::poorly_determined of its
+  /// value): FitResult::identifiability says why.
+  bool determined = true;
 };
 
 struct JointEstimate {
@@ -56,6 +67,13 @@ struct FitResult {
   double condition_number = 0.0;  ///< of the column-scaled Q
   double residual_rms = 0.0;      ///< rms of Q b − p, m
   double residual_relative = 0.0; ///< |Q b − p| / |p|
+  /// "propagated noise": generalised least squares with the equations' noise covariance,
+  /// intervals from it, widened by the residual where that is larger (χ² per degree of freedom
+  /// above 1); "residual": ordinary least squares, intervals from the residual alone.
+  std::string interval_method;
+  double chi2_per_dof = 0.0; ///< the weighted residual's χ² / (equations − unknowns); NaN: residual method
+  std::vector<double> singular_values;     ///< of the column-scaled (weighted) Q, largest first
+  std::vector<std::string> identifiability; ///< what the tests do not determine, in words
   std::vector<std::string> warnings;
   /// The joints with their identified values (fixed terms unchanged).
   std::vector<joints::Joint> identified(const std::vector<joints::Joint>& model_joints) const;
@@ -70,6 +88,19 @@ struct TestSpectrum {
   Eigen::MatrixXcd F;               ///< (K+1) × n_forces
   Eigen::MatrixXcd X2;              ///< (K+1) × n_set2 displacements at the joints' DOFs
   std::vector<Eigen::MatrixXcd> G;  ///< per joint: (K+1) × n_terms basis-function harmonics
+
+  /// What propagating the measurement noise into the fit needs (`noise_known` false for tables
+  /// and records whose noise could not be estimated).
+  bool noise_known = false;
+  Eigen::VectorXd t;          ///< the analysed samples (whole periods; one when averaged), s
+  Eigen::MatrixXd y, ydot;    ///< joint deformations and rates there (samples × joints)
+  int derived_harmonics = 0;  ///< harmonics of the signals derived from others
+  /// Per set-2 DOF: the channel its displacement comes from — its power p (x = (iω)^−p times
+  /// it: 0 x, 1 v, 2 a) and the noise variance of one analysed sample — and the variance of a
+  /// separately measured velocity channel (NaN: the velocity is derived from that channel).
+  std::vector<int> x_power;
+  std::vector<double> x_variance, v_variance;
+  std::vector<double> f_variance; ///< per force channel, of one analysed sample
 };
 
 /// The joints' DOFs (set 2), in the order used by TestSpectrum::X2.

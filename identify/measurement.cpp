@@ -144,7 +144,8 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   const int per = static_cast<int>(std::lround(per_period));
   const double periods = n * dt * m.frequency_hz;
   span.periods = static_cast<int>(std::lround(periods));
-  span.averaged = span.periods >= 2 && std::abs(per_period - per) <= 1e-6 * per_period &&
+  span.averaged = o.average_periods && span.periods >= 2 &&
+                  std::abs(per_period - per) <= 1e-6 * per_period &&
                   static_cast<long long>(per) * span.periods == n;
   if (span.averaged) {
     span.t = r.t.head(per);
@@ -181,6 +182,7 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   m.F_variance.resize(K + 1, f.cols());
   for (Eigen::Index i = 0; i < f.cols(); ++i) {
     const double variance = noise_variance(forces[i]->samples.head(n), span, omega);
+    m.force_noise.push_back(std::sqrt(variance));
     for (int k = 0; k <= K; ++k)
       m.F_variance(k, i) = (k == 0 ? 1.0 : 4.0) * variance / n;
   }
@@ -191,6 +193,7 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   m.x.resize(span.t.size(), nr);
   m.v.resize(span.t.size(), nr);
   const int dense = std::max(K, span.dense_harmonics);
+  m.derived_harmonics = dense;
   for (Eigen::Index j = 0; j < nr; ++j) {
     const Channel& c = *best[j];
     const fem::NodeDof at = c.at;
@@ -212,10 +215,12 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
       m.X_variance(k, j) = (k == 0 ? (power == 0 ? variance / n : nan) : 4.0 * variance / n) * gain;
     }
     // Displacement and velocity samples for the basis functions.
+    m.velocity_noise.push_back(nan);
     if (power == 0) {
       m.x.col(j) = samples;
       if (const Channel* v = r.find(Quantity::velocity, at)) {
         m.v.col(j) = analysed(v->samples);
+        m.velocity_noise.back() = std::sqrt(noise_variance(v->samples.head(n), span, omega));
       } else {
         m.v.col(j) = synthesise(span.t, differentiate(Q, omega, 1), omega);
         m.warnings.push_back(r.source + ": no velocity channel v@" + fem::to_string(at) +
@@ -297,8 +302,10 @@ Measurement measure_phasors(const Phasors& row, const MeasureOptions& o) {
   m.F_variance = Eigen::MatrixXd::Constant(K + 1, nf, nan);
   m.X = Eigen::MatrixXcd::Zero(K + 1, nr);
   m.X_variance = Eigen::MatrixXd::Constant(K + 1, nr, nan);
-  for (Eigen::Index i = 0; i < nf; ++i)
+  for (Eigen::Index i = 0; i < nf; ++i) {
     m.F(1, i) = forces[i];
+    m.force_noise.push_back(nan);
+  }
   // One period of the fundamental's sinusoid, finely sampled, for the basis functions.
   const int samples = 64 * (K + 1);
   m.t = Eigen::VectorXd::LinSpaced(samples, 0.0, (samples - 1.0) / (samples * row.frequency_hz));
@@ -308,6 +315,7 @@ Measurement measure_phasors(const Phasors& row, const MeasureOptions& o) {
     m.X(1, j) = responses[j];
     m.has_mean.push_back(false);
     m.channel_noise.push_back(nan);
+    m.velocity_noise.push_back(nan);
     for (int i = 0; i < samples; ++i) {
       const Complex e = std::polar(1.0, omega * m.t(i));
       m.x(i, j) = (responses[j] * e).real();

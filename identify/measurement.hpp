@@ -49,6 +49,10 @@ struct MeasureOptions {
   /// Warn when the fundamental of the first and last half of a record differ by more than
   /// this (relative), beyond what the record's noise explains.
   double steady_tolerance = 1e-3;
+  /// Average a record's periods before the basis functions see it (where a period holds a whole
+  /// number of samples): the noise variance the non-linear basis functions turn into bias is
+  /// divided by the number of periods.
+  bool average_periods = true;
 };
 
 struct Measurement {
@@ -79,6 +83,14 @@ struct Measurement {
   /// Per response DOF: noise standard deviation of its measured channel's samples (its own
   /// unit), NaN where unknown.
   std::vector<double> channel_noise;
+  /// Per response DOF: that of a separately measured velocity channel used for `v`; NaN where
+  /// `v` is derived from the response's own channel (or unknown).
+  std::vector<double> velocity_noise;
+  /// Per force channel: the noise standard deviation of its samples (N or N·m), NaN if unknown.
+  std::vector<double> force_noise;
+  /// Harmonics 1 … this of a channel make the signals derived from it (x from v or a, v from x
+  /// or a): derived(t) = Σ_k Re((ikω)^p Q_k e^{ikωt}).
+  int derived_harmonics = 0;
 
   std::vector<std::string> warnings;
 

@@ -177,6 +177,7 @@ std::string identify_result_json(const identify::FitResult& result,
       term["std"] = number(t.std);
       term["ci95"] = Json::array({number(t.ci_low), number(t.ci_high)});
       term["fixed"] = t.fixed;
+      term["determined"] = t.determined;
       terms.push_back(std::move(term));
     }
     Json j;
@@ -197,6 +198,13 @@ std::string identify_result_json(const identify::FitResult& result,
   out["condition_number"] = number(result.condition_number);
   out["residual_rms"] = number(result.residual_rms);
   out["residual_relative"] = number(result.residual_relative);
+  out["interval_method"] = result.interval_method;
+  out["chi2_per_dof"] = number(result.chi2_per_dof);
+  Json sv = Json::array();
+  for (double v : result.singular_values)
+    sv.push_back(number(v));
+  out["singular_values"] = std::move(sv);
+  out["identifiability"] = result.identifiability;
   out["warnings"] = std::move(warnings);
   return text(out);
 }

@@ -12,8 +12,9 @@ namespace jointid::io {
 
 /// The identification result as DESIGN.md's JSON:
 /// {"joints": [{"name", "terms": [{"term", "effect", "value", "std", "ci95": [lo, hi],
-/// "fixed"}]}], "equations", "unknowns", "condition_number", "residual_rms",
-/// "residual_relative", "warnings": [...]}. `extra` warnings are appended to the result's.
+/// "fixed", "determined"}]}], "equations", "unknowns", "condition_number", "residual_rms",
+/// "residual_relative", "interval_method", "chi2_per_dof", "singular_values",
+/// "identifiability": [...], "warnings": [...]}. `extra` warnings are appended to the result's.
 /// NaN and infinite numbers are written as null.
 std::string identify_result_json(const identify::FitResult& result,
                                  const std::vector<std::string>& extra = {});

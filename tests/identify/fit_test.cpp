@@ -380,3 +380,93 @@ TEST(EveryTermCases, CoverTheWholeLibrary) {
   for (std::size_t i = 2; i < joints::all_terms.size(); ++i)
     EXPECT_NO_THROW(term_case(joints::all_terms[i])) << joints::term_name(joints::all_terms[i]);
 }
+
+// The 95 % intervals hold what they say: Monte Carlo over the measurement noise (white Gaussian
+// on force and response channels, fixed seeds) of sine tests made by time integration. 200
+// repetitions: a true coverage of 95 % gives 95 ± 1.5 % (one standard deviation), so [90, 98] %
+// fails a method that under- or over-states the uncertainty by about 20 % (doubling every
+// standard deviation gives 100 %; the residual intervals of ordinary least squares, 10–25 %).
+// The bias is reported and must stay well inside the scatter.
+struct Coverage {
+  std::string name;
+  std::vector<joints::Joint> truth;
+  std::vector<identify::SineTestPlan> plans;
+  double level;
+};
+
+class IntervalCoverage : public ::testing::TestWithParam<Coverage> {};
+
+TEST_P(IntervalCoverage, HoldsForEveryParameter) {
+  const Coverage& c = GetParam();
+  const frf::Substructure sub(test::paper_cantilever());
+  identify::SimulationOptions so;
+  so.steps_per_period = 1024;
+  so.samples_per_period = 256;
+  so.periods = 8;
+  const auto clean = identify::simulate_sine_tests(sub, c.truth, {7, fem::Dof::uy}, c.plans, so);
+  identify::FitOptions fo;
+  fo.harmonics = {1, 2, 3};
+  constexpr int reps = 200;
+  std::vector<std::pair<std::size_t, std::size_t>> params;
+  for (std::size_t j = 0; j < c.truth.size(); ++j)
+    for (std::size_t t = 0; t < c.truth[j].terms.size(); ++t)
+      params.push_back({j, t});
+  std::vector<int> covered(params.size(), 0);
+  std::vector<double> bias(params.size(), 0.0), square(params.size(), 0.0);
+  for (int r = 0; r < reps; ++r) {
+    std::vector<identify::SineTest> tests;
+    for (std::size_t i = 0; i < clean.size(); ++i) {
+      identify::Record rec = clean[i].record;
+      identify::add_noise(rec, c.level, 104729ull * static_cast<unsigned long long>(r) + i);
+      tests.emplace_back(std::move(rec));
+    }
+    const identify::FitResult fit =
+        identify::fit(sub, c.truth, identify::measure(tests, identify::measure_options(fo)), fo);
+    ASSERT_EQ(fit.interval_method, "propagated noise");
+    for (std::size_t q = 0; q < params.size(); ++q) {
+      const auto& te = fit.joints[params[q].first].terms[params[q].second];
+      const double truth = c.truth[params[q].first].values[params[q].second];
+      covered[q] += te.ci_low <= truth && truth <= te.ci_high;
+      bias[q] += (te.value - truth) / truth / reps;
+      square[q] += std::pow((te.value - truth) / truth, 2) / reps;
+    }
+  }
+  for (std::size_t q = 0; q < params.size(); ++q) {
+    const auto& j = c.truth[params[q].first];
+    const std::string name =
+        std::string(joints::term_name(j.terms[params[q].second])) + " of '" + j.name + "'";
+    const double coverage = static_cast<double>(covered[q]) / reps;
+    const double scatter = std::sqrt(square[q] - bias[q] * bias[q]);
+    std::printf("  %-12s coverage %5.1f %%, bias %+.2e, scatter %.2e (relative)\n", name.c_str(),
+                100.0 * coverage, bias[q], scatter);
+    EXPECT_GE(coverage, 0.90) << name;
+    EXPECT_LE(coverage, 0.98) << name;
+    // The errors-in-variables bias (noise through the non-linear basis functions), reduced by
+    // averaging the records' periods, stays below half the scatter.
+    EXPECT_LT(std::abs(bias[q]), 0.5 * scatter) << name;
+  }
+}
+
+std::vector<Coverage> coverage_cases() {
+  using T = Term;
+  auto tip = [](std::vector<T> terms, std::vector<double> values) {
+    return make_joint("tip", 7, 0, std::move(terms), std::move(values));
+  };
+  std::vector<identify::SineTestPlan> case_I; // the paper's case I: 80 N at 1.0 … 4.6 Hz
+  for (int i = 0; i < 10; ++i)
+    case_I.push_back({1.0 + 0.4 * i, 80.0});
+  std::vector<identify::SineTestPlan> grid; // two joints: 2 … 7 Hz at 10, 40, 80 N
+  for (double f : {2.0, 3.0, 4.0, 5.0, 6.0, 7.0})
+    for (double a : {10.0, 40.0, 80.0})
+      grid.push_back({f, a});
+  const auto model_I = tip({T::k, T::c, T::c2, T::k3}, {4800.0, 20.0, 500.0, 1.6e8});
+  const std::vector<joints::Joint> two{tip({T::k, T::c}, {4800.0, 20.0}),
+                                       make_joint("mid", 4, 0, {T::k, T::c, T::k3},
+                                                  {2e4, 10.0, 2e9})};
+  return {{"ModelI_1pc", {model_I}, case_I, 0.01},
+          {"ModelI_5pc", {model_I}, case_I, 0.05},
+          {"TwoJoints_1pc", two, grid, 0.01}};
+}
+
+INSTANTIATE_TEST_SUITE_P(MonteCarlo, IntervalCoverage, ::testing::ValuesIn(coverage_cases()),
+                         [](const auto& info) { return info.param.name; });
