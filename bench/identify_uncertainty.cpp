@@ -9,7 +9,7 @@
 // force's fundamental a nuisance parameter of every test, measured with its own noise).
 // Results: docs/identification_uncertainty.md.
 //
-//   bench_identify_uncertainty [repetitions (200)]
+//   bench_identify_uncertainty [repetitions (200)] [harmonics]   (harmonics: the harmonics study)
 #include "frf/harmonic_balance.hpp"
 #include "identify/fit.hpp"
 #include "identify/sine_tests.hpp"
@@ -32,8 +32,8 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 
 joints::Joint joint(std::string name, int node, std::vector<Term> terms,
                     std::vector<double> values) {
-  joints::Joint j{std::move(name), node, 0, fem::Dof::uy, std::move(terms), std::move(values),
-                  {}, {}};
+  joints::Joint j{std::move(name),   node, 0, fem::Dof::uy, std::move(terms),
+                  std::move(values), {},   {}};
   j.fixed.assign(j.terms.size(), false);
   return j;
 }
@@ -217,9 +217,63 @@ void report(const Study& s, int reps) {
     for (std::size_t q = 0; q < names.size(); ++q)
       std::printf("| %s | %.1f %% / %+.2e / %.2e | %.1f %% / %+.2e / %.2e / %.2e | %+.2e / %.2e "
                   "| %.2e | %.2f |\n",
-                  names[q].c_str(), 100 * a.coverage[q], a.bias[q], a.rms[q],
-                  100 * b.coverage[q], b.bias[q], b.rms[q], b.mean_std[q], c.bias[q], c.rms[q],
-                  crb[q], b.rms[q] / crb[q]);
+                  names[q].c_str(), 100 * a.coverage[q], a.bias[q], a.rms[q], 100 * b.coverage[q],
+                  b.bias[q], b.rms[q], b.mean_std[q], c.bias[q], c.rms[q], crb[q],
+                  b.rms[q] / crb[q]);
+    std::fflush(stdout);
+  }
+}
+
+// Harmonics 1 … K against the fundamental alone, on a study at 1 % noise: the scatter of every
+// parameter and the condition number of the weighted equations.
+void harmonics_study(const Study& s, int reps) {
+  const frf::Substructure sub(test::paper_cantilever());
+  identify::SimulationOptions so;
+  so.steps_per_period = 1024;
+  so.samples_per_period = 256;
+  so.periods = 8;
+  const auto clean = identify::simulate_sine_tests(sub, s.truth, {7, fem::Dof::uy}, s.plans, so);
+  std::printf("\n### Harmonics used: %s, 1 %% noise, %d repetitions\n\n", s.name.c_str(), reps);
+  std::printf("| harmonics | equations | mean condition number |");
+  for (const auto& j : s.truth)
+    for (Term t : j.terms)
+      std::printf(" rms %s of '%s' |", std::string(joints::term_name(t)).c_str(), j.name.c_str());
+  std::printf("\n|---|---|---|");
+  for (const auto& j : s.truth)
+    for (std::size_t t = 0; t < j.terms.size(); ++t)
+      std::printf("---|");
+  std::printf("\n");
+  for (const std::vector<int>& harmonics :
+       {std::vector<int>{1}, std::vector<int>{1, 2, 3}, std::vector<int>{1, 2, 3, 4, 5}}) {
+    identify::FitOptions fo;
+    fo.harmonics = harmonics;
+    std::vector<double> square;
+    double condition = 0.0;
+    int equations = 0;
+    for (int r = 0; r < reps; ++r) {
+      std::vector<identify::SineTest> tests;
+      for (std::size_t i = 0; i < clean.size(); ++i) {
+        identify::Record rec = clean[i].record;
+        identify::add_noise(rec, 0.01, 7919ull * static_cast<unsigned long long>(r) + i);
+        tests.emplace_back(std::move(rec));
+      }
+      const auto fit =
+          identify::fit(sub, s.truth, identify::measure(tests, identify::measure_options(fo)), fo);
+      condition += fit.condition_number / reps;
+      equations = fit.equations;
+      std::size_t q = 0;
+      for (std::size_t j = 0; j < s.truth.size(); ++j)
+        for (std::size_t t = 0; t < s.truth[j].terms.size(); ++t, ++q) {
+          if (square.size() <= q) square.push_back(0.0);
+          const double truth = s.truth[j].values[t];
+          square[q] += std::pow((fit.joints[j].terms[t].value - truth) / truth, 2) / reps;
+        }
+    }
+    std::printf("| %d … %d | %d | %.3g |", harmonics.front(), harmonics.back(), equations,
+                condition);
+    for (double v : square)
+      std::printf(" %.2e |", std::sqrt(v));
+    std::printf("\n");
     std::fflush(stdout);
   }
 }
@@ -228,10 +282,10 @@ void report(const Study& s, int reps) {
 
 int main(int argc, char** argv) {
   const int reps = argc > 1 ? std::atoi(argv[1]) : 200;
-  Study model_I{"Paper model I, case I",
-                {joint("tip", 7, {Term::k, Term::c, Term::c2, Term::k3},
-                       {4800.0, 20.0, 500.0, 1.6e8})},
-                {}};
+  Study model_I{
+      "Paper model I, case I",
+      {joint("tip", 7, {Term::k, Term::c, Term::c2, Term::k3}, {4800.0, 20.0, 500.0, 1.6e8})},
+      {}};
   for (int i = 0; i < 10; ++i)
     model_I.plans.push_back({1.0 + 0.4 * i, 80.0});
   Study two{"Two joints: tip (k, c) and mid-span (k, c, k3)",
@@ -241,6 +295,11 @@ int main(int argc, char** argv) {
   for (double f : {2.0, 3.0, 4.0, 5.0, 6.0, 7.0})
     for (double a : {10.0, 40.0, 80.0})
       two.plans.push_back({f, a});
+  if (argc > 2 && std::string(argv[2]) == "harmonics") {
+    harmonics_study(two, reps);
+    harmonics_study(model_I, reps);
+    return 0;
+  }
   report(model_I, reps);
   report(two, reps);
 }

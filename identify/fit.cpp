@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -134,8 +134,8 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   }
   for (std::size_t f = 0; f < m.force_noise.size(); ++f) {
     s.f_variance.push_back(m.force_noise[f] * m.force_noise[f] / P);
-    s.noise_known =
-        s.noise_known && meaningful(m.force_noise[f], std::abs(m.F(1, static_cast<Eigen::Index>(f))));
+    s.noise_known = s.noise_known &&
+                    meaningful(m.force_noise[f], std::abs(m.F(1, static_cast<Eigen::Index>(f))));
   }
   return s;
 }
@@ -230,15 +230,17 @@ Eigen::MatrixXd equation_covariance(const TestSpectrum& ts, const std::vector<Ro
     for (Eigen::Index d = 0; d < n2; ++d) {
       if (B(d, j) == 0.0) continue;
       const auto dd = static_cast<std::size_t>(d);
-      var_rate += B(d, j) * B(d, j) *
-                  (std::isfinite(ts.v_variance[dd]) ? ts.v_variance[dd]
-                                                    : ts.x_variance[dd] * op.gain(1 - ts.x_power[dd], N));
+      var_rate +=
+          B(d, j) * B(d, j) *
+          (std::isfinite(ts.v_variance[dd]) ? ts.v_variance[dd]
+                                            : ts.x_variance[dd] * op.gain(1 - ts.x_power[dd], N));
     }
     for (Eigen::Index n = 0; n < N; ++n) {
       const double y = ts.y(n, j), v = ts.ydot(n, j);
       for (std::size_t t = 0; t < J.terms.size(); ++t) {
         if (joints::is_dry_friction(J.terms[t])) {
-          const double pflip = var_rate > 0.0 ? 0.5 * std::erfc(std::abs(v) / std::sqrt(2.0 * var_rate)) : 0.0;
+          const double pflip =
+              var_rate > 0.0 ? 0.5 * std::erfc(std::abs(v) / std::sqrt(2.0 * var_rate)) : 0.0;
           flip(n, j) += 4.0 * J.values[t] * J.values[t] * pflip * (1.0 - pflip);
         } else {
           gy(n, j) += J.values[t] * joints::basis_dy(J.terms[t], y, v);
@@ -253,7 +255,8 @@ Eigen::MatrixXd equation_covariance(const TestSpectrum& ts, const std::vector<Ro
   std::vector<Eigen::Index> v_block(static_cast<std::size_t>(n2), -1);
   Eigen::Index blocks = n2;
   for (Eigen::Index d = 0; d < n2; ++d)
-    if (std::isfinite(ts.v_variance[static_cast<std::size_t>(d)])) v_block[static_cast<std::size_t>(d)] = blocks++;
+    if (std::isfinite(ts.v_variance[static_cast<std::size_t>(d)]))
+      v_block[static_cast<std::size_t>(d)] = blocks++;
   const Eigen::Index f_block = blocks, flip_block = blocks + nf;
   blocks += nf + nj;
   Eigen::VectorXd variance(blocks * N);
@@ -365,6 +368,7 @@ std::vector<std::string> explain_identifiability(const FitResult& result,
     }
     return std::pair{lo, hi};
   };
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> said; // pairs already explained
   for (Eigen::Index u = 0; u < nu; ++u) {
     if (estimate(u).determined) continue;
     std::string where;
@@ -385,6 +389,8 @@ std::vector<std::string> explain_identifiability(const FitResult& result,
                     " of the joint's (in " + where +
                     "); tests at larger amplitudes would bring it out");
     } else if (partner >= 0 && std::abs(corr) > 0.95) {
+      if (std::find(said.begin(), said.end(), std::pair{partner, u}) != said.end()) continue;
+      said.push_back({u, partner});
       const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
       const auto [pi, pt] = unknowns[static_cast<std::size_t>(partner)];
       const auto nature = joints::term_info(joints[i].terms[t]).nature;
@@ -506,8 +512,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
                                                 Eigen::ComputeThinU | Eigen::ComputeThinV);
     sol.sv = svd.singularValues();
     sol.V = svd.matrixV();
-    sol.condition = sol.sv(nu - 1) > 0.0 ? sol.sv(0) / sol.sv(nu - 1)
-                                         : std::numeric_limits<double>::infinity();
+    sol.condition =
+        sol.sv(nu - 1) > 0.0 ? sol.sv(0) / sol.sv(nu - 1) : std::numeric_limits<double>::infinity();
     if (!(sol.condition < 1e13)) {
       Eigen::Index worst;
       svd.matrixV().col(nu - 1).cwiseAbs().maxCoeff(&worst);
@@ -522,8 +528,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   auto with_values = [&](const Eigen::VectorXd& b) {
     std::vector<joints::Joint> js = joints;
     for (int u = 0; u < nu; ++u)
-      js[static_cast<std::size_t>(unknowns[u].joint)].values[static_cast<std::size_t>(unknowns[u].term)] =
-          b(u);
+      js[static_cast<std::size_t>(unknowns[u].joint)]
+          .values[static_cast<std::size_t>(unknowns[u].term)] = b(u);
     return js;
   };
   Solution sol = solve(Q, p);
@@ -531,8 +537,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   // 3. With the noise known everywhere: generalised least squares, its covariance at the
   //    ordinary estimate first, then once more at the weighted one.
   const bool propagated =
-      o.propagate_noise && std::all_of(tests.begin(), tests.end(),
-                                       [](const TestSpectrum& t) { return t.noise_known; });
+      o.propagate_noise &&
+      std::all_of(tests.begin(), tests.end(), [](const TestSpectrum& t) { return t.noise_known; });
   std::vector<Eigen::LLT<Eigen::MatrixXd>> whiten(tests.size());
   std::vector<std::vector<int>> test_rows(tests.size());
   for (int r = 0; r < m; ++r)
@@ -554,11 +560,13 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
         Eigen::MatrixXd Qi(static_cast<Eigen::Index>(idx.size()), nu);
         Eigen::VectorXd pi(static_cast<Eigen::Index>(idx.size()));
         for (std::size_t r = 0; r < idx.size(); ++r)
-          Qi.row(static_cast<Eigen::Index>(r)) = Q.row(idx[r]), pi(static_cast<Eigen::Index>(r)) = p(idx[r]);
+          Qi.row(static_cast<Eigen::Index>(r)) = Q.row(idx[r]),
+          pi(static_cast<Eigen::Index>(r)) = p(idx[r]);
         Qi = whiten[ti].matrixL().solve(Qi);
         pi = whiten[ti].matrixL().solve(pi);
         for (std::size_t r = 0; r < idx.size(); ++r)
-          Qw.row(idx[r]) = Qi.row(static_cast<Eigen::Index>(r)), pw(idx[r]) = pi(static_cast<Eigen::Index>(r));
+          Qw.row(idx[r]) = Qi.row(static_cast<Eigen::Index>(r)),
+          pw(idx[r]) = pi(static_cast<Eigen::Index>(r));
       }
       sol = solve(Qw, pw);
     }

@@ -71,8 +71,9 @@ struct FitResult {
   /// intervals from it, widened by the residual where that is larger (χ² per degree of freedom
   /// above 1); "residual": ordinary least squares, intervals from the residual alone.
   std::string interval_method;
-  double chi2_per_dof = 0.0; ///< the weighted residual's χ² / (equations − unknowns); NaN: residual method
-  std::vector<double> singular_values;     ///< of the column-scaled (weighted) Q, largest first
+  double chi2_per_dof =
+      0.0; ///< the weighted residual's χ² / (equations − unknowns); NaN: residual method
+  std::vector<double> singular_values;      ///< of the column-scaled (weighted) Q, largest first
   std::vector<std::string> identifiability; ///< what the tests do not determine, in words
   std::vector<std::string> warnings;
   /// The joints with their identified values (fixed terms unchanged).
@@ -92,9 +93,9 @@ struct TestSpectrum {
   /// What propagating the measurement noise into the fit needs (`noise_known` false for tables
   /// and records whose noise could not be estimated).
   bool noise_known = false;
-  Eigen::VectorXd t;          ///< the analysed samples (whole periods; one when averaged), s
-  Eigen::MatrixXd y, ydot;    ///< joint deformations and rates there (samples × joints)
-  int derived_harmonics = 0;  ///< harmonics of the signals derived from others
+  Eigen::VectorXd t;         ///< the analysed samples (whole periods; one when averaged), s
+  Eigen::MatrixXd y, ydot;   ///< joint deformations and rates there (samples × joints)
+  int derived_harmonics = 0; ///< harmonics of the signals derived from others
   /// Per set-2 DOF: the channel its displacement comes from — its power p (x = (iω)^−p times
   /// it: 0 x, 1 v, 2 a) and the noise variance of one analysed sample — and the variance of a
   /// separately measured velocity channel (NaN: the velocity is derived from that channel).

@@ -2,9 +2,12 @@
 
 #include "identify/harmonics.hpp"
 #include "io/files.hpp"
+#include "io/uff58.hpp"
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <iterator>
@@ -421,6 +424,18 @@ std::vector<identify::SineTest> stepped_sine_tests(const SteppedSineTable& table
   return tests;
 }
 
+namespace {
+
+// Universal files: .uff, .unv, .uf58, in any case.
+bool is_universal_file(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".uff" || extension == ".unv" || extension == ".uf58";
+}
+
+} // namespace
+
 std::vector<identify::SineTest> read_tests(const std::vector<std::filesystem::path>& paths) {
   std::vector<identify::SineTest> tests;
   std::map<std::filesystem::path, std::string> seen;
@@ -433,6 +448,11 @@ std::vector<identify::SineTest> read_tests(const std::vector<std::filesystem::pa
                               "uncertainty come out falsely small)",
                               path.string(),
                               it->second == path.string() ? "" : " (also as " + it->second + ")"));
+    if (is_universal_file(path)) {
+      for (auto& t : uff58_tests(read_uff58(path), path))
+        tests.push_back(std::move(t));
+      continue;
+    }
     const CsvText csv = scan(path, "t,f@7:uy,x@7:uy (a time record) or "
                                    "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im (a "
                                    "stepped-sine table)");

@@ -62,10 +62,12 @@ std::string stepped_sine_csv(const SteppedSineTable& table,
 std::vector<identify::SineTest> stepped_sine_tests(const SteppedSineTable& table,
                                                    const std::filesystem::path& path);
 
-/// Reads measured sine tests from files of either kind, told apart by the header's first
-/// column: `t` (a time record: one test) or `freq_hz` (a stepped-sine table: one test per
-/// row). Throws io::Error naming the file for anything else, and when a file is given twice
-/// (its tests would count twice and the intervals come out falsely narrow).
+/// Reads measured sine tests from files of three kinds: universal files (name ending in .uff,
+/// .unv or .uf58, any case: the time responses of their datasets 58, one test per abscissa, see
+/// io/uff58.hpp's uff58_tests), and CSV files told apart by the header's first column: `t` (a
+/// time record: one test) or `freq_hz` (a stepped-sine table: one test per row). Throws
+/// io::Error naming the file for anything else, and when a file is given twice (its tests would
+/// count twice and the intervals come out falsely narrow).
 std::vector<identify::SineTest> read_tests(const std::vector<std::filesystem::path>& paths);
 
 } // namespace jointid::io

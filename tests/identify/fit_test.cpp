@@ -460,9 +460,9 @@ std::vector<Coverage> coverage_cases() {
     for (double a : {10.0, 40.0, 80.0})
       grid.push_back({f, a});
   const auto model_I = tip({T::k, T::c, T::c2, T::k3}, {4800.0, 20.0, 500.0, 1.6e8});
-  const std::vector<joints::Joint> two{tip({T::k, T::c}, {4800.0, 20.0}),
-                                       make_joint("mid", 4, 0, {T::k, T::c, T::k3},
-                                                  {2e4, 10.0, 2e9})};
+  const std::vector<joints::Joint> two{
+      tip({T::k, T::c}, {4800.0, 20.0}),
+      make_joint("mid", 4, 0, {T::k, T::c, T::k3}, {2e4, 10.0, 2e9})};
   return {{"ModelI_1pc", {model_I}, case_I, 0.01},
           {"ModelI_5pc", {model_I}, case_I, 0.05},
           {"TwoJoints_1pc", two, grid, 0.01}};
@@ -470,3 +470,65 @@ std::vector<Coverage> coverage_cases() {
 
 INSTANTIATE_TEST_SUITE_P(MonteCarlo, IntervalCoverage, ::testing::ValuesIn(coverage_cases()),
                          [](const auto& info) { return info.param.name; });
+
+// What the tests cannot determine is said in words, and flagged, not returned as a confident
+// number.
+TEST(Identifiability, ACubicTermTooSmallAtTheseAmplitudesIsNamed) {
+  const frf::Substructure sub(test::paper_cantilever());
+  const auto truth = make_joint("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8});
+  // At 0.2 N the tip moves ~20 µm: the cubic force is ~1e-5 of the linear one.
+  std::vector<identify::SineTestPlan> plans;
+  for (double f : {2.0, 3.0, 4.0, 5.0})
+    plans.push_back({f, 0.2});
+  identify::SimulationOptions so;
+  so.steps_per_period = 512;
+  so.samples_per_period = 128;
+  auto tests = identify::simulate_sine_tests(sub, {truth}, {7, fem::Dof::uy}, plans, so);
+  std::vector<identify::SineTest> noisy;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    identify::add_noise(tests[i].record, 0.01, 11 + i);
+    noisy.emplace_back(tests[i].record);
+  }
+  identify::FitOptions fo;
+  fo.harmonics = {1, 2, 3};
+  const auto r =
+      identify::fit(sub, {truth}, identify::measure(noisy, identify::measure_options(fo)), fo);
+  EXPECT_TRUE(r.joints[0].terms[0].determined);  // k
+  EXPECT_FALSE(r.joints[0].terms[2].determined); // k3
+  ASSERT_FALSE(r.identifiability.empty());
+  const std::string& s = r.identifiability.front();
+  EXPECT_NE(s.find("k3 of 'tip' is not determined"), std::string::npos) << s;
+  EXPECT_NE(s.find("its force is"), std::string::npos) << s;
+  EXPECT_NE(s.find("larger amplitudes"), std::string::npos) << s;
+}
+
+TEST(Identifiability, DampingAndFrictionAtOneVelocityAmplitudeAreNotSeparated) {
+  // Every test at the same frequency and force: the same velocity amplitude, so viscous and dry
+  // friction damping give the same fundamental (the joint slides throughout at 80 N).
+  const frf::Substructure sub(test::paper_cantilever());
+  const auto truth = make_joint("tip", 7, 0, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, 3.0});
+  identify::SimulationOptions so;
+  so.steps_per_period = 512;
+  so.samples_per_period = 128;
+  const auto clean =
+      identify::simulate_sine_tests(sub, {truth}, {7, fem::Dof::uy}, {{3.0, 80.0}}, so);
+  std::vector<identify::SineTest> noisy;
+  for (int i = 0; i < 4; ++i) {
+    identify::Record r = clean.front().record;
+    identify::add_noise(r, 0.01, 31 + i);
+    r.source = "repeat " + std::to_string(i);
+    noisy.emplace_back(std::move(r));
+  }
+  identify::FitOptions fo;
+  fo.harmonics = {1};
+  const auto r =
+      identify::fit(sub, {truth}, identify::measure(noisy, identify::measure_options(fo)), fo);
+  std::string all;
+  for (const auto& s : r.identifiability)
+    all += s + "\n";
+  EXPECT_NE(all.find("not separated"), std::string::npos) << all;
+  EXPECT_NE(all.find("c of 'tip'"), std::string::npos) << all;
+  EXPECT_NE(all.find("fc of 'tip'"), std::string::npos) << all;
+  EXPECT_NE(all.find("same velocity amplitude"), std::string::npos) << all;
+  EXPECT_FALSE(r.joints[0].terms[1].determined && r.joints[0].terms[2].determined);
+}
