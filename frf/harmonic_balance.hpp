@@ -17,7 +17,13 @@
 #include "frf/receptance.hpp"
 #include "joints/joint.hpp"
 
+#include <memory>
+
 namespace jointid::frf {
+
+namespace detail {
+struct Equations; // frf/hb_equations.hpp, internal
+}
 
 struct HarmonicBalanceOptions {
   int harmonics = 9;            ///< K, harmonics 0 … K
@@ -63,6 +69,16 @@ public:
   HarmonicBalanceResult solve(const std::vector<joints::Joint>& joints, const Eigen::MatrixXcd& F,
                               const Eigen::MatrixXcd* start = nullptr) const;
   const HarmonicBalanceOptions& options() const { return options_; }
+  double frequency_hz() const { return frequency_hz_; }
+
+  /// Low level, for the frequency continuation: the equations R(z) = 0 for these joints and
+  /// force (they refer to `joints` and to this object, which must outlive them), the packed
+  /// first guess, and the result for a solution z.
+  std::unique_ptr<detail::Equations> equations(const std::vector<joints::Joint>& joints,
+                                               const Eigen::MatrixXcd& F) const;
+  Eigen::VectorXd first_guess(const detail::Equations& equations,
+                              const Eigen::MatrixXcd* start) const;
+  HarmonicBalanceResult result(const detail::Equations& equations, const Eigen::VectorXd& z) const;
 
 private:
   struct Layout {
