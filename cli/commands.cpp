@@ -7,10 +7,12 @@
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "identify/sine_tests.hpp"
+#include "io/chart.hpp"
 #include "io/discovery_report.hpp"
 #include "io/files.hpp"
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
+#include "io/response_curves.hpp"
 #include "io/results_json.hpp"
 #include "io/vtk_output.hpp"
 #include "joints/joint.hpp"
@@ -24,6 +26,8 @@
 #include <set>
 #include <span>
 #include <stdexcept>
+
+#include <unistd.h>
 
 namespace jointid::cli {
 
@@ -361,6 +365,112 @@ void modes(const ModesOptions& o) {
   }
   for (const auto& w : warnings)
     warn(w);
+}
+
+void response(const ResponseOptions& o) {
+  // 1. The options.
+  if (o.amplitudes.empty()) throw io::Error("--amplitude: expected at least one amplitude (N)");
+  for (double a : o.amplitudes)
+    if (!(std::isfinite(a) && a > 0.0))
+      throw io::Error(
+          fmt::format("--amplitude: expected finite amplitudes > 0 (N or N m), got {}", a));
+  if (std::set<double>(o.amplitudes.begin(), o.amplitudes.end()).size() != o.amplitudes.size())
+    throw io::Error("--amplitude: an amplitude is listed twice");
+  double f0 = 0.0, f1 = 0.0;
+  {
+    const auto colon = o.freq_range.find(':');
+    bool ok = colon != std::string::npos;
+    if (ok) {
+      try {
+        std::size_t n0 = 0, n1 = 0;
+        const std::string a = o.freq_range.substr(0, colon), b = o.freq_range.substr(colon + 1);
+        f0 = std::stod(a, &n0);
+        f1 = std::stod(b, &n1);
+        ok = n0 == a.size() && n1 == b.size();
+      } catch (const std::exception&) {
+        ok = false;
+      }
+    }
+    if (!ok)
+      throw io::Error(
+          fmt::format("--freq-range: expected F0:F1 in Hz, e.g. 15:25, got \"{}\"", o.freq_range));
+    if (!(std::isfinite(f0) && std::isfinite(f1) && f0 > 0.0 && f1 > 0.0 && f0 != f1))
+      throw io::Error(fmt::format(
+          "--freq-range: expected two different frequencies > 0 Hz, got {} and {}", f0, f1));
+  }
+  if (o.harmonics < 1 || o.harmonics > 200)
+    throw io::Error(fmt::format("--harmonics: expected 1 to 200, got {}", o.harmonics));
+  check_output_dir(o.output_dir);
+
+  // 2. The model.
+  const io::ModelFile file = io::read_model(o.model);
+  if (file.joints.empty())
+    warn(o.model.string() + ": no [[joints]]: the response is the linear substructure's");
+  const frf::Substructure sub = file.substructure();
+  const fem::NodeDof force_at = resolve(file, sub, "--force", o.force);
+  const fem::NodeDof shown =
+      o.plot_dof.empty() ? force_at : resolve(file, sub, "--plot-dof", o.plot_dof);
+  bool drawable = shown == force_at;
+  for (const joints::Joint& j : file.joints)
+    drawable = drawable || shown == fem::NodeDof{j.node, j.dof} ||
+               (j.node_b != 0 && shown == fem::NodeDof{j.node_b, j.dof});
+  if (!drawable)
+    throw io::Error(fmt::format("--plot-dof {}: expected the force DOF ({}) or a joint's DOF",
+                                o.plot_dof, fem::to_string(force_at)));
+
+  // 3. The curves (progress on a terminal only).
+  frf::ContinuationOptions options;
+  options.hb.harmonics = o.harmonics;
+  const bool terminal = isatty(STDERR_FILENO) == 1;
+  std::function<void(std::size_t, double)> progress;
+  if (terminal)
+    progress = [&](std::size_t curve, double fraction) {
+      std::cerr << fmt::format("\rjointid response: {} N ({} of {}): {:3.0f} %",
+                               o.amplitudes[curve], curve + 1, o.amplitudes.size(),
+                               100.0 * fraction)
+                << std::flush;
+    };
+  frf::ResponseCurves curves;
+  try {
+    curves =
+        frf::response_curves(sub, file.joints, force_at, o.amplitudes, f0, f1, options, progress);
+  } catch (const std::invalid_argument& e) {
+    throw io::Error(o.model.string() + ": " + e.what());
+  }
+  if (terminal) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
+
+  // 4. Write.
+  make_output_dir(o.output_dir);
+  const fs::path json = o.output_dir / "response.json";
+  io::write_json(json, io::response_json(curves));
+  fmt::print("wrote {}\n", json.string());
+  if (o.plot) {
+    std::string why;
+    if (io::can_render_charts(&why)) {
+      const fs::path png = o.output_dir / "response.png";
+      io::write_chart_png(png, io::response_figure(curves, shown));
+      fmt::print("wrote {}\n", png.string());
+    } else {
+      warn("no response.png: " + why + " (run under xvfb-run -a)");
+    }
+  }
+  for (std::size_t i = 0; i < curves.curves.size(); ++i) {
+    const frf::ResponseBranch& b = curves.curves[i];
+    std::vector<std::string> folds;
+    for (int f : b.folds)
+      folds.push_back(fmt::format("{:.4f} Hz", b.points[f].hb.frequency_hz));
+    int unstable = 0;
+    for (const auto& p : b.points)
+      unstable += p.stable.has_value() && !*p.stable;
+    fmt::print("{:g} N: {} points, {} folds{}{}, {} unstable{}\n", o.amplitudes[i], b.points.size(),
+               b.folds.size(), folds.empty() ? "" : " at ",
+               fmt::format("{}", fmt::join(folds, ", ")), unstable,
+               b.complete ? "" : " (incomplete)");
+    for (const auto& n : b.notes)
+      (b.complete ? fmt::print("  {}\n", n) : warn(fmt::format("{:g} N: {}", o.amplitudes[i], n)));
+  }
+  for (const auto& n : curves.notes)
+    fmt::print("note: {}\n", n);
 }
 
 } // namespace jointid::cli

@@ -70,4 +70,19 @@ struct ModesOptions {
 /// none); without one it is skipped with a warning.
 void modes(const ModesOptions& options);
 
+struct ResponseOptions {
+  std::filesystem::path model;
+  std::string force;              ///< NODE:DOF of the sine force
+  std::vector<double> amplitudes; ///< N or N·m (peak), one curve each
+  std::string freq_range;         ///< F0:F1, Hz (traced from F0 to F1; either order)
+  int harmonics = 9;              ///< harmonics 0 … K of the harmonic balance
+  std::string plot_dof;           ///< NODE:DOF drawn in response.png; empty: the force DOF
+  bool plot = true;
+  std::filesystem::path output_dir;
+};
+
+/// Response curves by harmonic balance with continuation: DIR/response.json (README's
+/// contract) and DIR/response.png. Progress on a terminal (stderr), nothing otherwise.
+void response(const ResponseOptions& options);
+
 } // namespace jointid::cli

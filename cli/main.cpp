@@ -163,12 +163,37 @@ int main(int argc, char** argv) {
   modes->add_option("--pictures", mod.pictures, "Modes drawn in DIR/modes.png (0: none)")
       ->capture_default_str();
 
+  cli::ResponseOptions resp;
+  auto* response = app.add_subcommand(
+      "response", "Response curves (harmonic balance with continuation, stability, folds) of the "
+                  "model with its joints; writes DIR/response.json and DIR/response.png");
+  response->add_option("MODEL", resp.model, "Model file (TOML)")->required();
+  response->add_option("--force", resp.force, "DOF of the sine force, NODE:DOF (e.g. 7:uy)")
+      ->required();
+  response
+      ->add_option("--amplitude", resp.amplitudes,
+                   "Force amplitudes, N or N m (peak; comma-separated, one curve each)")
+      ->required()
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  response->add_option("--freq-range", resp.freq_range, "Band F0:F1 in Hz, traced from F0 to F1")
+      ->required();
+  response->add_option("--harmonics", resp.harmonics, "Harmonics 0 … K of the harmonic balance")
+      ->capture_default_str();
+  response->add_option("--plot-dof", resp.plot_dof,
+                       "DOF drawn in response.png, NODE:DOF (default: the force DOF)");
+  response->add_flag("!--no-plot", resp.plot, "Write no response.png");
+  response->add_option("-o,--output", resp.output_dir, "Output directory (created if missing)")
+      ->required();
+
   try {
     app.parse(argc, argv);
     if (simulate->parsed()) cli::simulate(sim);
     if (identify->parsed()) cli::identify(ident);
     if (discover->parsed() && disc.plots) rerun_with_display(argv);
     if (discover->parsed()) cli::discover(disc);
+    if (response->parsed() && resp.plot) rerun_with_display(argv);
+    if (response->parsed()) cli::response(resp);
     if (modes->parsed() && mod.pictures > 0) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
     return 0;

@@ -4,19 +4,63 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <numbers>
 #include <stdexcept>
 
 namespace jointid::frf {
 
+// The AFT tables that do not depend on ω, for K harmonics and Nt samples θ_n = 2πn / Nt:
+// cos pθ_n and sin pθ_n for p ≤ 2K (Nt × (2K+1), the Jacobian's products), ∂y_n/∂z (Nt × (2K+1)),
+// ∂ẏ_n/∂z / ω, and the forward transform from samples to packed harmonics ((2K+1) × Nt). Kept
+// in a cache: the continuation builds a HarmonicBalance at every frequency it visits, and
+// computing (and allocating) these each time was most of its cost.
+struct detail::Tables {
+  Eigen::MatrixXd cos, sin, dy, dv_unit, forward;
+};
+
 namespace {
+
+const detail::Tables& aft_tables(int Nt, int K) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, std::unique_ptr<const detail::Tables>> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{Nt, K}];
+  if (!slot) {
+    auto t = std::make_unique<detail::Tables>();
+    const int P = 2 * K, m = 2 * K + 1;
+    t->cos.resize(Nt, P + 1), t->sin.resize(Nt, P + 1);
+    for (int n = 0; n < Nt; ++n)
+      for (int p = 0; p <= P; ++p) { // the angle reduced exactly, p n mod Nt
+        const double a = 2.0 * std::numbers::pi * (static_cast<long long>(p) * n % Nt) / Nt;
+        t->cos(n, p) = std::cos(a), t->sin(n, p) = std::sin(a);
+      }
+    t->dy.resize(Nt, m), t->dv_unit.resize(Nt, m), t->forward.resize(m, Nt);
+    for (int n = 0; n < Nt; ++n) {
+      t->dy(n, 0) = 1.0;
+      t->dv_unit(n, 0) = 0.0;
+      t->forward(0, n) = 1.0 / Nt;
+      for (int k = 1; k <= K; ++k) {
+        const double c = t->cos(n, k), s = t->sin(n, k);
+        t->dy(n, 2 * k - 1) = c, t->dy(n, 2 * k) = -s;
+        t->dv_unit(n, 2 * k - 1) = -k * s, t->dv_unit(n, 2 * k) = -k * c;
+        t->forward(2 * k - 1, n) = 2.0 * c / Nt, t->forward(2 * k, n) = -2.0 * s / Nt;
+      }
+    }
+    slot = std::move(t);
+  }
+  return *slot;
+}
+
+} // namespace
 
 using detail::Equations;
 using detail::Friction;
 using detail::two_pi;
 
-bool newton(const Equations& P, Eigen::VectorXd& z, double load, const HarmonicBalanceOptions& o,
-            int& iterations, double& res_norm) {
+bool detail::newton(const Equations& P, Eigen::VectorXd& z, double load,
+                    const HarmonicBalanceOptions& o, int& iterations, double& res_norm) {
   const int n = P.size();
   Eigen::MatrixXd J(n, n);
   Eigen::VectorXd r = P.residual(z, load, &J);
@@ -51,8 +95,6 @@ bool newton(const Equations& P, Eigen::VectorXd& z, double load, const HarmonicB
   res_norm = r.norm() / std::max(P.norm(z), 1e-300);
   return res_norm < o.tolerance;
 }
-
-} // namespace
 
 Eigen::MatrixXcd sine_force(double amplitude) {
   Eigen::MatrixXcd F = Eigen::MatrixXcd::Zero(2, 1);
@@ -96,28 +138,8 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   omega_ = two_pi * frequency_hz;
   for (const auto& j : joints)
     layout_.push_back({j.node, j.node_b, j.dof});
-  // Sample tables of one joint's deformation and rate, y_n = dy z and ẏ_n = dv z, and the
-  // transform from samples to packed harmonics.
-  const int m = 2 * K_ + 1;
-  dy_.resize(Nt_, m), dv_.resize(Nt_, m), forward_.resize(m, Nt_);
-  for (int n = 0; n < Nt_; ++n) {
-    const double theta = two_pi * n / Nt_;
-    dy_(n, 0) = 1.0;
-    dv_(n, 0) = 0.0;
-    forward_(0, n) = 1.0 / Nt_;
-    for (int k = 1; k <= K_; ++k) {
-      const double c = std::cos(k * theta), s = std::sin(k * theta);
-      dy_(n, 2 * k - 1) = c, dy_(n, 2 * k) = -s;
-      dv_(n, 2 * k - 1) = -k * omega_ * s, dv_(n, 2 * k) = -k * omega_ * c;
-      forward_(2 * k - 1, n) = 2.0 * c / Nt_, forward_(2 * k, n) = -2.0 * s / Nt_;
-    }
-  }
-  cos2_.resize(Nt_, 2 * K_ + 1), sin2_.resize(Nt_, 2 * K_ + 1);
-  for (int n = 0; n < Nt_; ++n)
-    for (int p = 0; p <= 2 * K_; ++p) {
-      const double a = two_pi * (static_cast<long long>(p) * n % Nt_) / Nt_;
-      cos2_(n, p) = std::cos(a), sin2_(n, p) = std::sin(a);
-    }
+  tables_ = &aft_tables(Nt_, K_);
+  dv_ = omega_ * tables_->dv_unit;
   // Joint DOFs (node and node_b) and the B matrix restricted to them.
   const std::vector<int> jdofs = joints::joint_dof_set(joints, dofs);
   const Eigen::MatrixXcd B = joints::joint_coordinates_on(joints, dofs, jdofs).cast<Complex>();
@@ -165,10 +187,10 @@ HarmonicBalance::equations(const std::vector<joints::Joint>& joints,
     const double c = std::max(std::abs(Hyy_[1](j, j)), 1e-300);
     friction.push_back({j, limit, 1.0 / (omega_ * c), c});
   }
-  return std::make_unique<Equations>(Equations{K_, nj_, Nt_, Hyy_, std::move(HyF_F), std::move(Fk),
-                                               joints, exact ? 0.0 : options_.friction_width,
-                                               std::move(friction), dy_, dv_, forward_, cos2_,
-                                               sin2_, omega_});
+  return std::make_unique<Equations>(
+      Equations{K_, nj_, Nt_, Hyy_, std::move(HyF_F), std::move(Fk), joints,
+                exact ? 0.0 : options_.friction_width, std::move(friction), tables_->dy, dv_,
+                tables_->forward, tables_->cos, tables_->sin, omega_});
 }
 
 Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
@@ -224,7 +246,7 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
       Eigen::VectorXd slip(Nt_);
       for (int n = 0; n < Nt_; ++n)
         slip(n) = v(n) > 0.0 ? friction[f].limit : v(n) < 0.0 ? -friction[f].limit : 0.0;
-      z.segment((nj_ + static_cast<int>(f)) * (2 * K_ + 1), 2 * K_ + 1) = forward_ * slip;
+      z.segment((nj_ + static_cast<int>(f)) * (2 * K_ + 1), 2 * K_ + 1) = tables_->forward * slip;
     }
   }
   return z;
@@ -251,13 +273,14 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
   const Eigen::VectorXd z_start = z;
   int iterations = 0;
   double residual = 0.0;
-  bool converged = newton(*P, z, 1.0, options_, iterations, residual);
+  bool converged = detail::newton(*P, z, 1.0, options_, iterations, residual);
   if (!converged) { // load continuation from a small, nearly linear level
     const int steps = std::max(1, options_.continuation_steps);
     z = z_start / steps;
     converged = true;
     for (int s = 1; s <= steps && converged; ++s)
-      converged = newton(*P, z, static_cast<double>(s) / steps, options_, iterations, residual);
+      converged =
+          detail::newton(*P, z, static_cast<double>(s) / steps, options_, iterations, residual);
   }
   HarmonicBalanceResult out = result(*P, z);
   out.converged = converged;

@@ -23,7 +23,8 @@ namespace jointid::frf {
 
 namespace detail {
 struct Equations; // frf/hb_equations.hpp, internal
-}
+struct Tables;    // frf/harmonic_balance.cpp: AFT sample tables, shared by (K, samples)
+} // namespace detail
 
 struct HarmonicBalanceOptions {
   int harmonics = 9;            ///< K, harmonics 0 … K
@@ -90,8 +91,8 @@ private:
   int K_, nj_, nf_, Nt_;
   double omega_, frequency_hz_;
   std::vector<CMatrix> Hyy_, HyF_, HoB_, HoF_; // per harmonic
-  Eigen::MatrixXd dy_, dv_, forward_;          // AFT sample tables (see solve())
-  Eigen::MatrixXd cos2_, sin2_;                // cos, sin of p θ_n, p ≤ 2K (the Jacobian)
+  const detail::Tables* tables_ = nullptr;     // AFT sample tables independent of ω (cached)
+  Eigen::MatrixXd dv_;                         // ∂ẏ_n/∂z at this ω
 };
 
 /// One steady state under F0 sin(2π f t) at `force_equation`.

@@ -209,4 +209,9 @@ struct Equations {
   }
 };
 
+/// Newton's method (least-norm steps where J is singular, backtracking) on R(z) = 0 at the
+/// given load factor; true when |R| / |z| < options.tolerance. Counts into `iterations`.
+bool newton(const Equations& equations, Eigen::VectorXd& z, double load,
+            const HarmonicBalanceOptions& options, int& iterations, double& residual);
+
 } // namespace jointid::frf::detail

@@ -83,6 +83,23 @@ ModalSynthesis ModalSynthesis::with_damping_scale(double factor) const {
   return scaled;
 }
 
+Eigen::MatrixXd ModalSynthesis::shapes(std::span<const int> equations) const {
+  Eigen::MatrixXd out(equations.size(), phi_.cols());
+  for (std::size_t i = 0; i < equations.size(); ++i)
+    out.row(static_cast<Eigen::Index>(i)) = phi_.row(position(equations[i]));
+  return out;
+}
+
+Eigen::MatrixXd ModalSynthesis::residual_flexibility(std::span<const int> rows,
+                                                     std::span<const int> cols) const {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(rows.size(), cols.size());
+  if (!has_residual_) return out;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (std::size_t j = 0; j < cols.size(); ++j)
+      out(i, j) = residual_(position(rows[i]), position(cols[j]));
+  return out;
+}
+
 int ModalSynthesis::position(int equation) const {
   const auto it = std::find(dofs_.begin(), dofs_.end(), equation);
   if (it == dofs_.end())

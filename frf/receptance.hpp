@@ -56,6 +56,14 @@ public:
   bool has_residual() const { return has_residual_; }
   int num_modes() const { return static_cast<int>(omega_.size()); }
   const std::vector<int>& dofs() const { return dofs_; }
+  /// The modes behind the synthesis: ω_r (rad/s), 2ζ_rω_r (1/s), and the mass-normalised shapes
+  /// at the given equations (|equations| × n_modes; each one of `dofs`).
+  const Eigen::VectorXd& natural_frequencies() const { return omega_; }
+  const Eigen::VectorXd& modal_damping() const { return modal_damping_; }
+  Eigen::MatrixXd shapes(std::span<const int> equations) const;
+  /// The static residual flexibility (m/N) of the modes not computed, rows × cols (zero when
+  /// the synthesis has none).
+  Eigen::MatrixXd residual_flexibility(std::span<const int> rows, std::span<const int> cols) const;
 
 private:
   int position(int equation) const;

@@ -96,7 +96,8 @@ TEST_F(CliTest, EveryCommandHasHelp) {
                                                {"simulate", "--help"},
                                                {"identify", "--help"},
                                                {"discover", "--help"},
-                                               {"modes", "--help"}}) {
+                                               {"modes", "--help"},
+                                               {"response", "--help"}}) {
     const Outcome run = jointid(args, dir());
     EXPECT_EQ(run.status, 0) << args[0];
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << run.out;
@@ -498,6 +499,78 @@ TEST_F(CliTest, UsageErrorsAreOneLine) {
   expect_one_line_error(
       jointid({"modes", (dir() / "missing.toml").string(), "-o", (dir() / "m").string()}, dir()),
       "missing.toml");
+}
+
+TEST_F(CliTest, ResponseWritesTheContractWithFoldsAndStability) {
+  // The README's hardening cantilever: at 10 N the curve is single-valued and stable; at 80 N it
+  // overhangs: two folds, the points between them unstable, those outside stable. (The physics
+  // is tested in frf/continuation_test.cpp; here the command and its JSON contract.)
+  const fs::path model =
+      fs::path(JOINTID_SOURCE_DIR) / "examples" / "response" / "hardening_tip.toml";
+  const fs::path out = dir() / "response";
+  const Outcome run =
+      jointid({"response", model.string(), "--force", "7:uy", "--amplitude", "10,80",
+               "--freq-range", "15:30", "--harmonics", "5", "--no-plot", "-o", out.string()},
+              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(run.err.empty()) << run.err; // not a terminal: no progress
+  EXPECT_FALSE(fs::exists(out / "response.png"));
+  const json j = json::parse(test::read_text(out / "response.json"));
+  EXPECT_EQ(j.at("harmonics").get<int>(), 5);
+  ASSERT_EQ(j.at("curves").size(), 2u);
+  for (std::size_t c = 0; c < 2; ++c) {
+    const json& curve = j["curves"][c];
+    EXPECT_DOUBLE_EQ(curve.at("amplitude").get<double>(), c == 0 ? 10.0 : 80.0);
+    const json& points = curve.at("points");
+    ASSERT_GT(points.size(), 20u);
+    EXPECT_DOUBLE_EQ(points.front().at("freq_hz").get<double>(), 15.0);
+    EXPECT_DOUBLE_EQ(points.back().at("freq_hz").get<double>(), 30.0);
+    const std::vector<int> folds = curve.at("folds").get<std::vector<int>>();
+    ASSERT_EQ(folds.size(), c == 0 ? 0u : 2u);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const json& x = points[i].at("x");
+      ASSERT_EQ(x.size(), 1u); // the joint's DOF is the force DOF
+      ASSERT_EQ(x.at("7:uy").size(), 6u);
+      EXPECT_EQ(x["7:uy"][1].size(), 2u);
+      const bool between =
+          folds.size() == 2 && static_cast<int>(i) > folds[0] && static_cast<int>(i) < folds[1];
+      const double mu = points[i].at("max_multiplier").get<double>();
+      if (std::abs(mu - 1.0) > 1e-3) {
+        EXPECT_EQ(points[i].at("stable").get<bool>(), !between) << c << " " << i;
+      }
+    }
+    if (c == 1) {
+      // Hardening: the first fold (end of the upper branch) at the higher frequency and amplitude.
+      const json &a = points[folds[0]], &b = points[folds[1]];
+      EXPECT_GT(a["freq_hz"].get<double>(), b["freq_hz"].get<double>() + 1.0);
+      const auto amplitude1 = [](const json& p) {
+        return std::hypot(p["x"]["7:uy"][1][0].get<double>(), p["x"]["7:uy"][1][1].get<double>());
+      };
+      EXPECT_GT(amplitude1(a), 2.0 * amplitude1(b));
+    }
+  }
+}
+
+TEST_F(CliTest, ResponseChecksItsOptionsBeforeWriting) {
+  const fs::path model =
+      fs::path(JOINTID_SOURCE_DIR) / "examples" / "response" / "hardening_tip.toml";
+  const fs::path out = dir() / "response_bad";
+  auto run = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"response", model.string(), "--no-plot", "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    if (std::find(extra.begin(), extra.end(), "--force") == extra.end())
+      args.insert(args.end(), {"--force", "7:uy"});
+    return jointid(args, dir());
+  };
+  expect_one_line_error(run({"--amplitude", "10", "--freq-range", "15-30"}), "F0:F1");
+  expect_one_line_error(run({"--amplitude", "10", "--freq-range", "20:20"}), "different");
+  expect_one_line_error(run({"--amplitude", "10,10", "--freq-range", "15:30"}), "twice");
+  expect_one_line_error(run({"--amplitude", "-1", "--freq-range", "15:30"}), "> 0");
+  expect_one_line_error(run({"--amplitude", "10", "--freq-range", "15:30", "--plot-dof", "3:uy"}),
+                        "force DOF (7:uy) or a joint's DOF");
+  expect_one_line_error(run({"--amplitude", "10", "--freq-range", "15:30", "--force", "9:uy"}),
+                        "--force 9:uy");
+  EXPECT_FALSE(fs::exists(out));
 }
 
 } // namespace

@@ -1,0 +1,481 @@
+#include "frf/continuation.hpp"
+
+#include "frf/hb_equations.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace jointid::frf {
+
+using detail::two_pi;
+
+namespace {
+
+bool has_exact_friction(const std::vector<joints::Joint>& joints, const HarmonicBalanceOptions& o) {
+  if (!o.exact_friction) return false;
+  for (const joints::Joint& j : joints) {
+    const int t = j.term_index(joints::Term::fc);
+    if (t >= 0 && j.values[t] != 0.0) return true;
+  }
+  return false;
+}
+
+std::string hz(double f) {
+  std::ostringstream s;
+  s.precision(6);
+  s << f << " Hz";
+  return s.str();
+}
+
+// The harmonic-balance problem at one frequency: its receptances and its equations.
+struct Frame {
+  double omega;
+  std::unique_ptr<HarmonicBalance> hb;
+  std::unique_ptr<detail::Equations> eq;
+};
+
+class Tracer {
+public:
+  Tracer(const ModalSynthesis& H, const std::vector<joints::Joint>& joints, const fem::DofMap& dofs,
+         std::vector<int> force_equations, const Eigen::MatrixXcd& F, std::vector<int> outputs,
+         const ContinuationOptions& o)
+      : H_(H), joints_(joints), dofs_(dofs), forces_(std::move(force_equations)), F_(F),
+        outputs_(std::move(outputs)), o_(o) {}
+
+  // `hz`, if given, is ω / 2π exactly as the user wrote it (the ends of the band).
+  Frame frame(double omega, double hz = 0.0) const {
+    Frame fr{omega,
+             std::make_unique<HarmonicBalance>(H_, joints_, dofs_, forces_, outputs_,
+                                               hz > 0.0 ? hz : omega / two_pi, o_.hb),
+             nullptr};
+    fr.eq = fr.hb->equations(joints_, F_);
+    return fr;
+  }
+
+  // ∂R/∂ω at (z, ω) by a central difference.
+  Eigen::VectorXd dR_domega(const Eigen::VectorXd& z, double omega) const {
+    const double d = 1e-5 * omega;
+    const Frame up = frame(omega + d), down = frame(omega - d);
+    return (up.eq->residual(z, 1.0, nullptr) - down.eq->residual(z, 1.0, nullptr)) / (2.0 * d);
+  }
+
+  const HarmonicBalanceOptions& hb_options() const { return o_.hb; }
+
+private:
+  const ModalSynthesis& H_;
+  const std::vector<joints::Joint>& joints_;
+  const fem::DofMap& dofs_;
+  std::vector<int> forces_;
+  Eigen::MatrixXcd F_;
+  std::vector<int> outputs_;
+  ContinuationOptions o_;
+};
+
+// A point of the branch in physical units, with its unit tangent in the scaled coordinates of
+// the time it was computed (`t`: n + 1 entries, the last one ω's).
+struct State {
+  Eigen::VectorXd z;
+  double omega = 0.0;
+  Eigen::VectorXd t;
+  int iterations = 0;
+  double residual = 0.0;
+};
+
+Eigen::VectorXd solve_bordered(const Eigen::MatrixXd& A, const Eigen::VectorXd& b) {
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(A);
+  if (lu.isInvertible()) return lu.solve(b);
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+  cod.setThreshold(1e-13);
+  return cod.solve(b);
+}
+
+} // namespace
+
+Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
+                            const fem::DofMap& dofs, const HarmonicBalanceResult& r,
+                            const HarmonicBalanceOptions& o) {
+  Stability out;
+  if (has_exact_friction(joints, o)) {
+    out.note = "not determined: exact dry friction has no derivative while a joint sticks";
+    return out;
+  }
+  const int nj = static_cast<int>(joints.size());
+  if (r.Y.cols() != nj || r.Y.rows() < 2 || !(r.frequency_hz > 0.0))
+    throw std::invalid_argument("floquet_stability: the steady state does not fit the joints");
+  const int K = static_cast<int>(r.Y.rows()) - 1;
+  const double omega = two_pi * r.frequency_hz, T = two_pi / omega;
+  const std::vector<int> jdofs = joints::joint_dof_set(joints, dofs);
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, jdofs);
+  const Eigen::VectorXd& Om = H.natural_frequencies();
+  const Eigen::VectorXd& D = H.modal_damping();
+  // The modes kept: below the cut-off, lowest first, at most 60.
+  std::vector<int> keep;
+  const double cutoff = 2.0 * (K + 1) * omega;
+  std::vector<int> order(Om.size());
+  for (int m = 0; m < Om.size(); ++m)
+    order[m] = m;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return Om(a) < Om(b); });
+  for (int m : order)
+    if (keep.size() < 3 || (Om(m) <= cutoff && keep.size() < 60)) keep.push_back(m);
+  if (keep.empty()) {
+    out.note = "not determined: the substructure has no modes";
+    return out;
+  }
+  const int n = static_cast<int>(keep.size());
+  out.modes = n;
+  const Eigen::MatrixXd phi_all = H.shapes(jdofs);
+  Eigen::MatrixXd phi(jdofs.size(), n);
+  Eigen::VectorXd om(n), d(n);
+  std::vector<bool> kept(Om.size(), false);
+  for (int i = 0; i < n; ++i)
+    phi.col(i) = phi_all.col(keep[i]), om(i) = Om(keep[i]), d(i) = D(keep[i]), kept[keep[i]] = true;
+  const Eigen::MatrixXd P = B.transpose() * phi; // nj × n
+  // The modes left out respond quasi-statically: the joints see their flexibility R (and the
+  // synthesis' residual flexibility), in series with the kept modes.
+  Eigen::MatrixXd R = B.transpose() * H.residual_flexibility(jdofs, jdofs) * B;
+  for (int m = 0; m < Om.size(); ++m)
+    if (!kept[m] && Om(m) > 0.0) {
+      const Eigen::VectorXd p = B.transpose() * phi_all.col(m);
+      R += p * p.transpose() / (Om(m) * Om(m));
+    }
+
+  // The joints' stiffness and damping along the orbit, seen through the flexibility of the
+  // modes left out: δg = Gy δy + Gv δẏ with δy = P δq − R δg (and δẏ ≈ P δq̇ — the left-out
+  // modes' share of the rate is neglected), so δg = S_y P δq + S_v P δq̇ with
+  // S = (I + Gy R)⁻¹ [Gy, Gv].
+  const double width = o.exact_friction ? 0.0 : o.friction_width;
+  Eigen::VectorXd gy(nj), gv(nj);
+  auto sample = [&](double t) {
+    for (int j = 0; j < nj; ++j) {
+      double y = r.Y(0, j).real(), v = 0.0;
+      for (int k = 1; k <= K; ++k) {
+        const Complex e = std::polar(1.0, k * omega * t);
+        y += (r.Y(k, j) * e).real();
+        v += (Complex(0.0, k * omega) * r.Y(k, j) * e).real();
+      }
+      double g;
+      detail::joint_force(joints[j], y, v, width, g, gy(j), gv(j));
+    }
+  };
+  Eigen::MatrixXd Sy(nj, nj), Sv(nj, nj);
+  auto derivatives = [&](double t) {
+    sample(t);
+    const Eigen::MatrixXd A = Eigen::MatrixXd::Identity(nj, nj) + gy.asDiagonal() * R; // I + Gy R
+    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(A);
+    Sy = lu.solve(Eigen::MatrixXd(gy.asDiagonal()));
+    Sv = lu.solve(Eigen::MatrixXd(gv.asDiagonal()));
+  };
+  // Step: h ω_est ≤ 0.5 with ω_est² ≥ the largest stiffness over the period (Gershgorin-like
+  // bound), and at least 16 steps per period of the highest harmonic.
+  const int probe = 16 * (K + 1);
+  double gy_max = 0.0, gv_max = 0.0;
+  for (int i = 0; i < probe; ++i) {
+    sample(T * i / probe);
+    gy_max = std::max(gy_max, gy.cwiseAbs().maxCoeff());
+    gv_max = std::max(gv_max, gv.cwiseAbs().maxCoeff());
+  }
+  const double p2 = P.squaredNorm();
+  const double w_est = std::max(
+      {std::sqrt(om.array().square().maxCoeff() + gy_max * p2), d.maxCoeff() + gv_max * p2, omega});
+  const long steps = std::max<long>(probe, static_cast<long>(std::ceil(T * w_est / 0.5)));
+  if (steps > 400000) {
+    out.note = "not determined: the joints are too stiff for the explicit check (" +
+               std::to_string(steps) + " steps a period)";
+    return out;
+  }
+  const double h = T / static_cast<double>(steps);
+  // W = [δq; δq̇] for the 2n unit initial conditions; Ẇ = A(t) W.
+  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(2 * n, 2 * n);
+  auto rate = [&](double t, const Eigen::MatrixXd& X) {
+    derivatives(t);
+    Eigen::MatrixXd Y(2 * n, 2 * n);
+    const auto q = X.topRows(n), v = X.bottomRows(n);
+    Y.topRows(n) = v;
+    Y.bottomRows(n) = -(om.array().square().matrix().asDiagonal() * q) - d.asDiagonal() * v -
+                      P.transpose() * (Sy * (P * q) + Sv * (P * v));
+    return Y;
+  };
+  for (long s = 0; s < steps; ++s) {
+    const double t = s * h;
+    const Eigen::MatrixXd k1 = rate(t, W);
+    const Eigen::MatrixXd k2 = rate(t + 0.5 * h, W + 0.5 * h * k1);
+    const Eigen::MatrixXd k3 = rate(t + 0.5 * h, W + 0.5 * h * k2);
+    const Eigen::MatrixXd k4 = rate(t + h, W + h * k3);
+    W += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  }
+  if (!W.allFinite()) {
+    out.note = "not determined: the check diverged";
+    return out;
+  }
+  out.multipliers = Eigen::EigenSolver<Eigen::MatrixXd>(W, false).eigenvalues();
+  out.stable = out.multipliers.cwiseAbs().maxCoeff() < 1.0 + 1e-6;
+  return out;
+}
+
+ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
+                              const fem::DofMap& dofs, std::vector<int> force_equations,
+                              const Eigen::MatrixXcd& F, std::vector<int> outputs, double start_hz,
+                              double end_hz, const ContinuationOptions& o,
+                              const std::function<void(double)>& progress) {
+  if (!(start_hz > 0.0) || !(end_hz > 0.0) || start_hz == end_hz)
+    throw std::invalid_argument("response curve: the band needs two different frequencies > 0 "
+                                "Hz, got " +
+                                hz(start_hz) + " and " + hz(end_hz));
+  if (!(o.min_step > 0.0) || !(o.initial_step >= o.min_step) || !(o.max_step >= o.initial_step))
+    throw std::invalid_argument(
+        "response curve: steps must satisfy 0 < min_step <= initial_step <= max_step");
+  if (o.max_points < 2)
+    throw std::invalid_argument("response curve: max_points must be at least 2");
+  const Tracer tracer(H, joints, dofs, std::move(force_equations), F, std::move(outputs), o);
+  const double w0 = two_pi * start_hz, w1 = two_pi * end_hz, dir = w1 > w0 ? 1.0 : -1.0;
+  const double band = std::abs(w1 - w0);
+  const double tol = std::max(o.hb.tolerance, 1e-10);
+  ResponseBranch branch;
+  const bool exact_friction = has_exact_friction(joints, o.hb);
+  if (o.stability && exact_friction)
+    branch.notes.push_back("stability not determined: exact dry friction has no derivative "
+                           "while a joint sticks");
+
+  // The start: a fixed-frequency solve (from the linear guess, then by load steps).
+  Frame fr = tracer.frame(w0, start_hz);
+  const int n = fr.eq->size(), nY = fr.eq->nj * fr.eq->m();
+  // Scales: joint amplitudes by `amp` (the largest met so far); friction force unknowns through
+  // their compliance c; ω by the band.
+  Eigen::VectorXd unit = Eigen::VectorXd::Ones(n);
+  for (std::size_t f = 0; f < fr.eq->friction.size(); ++f)
+    unit.segment((fr.eq->nj + static_cast<int>(f)) * fr.eq->m(), fr.eq->m())
+        .setConstant(1.0 / fr.eq->friction[f].c);
+  State s;
+  s.omega = w0;
+  {
+    s.z = fr.hb->first_guess(*fr.eq, nullptr);
+    const Eigen::VectorXd guess = s.z;
+    bool ok = detail::newton(*fr.eq, s.z, 1.0, o.hb, s.iterations, s.residual);
+    const int steps = std::max(1, o.hb.continuation_steps);
+    if (!ok) {
+      s.z = guess / steps;
+      ok = true;
+      for (int i = 1; i <= steps && ok; ++i)
+        ok = detail::newton(*fr.eq, s.z, static_cast<double>(i) / steps, o.hb, s.iterations,
+                            s.residual);
+    }
+    if (!ok) {
+      branch.notes.push_back("no steady state found at the start, " + hz(start_hz) + " (residual " +
+                             std::to_string(s.residual) + ")");
+      return branch;
+    }
+  }
+  double amp = std::max(s.z.head(nY).norm(), 1e-300);
+  auto scale = [&](const Eigen::VectorXd& z, double w) {
+    Eigen::VectorXd u(n + 1);
+    u.head(n) = z.cwiseQuotient(unit) / amp;
+    u(n) = w / band;
+    return u;
+  };
+  auto unscale = [&](const Eigen::VectorXd& u, Eigen::VectorXd& z, double& w) {
+    z = u.head(n).cwiseProduct(unit) * amp;
+    w = u(n) * band;
+  };
+  // The bordered Jacobian [J_z S_z, R_ω Δω; tᵀ] at (z, ω) and the residual R.
+  auto bordered = [&](const Eigen::VectorXd& z, double w, const Eigen::VectorXd& t,
+                      Eigen::VectorXd& R, double* znorm) {
+    const Frame f = tracer.frame(w);
+    if (znorm) *znorm = f.eq->norm(z);
+    Eigen::MatrixXd Jz(n, n);
+    R = f.eq->residual(z, 1.0, &Jz);
+    Eigen::MatrixXd A(n + 1, n + 1);
+    A.topLeftCorner(n, n) = Jz * (unit * amp).asDiagonal();
+    A.topRightCorner(n, 1) = tracer.dR_domega(z, w) * band;
+    A.bottomRows(1) = t.transpose();
+    return A;
+  };
+  auto tangent = [&](const Eigen::VectorXd& z, double w, const Eigen::VectorXd& previous) {
+    Eigen::VectorXd R;
+    const Eigen::MatrixXd A = bordered(z, w, previous, R, nullptr);
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(n + 1);
+    e(n) = 1.0;
+    Eigen::VectorXd t = solve_bordered(A, e);
+    return Eigen::VectorXd(t / t.norm());
+  };
+  // Corrector from the prediction u_p along t: Newton on [R; tᵀ(u − u_p)] = 0.
+  auto correct = [&](const Eigen::VectorXd& u_p, const Eigen::VectorXd& t, State& out) {
+    Eigen::VectorXd u = u_p;
+    for (int it = 0; it < 12; ++it) {
+      unscale(u, out.z, out.omega);
+      if (!(out.omega > 0.0) || !out.z.allFinite()) return false;
+      Eigen::VectorXd R;
+      double znorm = 0.0;
+      const Eigen::MatrixXd A = bordered(out.z, out.omega, t, R, &znorm);
+      out.residual = R.norm() / std::max(znorm, 1e-300);
+      out.iterations = it;
+      const double arc = t.dot(u - u_p);
+      if (out.residual < tol && std::abs(arc) < 1e-10) return true;
+      Eigen::VectorXd b(n + 1);
+      b.head(n) = -R;
+      b(n) = -arc;
+      const Eigen::VectorXd du = solve_bordered(A, b);
+      if (!du.allFinite()) return false;
+      u += du;
+    }
+    unscale(u, out.z, out.omega);
+    const Frame f = tracer.frame(out.omega);
+    out.residual = f.eq->residual(out.z, 1.0, nullptr).norm() / std::max(f.eq->norm(out.z), 1e-300);
+    return out.residual < tol;
+  };
+  auto record = [&](const State& st) {
+    const Frame f = tracer.frame(st.omega, st.omega == w0   ? start_hz
+                                           : st.omega == w1 ? end_hz
+                                                            : 0.0);
+    ResponsePoint p;
+    p.hb = f.hb->result(*f.eq, st.z);
+    p.hb.converged = true;
+    p.hb.iterations = st.iterations;
+    p.hb.residual = st.residual;
+    if (o.stability && !exact_friction) {
+      const Stability stab = floquet_stability(H, joints, dofs, p.hb, o.hb);
+      p.stable = stab.stable;
+      if (stab.stable) p.max_multiplier = stab.multipliers.cwiseAbs().maxCoeff();
+    }
+    branch.points.push_back(std::move(p));
+  };
+  // A fixed-frequency solve at ω from a guess (the last point at the band's end).
+  auto solve_at = [&](double w, Eigen::VectorXd z, State& out) {
+    const Frame f = tracer.frame(w);
+    out.iterations = 0;
+    if (!detail::newton(*f.eq, z, 1.0, o.hb, out.iterations, out.residual)) return false;
+    out.z = std::move(z);
+    out.omega = w;
+    return true;
+  };
+
+  Eigen::VectorXd e_w = Eigen::VectorXd::Zero(n + 1);
+  e_w(n) = dir;
+  s.t = tangent(s.z, s.omega, e_w);
+  record(s);
+  double ds = o.initial_step, covered = 0.0;
+  const double corner_step = std::max(o.min_step, 1e-3 * o.max_step);
+  while (true) {
+    if (static_cast<int>(branch.points.size()) >= o.max_points) {
+      branch.notes.push_back("stopped after " + std::to_string(o.max_points) + " points at " +
+                             hz(s.omega / two_pi) + " (max_points)");
+      return branch;
+    }
+    if (ds < o.min_step) {
+      branch.notes.push_back("continuation stalled at " + hz(s.omega / two_pi) +
+                             ": no step down to " + std::to_string(o.min_step) + " converged");
+      return branch;
+    }
+    const Eigen::VectorXd u = scale(s.z, s.omega);
+    State next;
+    if (!correct(u + ds * s.t, s.t, next)) {
+      ds *= 0.5;
+      continue;
+    }
+    next.t = tangent(next.z, next.omega, s.t);
+    // A sharp turn: retried shorter, unless the step is already short — then it is a corner of
+    // the branch (exact friction: a sample's stick state changes), which no step removes.
+    if (next.t.dot(s.t) < std::cos(25.0 * std::numbers::pi / 180.0) && ds > corner_step) {
+      ds *= 0.5;
+      continue;
+    }
+    // A fold between s and next: locate it (secant on the arclength, tangent's ω component).
+    if (s.t(n) * next.t(n) < 0.0) {
+      double a = 0.0, b = ds, ta = s.t(n), tb = next.t(n);
+      State fold = next;
+      bool found = false;
+      for (int it = 0; it < 8; ++it) {
+        const double c = a - ta * (b - a) / (tb - ta);
+        State trial;
+        if (!correct(u + c * s.t, s.t, trial)) break;
+        trial.t = tangent(trial.z, trial.omega, s.t);
+        fold = trial, found = true;
+        if (std::abs(trial.t(n)) < 1e-8) break;
+        if (trial.t(n) * ta > 0.0)
+          a = c, ta = trial.t(n);
+        else
+          b = c, tb = trial.t(n);
+      }
+      if (found) {
+        record(fold);
+        branch.folds.push_back(static_cast<int>(branch.points.size()) - 1);
+      }
+    }
+    // Past the band's end: finish exactly there.
+    if ((next.omega - w1) * dir >= 0.0) {
+      const double x = (w1 - s.omega) / (next.omega - s.omega);
+      State last;
+      if (!solve_at(w1, s.z + x * (next.z - s.z), last)) {
+        branch.notes.push_back("no steady state found at the end, " + hz(end_hz));
+        return branch;
+      }
+      record(last);
+      branch.complete = true;
+      if (progress) progress(1.0);
+      return branch;
+    }
+    if ((next.omega - w0) * dir < 0.0) {
+      branch.notes.push_back("the branch turned back out of the band at its start, " +
+                             hz(start_hz) + ", after " + std::to_string(branch.folds.size()) +
+                             " folds");
+      return branch;
+    }
+    record(next);
+    ds = next.iterations <= 3   ? std::min(1.5 * ds, o.max_step)
+         : next.iterations >= 7 ? 0.7 * ds
+                                : ds;
+    s = std::move(next);
+    // Rescale to the largest amplitude met; the tangent, in the new scale, renormalised.
+    const double a_new = std::max(amp, s.z.head(nY).norm());
+    if (a_new > amp) {
+      s.t.head(n) *= amp / a_new;
+      s.t /= s.t.norm();
+      amp = a_new;
+    }
+    covered = std::max(covered, std::abs(s.omega - w0) / band);
+    if (progress) progress(covered);
+  }
+}
+
+ResponseCurves response_curves(const Substructure& sub, const std::vector<joints::Joint>& joints,
+                               const fem::NodeDof& force, const std::vector<double>& amplitudes,
+                               double start_hz, double end_hz, const ContinuationOptions& o,
+                               const std::function<void(std::size_t, double)>& progress) {
+  if (amplitudes.empty())
+    throw std::invalid_argument("response curves: expected at least one force amplitude");
+  for (double a : amplitudes)
+    if (!(std::isfinite(a) && a > 0.0))
+      throw std::invalid_argument("response curves: force amplitudes must be finite and > 0, got " +
+                                  std::to_string(a));
+  if (!(start_hz > 0.0) || !(end_hz > 0.0) || !std::isfinite(start_hz) || !std::isfinite(end_hz) ||
+      start_hz == end_hz)
+    throw std::invalid_argument("response curves: the band needs two different finite "
+                                "frequencies > 0 Hz, got " +
+                                hz(start_hz) + " and " + hz(end_hz));
+  const fem::DofMap& dofs = sub.dofs();
+  const int force_eq = dofs.equation(force); // throws for a DOF not in the model
+  ResponseCurves out;
+  out.harmonics = o.hb.harmonics;
+  out.amplitudes = amplitudes;
+  std::vector<int> outputs = joints::joint_dof_set(joints, dofs);
+  if (std::find(outputs.begin(), outputs.end(), force_eq) == outputs.end())
+    outputs.push_back(force_eq);
+  for (int e : outputs)
+    out.dofs.push_back(dofs.node_dof(e));
+  const ModalSynthesis synthesis = sub.synthesis(
+      outputs, synthesis_band_hz(std::max(start_hz, end_hz), o.hb.harmonics), &out.notes);
+  for (std::size_t i = 0; i < amplitudes.size(); ++i) {
+    std::function<void(double)> each;
+    if (progress) each = [&progress, i](double fraction) { progress(i, fraction); };
+    Eigen::MatrixXcd F = Eigen::MatrixXcd::Zero(2, 1);
+    F(1, 0) = Complex(0.0, -amplitudes[i]);
+    out.curves.push_back(
+        trace_response(synthesis, joints, dofs, {force_eq}, F, outputs, start_hz, end_hz, o, each));
+  }
+  return out;
+}
+
+} // namespace jointid::frf

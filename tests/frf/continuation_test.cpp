@@ -1,0 +1,268 @@
+// Response curves by continuation: against fixed-frequency harmonic balance, the exact linear
+// FRF, time integration from rest, and the Floquet multipliers of the bare structure.
+#include "frf/continuation.hpp"
+
+#include "fem/damping.hpp"
+#include "fem/time_integration.hpp"
+#include "support/beam_models.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+using namespace jointid;
+using fem::Dof;
+using frf::Complex;
+using joints::Term;
+
+namespace {
+
+constexpr double two_pi = 2.0 * std::numbers::pi;
+
+joints::Joint make(std::string name, int node, std::vector<Term> terms,
+                   std::vector<double> values) {
+  joints::Joint j{std::move(name), node, 0, Dof::uy, std::move(terms), std::move(values), {}, {}};
+  j.fixed.assign(j.terms.size(), true);
+  return j;
+}
+
+// The METHOD.md cantilever (first mode 3.0 Hz), 6 elements, 1 % modal damping, every mode kept.
+struct PaperCantilever {
+  fem::Model model = [] {
+    fem::Model m = test::cantilever(6, {});
+    m.damping.kind = fem::Damping::Kind::modal;
+    m.damping.modal_ratio = 0.01;
+    return m;
+  }();
+  fem::Assembled system = fem::assemble(model);
+  fem::Modes modes =
+      fem::modal_analysis(system, {.num_modes = 0, .engine = fem::ModalEngine::dense});
+  frf::ModalSynthesis H{system, modes, model.damping, test::all_equations(system)};
+  int eq(int node) const { return system.dofs.equation({node, Dof::uy}); }
+};
+
+frf::ResponseBranch trace(const PaperCantilever& c, const std::vector<joints::Joint>& js, double F0,
+                          double f0, double f1, frf::ContinuationOptions o = {}) {
+  return frf::trace_response(c.H, js, c.system.dofs, {c.eq(7)}, frf::sine_force(F0), {c.eq(7)}, f0,
+                             f1, o);
+}
+
+// Harmonic k of a periodic record sampled over whole periods: x = Re Σ X_k e^{ikωt}.
+Complex harmonic(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double omega, int k) {
+  Complex sum = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    sum += x(i) * std::polar(1.0, -k * omega * t(i));
+  return (k == 0 ? 1.0 : 2.0) / static_cast<double>(x.size()) * sum;
+}
+
+// Where the branch's frequency moves forwards (+1) or backwards (−1) at point i.
+double heading(const frf::ResponseBranch& b, std::size_t i) {
+  return b.points[i + 1].hb.frequency_hz > b.points[i].hb.frequency_hz ? 1.0 : -1.0;
+}
+
+// The point of segment [from, to) of the branch that crosses frequency f, linearly interpolated
+// in the harmonics of the joint deformation.
+Eigen::MatrixXcd crossing(const frf::ResponseBranch& b, int from, int to, double f) {
+  for (int i = from; i + 1 < to; ++i) {
+    const double fa = b.points[i].hb.frequency_hz, fb = b.points[i + 1].hb.frequency_hz;
+    if ((fa - f) * (fb - f) <= 0.0 && fa != fb) {
+      const double x = (f - fa) / (fb - fa);
+      return (1.0 - x) * b.points[i].hb.Y + x * b.points[i + 1].hb.Y;
+    }
+  }
+  ADD_FAILURE() << "no crossing of " << f << " Hz in points " << from << " … " << to;
+  return {};
+}
+
+} // namespace
+
+TEST(Continuation, LinearJointFollowsTheExactFrf) {
+  // g = k y + c ẏ at the tip: X = H_tt F / (1 + H_tt (k + iωc)) exactly (see the harmonic
+  // balance tests). Over 1 … 25 Hz (two resonances) the branch must go forwards only, end at
+  // 25 Hz, have no folds, and every point must be the exact solution (Newton's tolerance 1e-10
+  // on the linear problem).
+  const PaperCantilever c;
+  const double k = 4800.0, cv = 20.0, F0 = 80.0;
+  const std::vector<joints::Joint> js{make("tip", 7, {Term::k, Term::c}, {k, cv})};
+  const frf::ResponseBranch b = trace(c, js, F0, 1.0, 25.0);
+  ASSERT_TRUE(b.complete);
+  EXPECT_TRUE(b.folds.empty());
+  EXPECT_DOUBLE_EQ(b.points.front().hb.frequency_hz, 1.0);
+  EXPECT_DOUBLE_EQ(b.points.back().hb.frequency_hz, 25.0);
+  EXPECT_GT(b.points.size(), 50u);
+  const std::vector<int> tip{c.eq(7)};
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    const frf::ResponsePoint& p = b.points[i];
+    if (i + 1 < b.points.size()) {
+      EXPECT_GT(heading(b, i), 0.0) << i;
+    }
+    const double w = two_pi * p.hb.frequency_hz;
+    const Complex Htt = c.H.receptance(w, tip, tip)(0, 0);
+    const Complex X = Htt * Complex(0.0, -F0) / (1.0 + Htt * Complex(k, w * cv));
+    EXPECT_LE(std::abs(p.hb.X(1, 0) - X), 1e-9 * std::abs(X)) << p.hb.frequency_hz;
+    ASSERT_TRUE(p.stable.has_value());
+    EXPECT_TRUE(*p.stable);
+  }
+}
+
+TEST(Continuation, FloquetMultipliersOfTheBareStructure) {
+  // At a vanishing amplitude the joint (k3 only) adds nothing: the multipliers are those of the
+  // damped modes over one period, |μ_r| = exp(−ζ ω_r T) (ζ = 1 %), the largest from mode 1. The
+  // classical Runge–Kutta method with h ω_1 ≤ 0.5 ω_1/ω_max is accurate to ≪ 1e-6 for mode 1.
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{make("tip", 7, {Term::k3}, {1.6e8})};
+  for (double f : {1.0, 3.0, 7.0}) {
+    const frf::HarmonicBalanceResult r =
+        frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 1e-9, f, std::vector<int>{c.eq(7)});
+    ASSERT_TRUE(r.converged);
+    const frf::Stability s = frf::floquet_stability(c.H, js, c.system.dofs, r, {});
+    ASSERT_TRUE(s.stable.has_value()) << s.note;
+    EXPECT_TRUE(*s.stable);
+    EXPECT_GE(s.modes, 3);
+    const double w1 = c.H.natural_frequencies().minCoeff();
+    EXPECT_NEAR(s.multipliers.cwiseAbs().maxCoeff(), std::exp(-0.01 * w1 / f), 1e-6) << f;
+  }
+}
+
+TEST(Continuation, HardeningCubicFoldsAndStability) {
+  // k3 = 1.6e8 N/m³ at the tip, 0.5 N: the first resonance (3.0 Hz) bends to the right and
+  // overhangs. Checked: two folds (upper, then lower; 3 solutions between their frequencies);
+  // every point a steady state of the fixed-frequency harmonic balance; the branch goes
+  // backwards exactly between the folds, and exactly those points are unstable (a saddle-node:
+  // one multiplier through +1 at each fold, so |μ|max = 1 there up to the modes the check leaves
+  // out); time integration from rest between the folds ends on a stable branch, not the middle.
+  const PaperCantilever c;
+  const double F0 = 0.5;
+  const std::vector<joints::Joint> js{make("tip", 7, {Term::k3}, {1.6e8})};
+  const frf::ResponseBranch b = trace(c, js, F0, 2.5, 4.5);
+  ASSERT_TRUE(b.complete);
+  ASSERT_EQ(b.folds.size(), 2u);
+  const int up = b.folds[0], down = b.folds[1];
+  const double f_up = b.points[up].hb.frequency_hz, f_down = b.points[down].hb.frequency_hz;
+  EXPECT_GT(f_up, f_down + 0.1);
+  EXPECT_GT(f_down, 3.0); // hardening: both folds above the linear resonance
+  EXPECT_GT(std::abs(b.points[up].hb.X(1, 0)), 2.0 * std::abs(b.points[down].hb.X(1, 0)));
+
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    const frf::ResponsePoint& p = b.points[i];
+    // Fixed-frequency Newton started at the point stays there.
+    const frf::HarmonicBalance at(c.H, js, c.system.dofs, {c.eq(7)}, {c.eq(7)}, p.hb.frequency_hz);
+    const frf::HarmonicBalanceResult r = at.solve(js, frf::sine_force(F0), &p.hb.Y);
+    ASSERT_TRUE(r.converged) << i;
+    EXPECT_LE((r.Y - p.hb.Y).norm(), 1e-9 * p.hb.Y.norm()) << i;
+    const bool between = static_cast<int>(i) > up && static_cast<int>(i) < down;
+    const bool at_fold = static_cast<int>(i) == up || static_cast<int>(i) == down;
+    if (i + 1 < b.points.size() && !at_fold && static_cast<int>(i + 1) != up &&
+        static_cast<int>(i + 1) != down) {
+      EXPECT_EQ(heading(b, i), between ? -1.0 : 1.0) << i;
+    }
+    ASSERT_TRUE(p.stable.has_value()) << i;
+    if (at_fold) {
+      EXPECT_NEAR(p.max_multiplier, 1.0, 1e-3) << i;
+    } else if (std::abs(p.max_multiplier - 1.0) > 1e-3) { // clear of the folds
+      EXPECT_EQ(*p.stable, !between) << i << " at " << p.hb.frequency_hz << " Hz";
+    }
+  }
+
+  // Between the folds: three distinct steady states, and time integration from rest lands on
+  // one of the stable ones (the lower branch: it starts from small amplitudes), to its 1e-4.
+  const double f = 0.5 * (f_up + f_down), w = two_pi * f;
+  const Eigen::MatrixXcd lower = crossing(b, down, static_cast<int>(b.points.size()), f),
+                         middle = crossing(b, up, down + 1, f), upper = crossing(b, 0, up + 1, f);
+  const frf::HarmonicBalance at(c.H, js, c.system.dofs, {c.eq(7)}, {c.eq(7)}, f);
+  std::vector<frf::HarmonicBalanceResult> three;
+  for (const Eigen::MatrixXcd* start : {&lower, &middle, &upper}) {
+    three.push_back(at.solve(js, frf::sine_force(F0), start));
+    ASSERT_TRUE(three.back().converged);
+  }
+  EXPECT_GT(std::abs(three[1].X(1, 0)), 1.3 * std::abs(three[0].X(1, 0)));
+  EXPECT_GT(std::abs(three[2].X(1, 0)), 1.02 * std::abs(three[1].X(1, 0)));
+  EXPECT_TRUE(frf::floquet_stability(c.H, js, c.system.dofs, three[0], {}).stable.value());
+  EXPECT_FALSE(frf::floquet_stability(c.H, js, c.system.dofs, three[1], {}).stable.value());
+  EXPECT_TRUE(frf::floquet_stability(c.H, js, c.system.dofs, three[2], {}).stable.value());
+
+  const fem::SparseMatrix C = fem::damping_matrix(c.system, c.model.damping, &c.modes);
+  const joints::JointForces forces(js, c.system.dofs);
+  fem::SteadyStateOptions o;
+  o.steps_per_period = 2048;
+  o.output_periods = 1;
+  o.tolerance = 1e-9;
+  const std::vector<int> outputs{c.eq(7)};
+  const fem::SteadyState s = fem::steady_state(c.system, C, &forces, {c.eq(7), F0, f}, outputs, o);
+  ASSERT_EQ(s.status, fem::SteadyStateStatus::converged);
+  const Complex T1 = harmonic(s.u.col(0), s.t, w, 1);
+  EXPECT_LT(std::abs(T1 - three[0].X(1, 0)), 1e-4 * std::abs(three[0].X(1, 0)));
+}
+
+TEST(Continuation, SofteningTracedUpAndDownAlike) {
+  // k = 4800 N/m with k3 = −2e8 N/m³ at the tip, 0.3 N: the resonance (≈4.2 Hz with the joint's
+  // k) bends to the left. Traced upwards and downwards the branch is the same curve: the same
+  // two folds (in reverse order) at the same frequencies, to the location's accuracy (the secant
+  // stops at |t_ω| < 1e-8; a fold is quadratic in the arclength, so the frequency is exact to
+  // far below 1e-8 relative; 1e-6 asserted), both below the linear resonance.
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{make("tip", 7, {Term::k, Term::k3}, {4800.0, -2e8})};
+  const frf::ResponseBranch up = trace(c, js, 0.3, 3.0, 5.0), down = trace(c, js, 0.3, 5.0, 3.0);
+  ASSERT_TRUE(up.complete);
+  ASSERT_TRUE(down.complete);
+  ASSERT_EQ(up.folds.size(), 2u);
+  ASSERT_EQ(down.folds.size(), 2u);
+  for (int i : {0, 1}) {
+    const double fu = up.points[up.folds[i]].hb.frequency_hz;
+    const double fd = down.points[down.folds[1 - i]].hb.frequency_hz;
+    EXPECT_NEAR(fu, fd, 1e-6 * fu) << i;
+  }
+  // Upwards the branch turns back first at the higher frequency (the end of the lower branch,
+  // the jump up of a rising sweep), then forwards again at the lower one, where the upper
+  // branch begins: the amplitude is larger there.
+  const frf::ResponsePoint &a = up.points[up.folds[0]], &b = up.points[up.folds[1]];
+  EXPECT_GT(a.hb.frequency_hz, b.hb.frequency_hz);
+  EXPECT_GT(std::abs(b.hb.X(1, 0)), 1.3 * std::abs(a.hb.X(1, 0)));
+  // The linear resonance with the joint's k: ω² = eigenvalue of the tip-stiffened structure,
+  // above both folds. From the linear FRF's peak: scan |X| on a fine grid.
+  const std::vector<int> tip{c.eq(7)};
+  double f_peak = 0.0, peak = 0.0;
+  for (double f = 3.0; f <= 5.0; f += 1e-4) {
+    const double w = two_pi * f;
+    const Complex Htt = c.H.receptance(w, tip, tip)(0, 0);
+    const double x = std::abs(Htt / (1.0 + Htt * 4800.0));
+    if (x > peak) peak = x, f_peak = f;
+  }
+  EXPECT_LT(a.hb.frequency_hz, f_peak);
+}
+
+TEST(Continuation, ExactFrictionPointsAreFixedFrequencySteadyStates) {
+  // k y + c ẏ + fc sign(ẏ) with fc = 3 N at the tip, 10 N, 2 … 4.5 Hz. Every point must be the
+  // steady state an independent fixed-frequency solve finds from the linear guess (1e-8), and
+  // stability is reported as not determined (set-valued friction), never guessed.
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{
+      make("tip", 7, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, 3.0})};
+  const frf::ResponseBranch b = trace(c, js, 10.0, 2.0, 4.5);
+  for (const auto& n : b.notes)
+    std::printf("note: %s\n", n.c_str());
+  ASSERT_TRUE(b.complete);
+  ASSERT_FALSE(b.notes.empty());
+  EXPECT_NE(b.notes.front().find("not determined"), std::string::npos);
+  for (std::size_t i = 0; i < b.points.size(); i += 3) {
+    const frf::ResponsePoint& p = b.points[i];
+    EXPECT_FALSE(p.stable.has_value());
+    const frf::HarmonicBalanceResult r = frf::harmonic_balance(
+        c.H, js, c.system.dofs, c.eq(7), 10.0, p.hb.frequency_hz, std::vector<int>{c.eq(7)});
+    ASSERT_TRUE(r.converged) << i;
+    EXPECT_LE((r.X - p.hb.X).norm(), 1e-8 * r.X.norm()) << i << " at " << p.hb.frequency_hz;
+  }
+}
+
+TEST(Continuation, BadArgumentsThrow) {
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{make("tip", 7, {Term::k3}, {1.6e8})};
+  EXPECT_THROW(trace(c, js, 1.0, 3.0, 3.0), std::invalid_argument);
+  EXPECT_THROW(trace(c, js, 1.0, -1.0, 3.0), std::invalid_argument);
+  frf::ContinuationOptions o;
+  o.max_step = 1e-3; // below the initial step
+  EXPECT_THROW(trace(c, js, 1.0, 2.0, 3.0, o), std::invalid_argument);
+}
