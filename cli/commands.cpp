@@ -340,6 +340,18 @@ void modes(const ModesOptions& o) {
                                  : "modal analysis failed: the mass matrix is not positive "
                                    "definite (a DOF without mass?)");
   std::vector<std::string> warnings;
+  if (file.matrices) { // K and M given: no mesh to draw, no element table for mechanisms
+    make_output_dir(o.output_dir);
+    const fs::path out = o.output_dir / "modes.json";
+    io::write_json(out, io::modes_json(modes, count,
+                                       {"the substructure is given by its matrices ([matrices]): "
+                                        "no mesh, so no VTK files or pictures"}));
+    fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
+    for (int r = 0; r < std::min(count, modes.num_modes()); ++r)
+      fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
+    fmt::print("wrote {}\n", out.string());
+    return;
+  }
   if (const fem::ZeroModes z = fem::zero_modes(file.model, system, modes); z.count > 0)
     warnings.push_back(z.describe());
   make_output_dir(o.output_dir);

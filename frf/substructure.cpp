@@ -2,6 +2,7 @@
 
 #include "fem/damping.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -35,7 +36,42 @@ fem::Modes checked(fem::Modes modes) {
 } // namespace
 
 Substructure::Substructure(fem::Model model)
-    : model_(std::move(model)), system_(fem::assemble(*model_)) {}
+    : model_(std::move(model)), system_(fem::assemble(*model_)), damping_(model_->damping) {}
+
+Substructure::Substructure(fem::Assembled system, fem::Damping damping) : damping_(damping) {
+  const int n = system.dofs.num_equations();
+  if (n == 0) throw std::invalid_argument("K and M: no DOFs");
+  for (const auto& [name, A] : {std::pair<const char*, const fem::SparseMatrix*>{"K", &system.K},
+                                std::pair<const char*, const fem::SparseMatrix*>{"M", &system.M}}) {
+    if (A->rows() != n || A->cols() != n)
+      throw std::invalid_argument(std::string(name) + " is " + std::to_string(A->rows()) + " x " +
+                                  std::to_string(A->cols()) + ", expected " + std::to_string(n) +
+                                  " x " + std::to_string(n) + " (one row per DOF of the table)");
+    double largest = 0.0;
+    for (Eigen::Index c = 0; c < A->outerSize(); ++c)
+      for (fem::SparseMatrix::InnerIterator it(*A, c); it; ++it) {
+        if (!std::isfinite(it.value()))
+          throw std::invalid_argument(std::string(name) + ": entry (" +
+                                      std::to_string(it.row() + 1) + ", " +
+                                      std::to_string(it.col() + 1) + ") is not finite");
+        largest = std::max(largest, std::abs(it.value()));
+      }
+    const fem::SparseMatrix D = *A - fem::SparseMatrix(A->transpose());
+    for (Eigen::Index c = 0; c < D.outerSize(); ++c)
+      for (fem::SparseMatrix::InnerIterator it(D, c); it; ++it)
+        if (std::abs(it.value()) > 1e-10 * largest)
+          throw std::invalid_argument(
+              std::string(name) + " is not symmetric: entries (" + std::to_string(it.row() + 1) +
+              ", " + std::to_string(it.col() + 1) + ") and (" + std::to_string(it.col() + 1) +
+              ", " + std::to_string(it.row() + 1) + ") differ by " + number(it.value()));
+  }
+  for (int i = 0; i < n; ++i)
+    if (system.M.coeff(i, i) < 0.0)
+      throw std::invalid_argument("M: diagonal entry " + std::to_string(i + 1) + " (" +
+                                  fem::to_string(system.dofs.node_dof(i)) +
+                                  ") is negative: " + number(system.M.coeff(i, i)));
+  system_ = std::move(system);
+}
 
 Substructure::Substructure(ModalModel modal) {
   modal.validate();
@@ -79,7 +115,7 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
     band = checked(fem::modal_analysis(*system_, options));
   }
   const fem::Modes& modes = band ? *band : all_modes();
-  ModalSynthesis synthesis(*system_, modes, model_->damping, std::move(dofs));
+  ModalSynthesis synthesis(*system_, modes, damping_, std::move(dofs));
   if (notes && modes.num_modes() < n && !synthesis.has_residual())
     notes->push_back("receptance from " + std::to_string(modes.num_modes()) + " of " +
                      std::to_string(n) +
@@ -92,7 +128,7 @@ fem::SparseMatrix Substructure::damping_matrix() const {
   if (!system_)
     throw std::logic_error("time integration needs a finite element model; this substructure "
                            "is given by its modes ([modal])");
-  const fem::Damping& damping = model_->damping;
+  const fem::Damping& damping = damping_;
   if (damping.kind != fem::Damping::Kind::modal) return fem::damping_matrix(*system_, damping);
   const int n = system_->dofs.num_equations();
   if (n > dense_limit())

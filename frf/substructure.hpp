@@ -26,10 +26,15 @@ public:
   explicit Substructure(fem::Model model);
   /// Validates (throws std::invalid_argument); equations are numbered as modal.dofs.
   explicit Substructure(ModalModel modal);
+  /// K and M given (exported by another finite element program), their rows numbered by
+  /// `system.dofs`, with this damping. Throws std::invalid_argument for matrices of the wrong
+  /// size, not finite, not symmetric (to 1e-10 of the largest entry) or with a negative mass on
+  /// the diagonal, naming the matrix and the entry.
+  Substructure(fem::Assembled system, fem::Damping damping);
 
   /// The equations: the FE model's free DOFs, or fem::DofMap::from_dofs(modal.dofs).
   const fem::DofMap& dofs() const;
-  const fem::Model* model() const { return model_ ? &*model_ : nullptr; }        ///< nullptr: modal
+  const fem::Model* model() const { return model_ ? &*model_ : nullptr; } ///< nullptr: modal, K/M
   const fem::Assembled* system() const { return system_ ? &*system_ : nullptr; } ///< ditto
   const ModalModel* modal() const { return modal_ ? &*modal_ : nullptr; }        ///< nullptr: FE
 
@@ -58,6 +63,7 @@ private:
   std::optional<fem::Model> model_;
   std::optional<fem::Assembled> system_;
   std::optional<ModalModel> modal_;
+  fem::Damping damping_; // of the FE model, or of the given matrices
   fem::DofMap modal_dofs_;
   mutable std::optional<fem::Modes> all_modes_; // a cache: not safe for concurrent first use
 };

@@ -4,6 +4,7 @@
 #include "fem/elements.hpp"
 #include "io/files.hpp"
 #include "io/gmsh.hpp"
+#include "io/matrix_market.hpp"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -257,8 +258,13 @@ public:
   ModelFile read() {
     Table root(file_, root_, "",
                {"model", "materials", "sections", "mesh", "element_sets", "supports", "masses",
-                "springs", "damping", "options", "joints", "modal"});
+                "springs", "damping", "options", "joints", "modal", "matrices"});
+    if (root.has("modal") && root.has("matrices"))
+      root.fail_at(*root.get("matrices"), "[matrices]",
+                   "give the substructure either by its modes ([modal]) or by its matrices "
+                   "([matrices]), not both");
     if (root.has("modal")) return read_modal_file(root);
+    if (root.has("matrices")) return read_matrices_file(root);
     read_model_table(root);
     read_materials(root);
     read_sections(root);
@@ -292,8 +298,9 @@ private:
     if (zero_is_ground && id == 0) return 0;
     if (!node_lines_.count(id))
       t.fail_at(n, label,
-                modal_ ? fmt::format("node {} is not among the [modal] dofs", id)
-                       : fmt::format("node {} does not exist in [mesh] nodes", id));
+                modal_      ? fmt::format("node {} is not among the [modal] dofs", id)
+                : matrices_ ? fmt::format("node {} is not in the [matrices] DOF table", id)
+                            : fmt::format("node {} does not exist in [mesh] nodes", id));
     return id;
   }
   int node_key(const Table& t, std::string_view key) {
@@ -302,11 +309,11 @@ private:
   // The nodes of a named Gmsh physical group (points, or every node of a group of lines).
   std::vector<int> group_nodes(const Table& t, const toml::node& n, const std::string& label) {
     const std::string name = t.to_string(n, label);
-    if (modal_)
+    if (modal_ || matrices_)
       t.fail_at(n, label,
-                "expected a node id; a substructure given by its modes ([modal]) has no groups "
-                "such as " +
-                    shown(n));
+                std::string("expected a node id; a substructure given by its ") +
+                    (modal_ ? "modes ([modal])" : "matrices ([matrices])") +
+                    " has no groups such as " + shown(n));
     if (!mesh_)
       t.fail_at(n, label,
                 "expected a node id; group names such as " + shown(n) +
@@ -329,11 +336,14 @@ private:
     return std::move(out_);
   }
 
-  void reject_finite_element_keys(const Table& root) {
+  void reject_finite_element_keys(const Table& root, bool damping_allowed = false,
+                                  std::string_view why = "[modal]: the substructure is given by "
+                                                         "its modes") {
     const toml::node* first = nullptr;
     std::string_view first_key;
     for (std::string_view key : {"mesh", "element_sets", "materials", "sections", "supports",
                                  "masses", "springs", "damping", "options"}) {
+      if (damping_allowed && key == "damping") continue;
       const toml::node* n = root.get(key);
       if (!n) continue;
       // An array of tables ([[supports]]) is reported at its first table.
@@ -341,8 +351,73 @@ private:
       if (!first || line_of(*n) < line_of(*first)) first = n, first_key = key;
     }
     if (first)
-      root.fail_at(*first, Table::key_label(first_key),
-                   "not used with [modal]: the substructure is given by its modes");
+      root.fail_at(*first, Table::key_label(first_key), "not used with " + std::string(why));
+  }
+
+  // A substructure given by its stiffness and mass matrices (MatrixMarket files exported by
+  // another program) and a DOF table naming their rows: [matrices], an optional [model] and
+  // [damping], and the joints; the other finite element tables are errors.
+  ModelFile read_matrices_file(const Table& root) {
+    reject_finite_element_keys(root, true,
+                               "[matrices]: the substructure is given by its K and M matrices");
+    if (root.has("model")) read_model_table(root);
+    Table t(file_, *table(root, "matrices"), "[matrices]", {"K", "M", "dofs"});
+    const int line = t.line();
+    auto file_key = [&](std::string_view key, std::string_view what) {
+      const toml::node& n = t.need(key, what);
+      return directory_ / t.to_string(n, Table::key_label(key));
+    };
+    const auto K_path = file_key("K", "the stiffness matrix, a MatrixMarket file (\"k.mtx\")");
+    const auto M_path = file_key("M", "the mass matrix, a MatrixMarket file (\"m.mtx\")");
+    const toml::node& d = t.need("dofs", "the DOF table: a file with one NODE:DOF per line, or a "
+                                         "list such as [\"1:uy\", \"1:rz\"]");
+    std::vector<fem::NodeDof> dofs;
+    if (d.is_string()) {
+      dofs = read_dof_table(directory_ / t.to_string(d, "key 'dofs'"));
+    } else {
+      const toml::array& list =
+          t.to_array(d, "key 'dofs'", "\"<node>:<dof>\" strings such as \"4:uy\"");
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string label = fmt::format("key 'dofs', entry {}", i + 1);
+        const std::string text = t.to_string(list[i], label);
+        fem::NodeDof nd;
+        try {
+          nd = fem::parse_node_dof(text);
+        } catch (const std::invalid_argument&) {
+          t.fail_at(list[i], label,
+                    "expected \"<node>:<dof>\" such as \"4:uy\", got " + shown(list[i]));
+        }
+        if (nd.node <= 0)
+          t.fail_at(list[i], label, "node ids must be > 0 (0 means ground), got " + shown(list[i]));
+        if (std::find(dofs.begin(), dofs.end(), nd) != dofs.end())
+          t.fail_at(list[i], label, shown(list[i]) + " is listed twice");
+        dofs.push_back(nd);
+      }
+      if (dofs.empty()) t.fail_at(d, "key 'dofs'", "expected at least one DOF");
+    }
+    if (root.has("model") && model().dimension == 2)
+      for (const fem::NodeDof& nd : dofs)
+        if (nd.dof != fem::Dof::ux && nd.dof != fem::Dof::uy && nd.dof != fem::Dof::rz)
+          file_.fail(line, "[matrices]: a planar model (dimension = 2) has only ux, uy and rz, "
+                           "the DOF table has " +
+                               fem::to_string(nd));
+    fem::Assembled& system = matrices_.emplace();
+    system.dofs = fem::DofMap::from_dofs(dofs);
+    system.K = read_matrix_market(K_path); // their errors name the .mtx file and line
+    system.M = read_matrix_market(M_path);
+    for (const fem::NodeDof& nd : dofs)
+      node_lines_.emplace(nd.node, line);
+    read_damping(root);
+    try {
+      (void)frf::Substructure(system, model().damping); // sizes, symmetry, masses
+    } catch (const std::invalid_argument& e) {
+      file_.fail(line, fmt::format("[matrices] ({}, {}, {} DOFs): {}", K_path.filename().string(),
+                                   M_path.filename().string(), dofs.size(), e.what()));
+    }
+    read_joints(root);
+    check_joints(system.dofs);
+    out_.matrices = std::move(matrices_);
+    return std::move(out_);
   }
 
   // [modal]: dofs, frequencies_hz, damping, shapes and the optional residual_flexibility.
@@ -962,6 +1037,7 @@ private:
   const toml::table& root_;
   ModelFile out_;
   std::filesystem::path directory_;
+  std::optional<fem::Assembled> matrices_; // [matrices]
   std::optional<GmshMesh> mesh_;
   std::map<int, int> node_lines_, element_lines_, element_position_;
   std::map<int, std::string> element_origin_; // "mesh.msh:LINE" of elements read from Gmsh
@@ -989,7 +1065,9 @@ ModelFile read_model(const std::filesystem::path& path) {
 }
 
 frf::Substructure ModelFile::substructure() const {
-  return modal ? frf::Substructure(*modal) : frf::Substructure(model);
+  if (modal) return frf::Substructure(*modal);
+  if (matrices) return frf::Substructure(*matrices, model.damping);
+  return frf::Substructure(model);
 }
 
 fem::NodeDof resolve_node_dof(const ModelFile& file, std::string_view text) {

@@ -20,9 +20,11 @@ struct ModelFile {
   std::filesystem::path path;           ///< the file it was read from, for messages
   std::optional<GmshMesh> mesh;         ///< the mesh it references, if any (its named groups)
   std::optional<frf::ModalModel> modal; ///< the substructure given by its modes ([modal])
+  /// The substructure given by K and M ([matrices]: MatrixMarket files and a DOF table).
+  std::optional<fem::Assembled> matrices;
 
-  /// The linear substructure: the modal model if given, else the finite element model
-  /// (validated and assembled on each call).
+  /// The linear substructure: the modal model or the matrices if given, else the finite
+  /// element model (validated and assembled on each call).
   frf::Substructure substructure() const;
 };
 
@@ -32,7 +34,9 @@ struct ModelFile {
 /// `fixed = ["k"]` lists terms whose `values` are known and held during identification.
 /// With [modal] (a substructure given by its modes, DESIGN.md) the finite element tables are
 /// errors, [model] is optional (dimension = 2 allows only ux, uy, rz) and the joints must be on
-/// the listed DOFs (fem::DofMap::from_dofs).
+/// the listed DOFs (fem::DofMap::from_dofs). With [matrices] (K = "k.mtx", M = "m.mtx", dofs =
+/// "dofs.txt" or a list; paths relative to the model file) the same holds, [damping] is allowed,
+/// and the matrices are checked (sizes against the DOF table, symmetry, masses).
 /// Throws io::Error naming the file, line, key and what was expected.
 ModelFile read_model(const std::filesystem::path& path);
 
