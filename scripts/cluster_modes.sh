@@ -26,9 +26,9 @@ else
   layout=(--map-by "ppr:1:socket:PE=$threads" --bind-to core)
 fi
 echo "cluster_modes: $ranks ranks on $nodes nodes, $threads BLAS threads each"
-# MUMPS: parallel ordering (PT-Scotch) so that no rank holds the whole graph, and 30 % more
-# working space than its estimate, since a failed factorisation costs a whole restart.
-export PETSC_OPTIONS="${PETSC_OPTIONS:-} -mat_mumps_icntl_28 2 -mat_mumps_icntl_29 1 -mat_mumps_icntl_14 30"
+# MUMPS (options of SLEPc's ST, prefix st_): 30 % more working space than its estimate, since
+# a failed factorisation costs the whole run; -eps_view prints what was solved (rank 0).
+export PETSC_OPTIONS="${PETSC_OPTIONS:-} -st_mat_mumps_icntl_14 30 -st_mat_mumps_icntl_4 1"
 mpirun --hostfile "$hostfile" -np "$ranks" "${layout[@]}" \
   -x OPENBLAS_NUM_THREADS="$threads" -x OMP_NUM_THREADS="$threads" -x PETSC_OPTIONS \
   "$jointid" modes "$model" --engine slepc --count "$count" --pictures 0 -o "$out"
