@@ -1,5 +1,7 @@
 #include "cli/commands.hpp"
 
+#include "cli/engine.hpp"
+
 #include "discover/discover.hpp"
 #include "fem/modal.hpp"
 #include "fem/zero_modes.hpp"
@@ -23,6 +25,7 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <span>
 #include <stdexcept>
@@ -139,7 +142,8 @@ void simulate(const SimulateOptions& o) {
 
   // 2. The model and the tests.
   const io::ModelFile file = io::read_model(o.model);
-  const frf::Substructure sub = file.substructure();
+  frf::Substructure sub = file.substructure();
+  use_engine(sub, parse_engine(o.engine));
   const fem::NodeDof force_at = resolve(file, sub, "--force", o.force);
   for (const auto& text : o.outputs)
     options.extra_outputs.push_back(resolve(file, sub, "--outputs", text));
@@ -179,7 +183,8 @@ void simulate(const SimulateOptions& o) {
       warn(w);
   }
 
-  // 4. Write.
+  // 4. Write (rank 0 of an MPI run).
+  if (!output_rank()) return;
   std::vector<std::pair<fs::path, std::string>> outputs;
   if (o.table) {
     std::vector<std::string> comments{"jointid simulate", "model: " + o.model.string(),
@@ -215,8 +220,10 @@ void identify(const IdentifyOptions& o) {
   options.harmonics = o.harmonics;
   const std::vector<identify::Measurement> measured =
       identify::measure(tests, identify::measure_options(options));
-  const identify::FitResult result =
-      identify::fit(file.substructure(), file.joints, measured, options);
+  frf::Substructure sub = file.substructure();
+  use_engine(sub, parse_engine(o.engine));
+  const identify::FitResult result = identify::fit(sub, file.joints, measured, options);
+  if (!output_rank()) return;
   io::write_json(o.output, io::identify_result_json(result));
 
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
@@ -277,9 +284,11 @@ void discover(const DiscoverOptions& o) {
     throw io::Error(o.model.string() + ": no [[joints]]: discovery starts from the joints' terms");
   const std::vector<identify::SineTest> tests = io::read_tests(o.records);
   const std::vector<identify::Measurement> measured = identify::measure(tests, {.harmonics = K});
-  const frf::Substructure sub = file.substructure();
+  frf::Substructure sub = file.substructure();
+  use_engine(sub, parse_engine(o.engine));
   const discover::Result result = discover::discover(sub, file.joints, measured, options);
 
+  if (!output_rank()) return;
   make_output_dir(o.output_dir);
   const fs::path json = o.output_dir / "discovery.json";
   io::write_json(json, io::discovery_json(result));
@@ -328,17 +337,24 @@ void modes(const ModesOptions& o) {
     fmt::print("wrote {}\n", out.string());
     return;
   }
-  const frf::Substructure sub = file.substructure();
-  const fem::Assembled& system = *sub.system();
-  const int count = std::min(o.count, system.dofs.num_equations());
+  // The slepc engine assembles K and M distributed by rows: rank 0 assembles them whole only
+  // afterwards, for the checks and the files.
+  const Engine engine = parse_engine(o.engine);
+  std::optional<frf::Substructure> sub;
+  if (engine != Engine::slepc) sub.emplace(file.substructure());
+  const int count = std::min(o.count, fem::DofMap(file.model).num_equations());
   fem::ModalOptions options;
   options.num_modes = count;
-  const fem::Modes modes = fem::modal_analysis(system, options);
+  const fem::Modes modes =
+      compute_modes(file.model, sub ? sub->system() : nullptr, options, engine);
   if (modes.status != fem::ModalStatus::success)
     throw std::runtime_error(modes.status == fem::ModalStatus::not_converging
                                  ? "modal analysis did not converge"
                                  : "modal analysis failed: the mass matrix is not positive "
                                    "definite (a DOF without mass?)");
+  if (!output_rank()) return;
+  if (!sub) sub.emplace(file.substructure());
+  const fem::Assembled& system = *sub->system();
   std::vector<std::string> warnings;
   if (file.matrices) { // K and M given: no mesh to draw, no element table for mechanisms
     make_output_dir(o.output_dir);
@@ -357,10 +373,18 @@ void modes(const ModesOptions& o) {
   make_output_dir(o.output_dir);
   const fs::path out = o.output_dir / "modes.json";
   io::write_json(out, io::modes_json(modes, count, warnings));
-  io::write_modes_vtk(o.output_dir, file.model, system.dofs, modes);
   fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
   for (int r = 0; r < std::min(count, modes.num_modes()); ++r)
     fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
+  if (!io::vtk_available()) {
+    fmt::print("wrote {}\n", out.string());
+    warnings.push_back(std::string(io::no_vtk_message) +
+                       " (modes.json only: no .vtu/.pvd files, no modes.png)");
+    for (const auto& w : warnings)
+      warn(w);
+    return;
+  }
+  io::write_modes_vtk(o.output_dir, file.model, system.dofs, modes);
   fmt::print("wrote {}, {} and {} (ParaView)\n", out.string(),
              (o.output_dir / "modes.vtu").string(), (o.output_dir / "mode_<r>.pvd").string());
   if (o.pictures > 0) {

@@ -22,7 +22,8 @@ struct SimulateOptions {
   std::vector<std::string> outputs;            ///< more response points, NODE:DOF
   double noise = 0.0;                          ///< noise RMS / channel RMS
   unsigned long long seed = 1;                 ///< noise generator seed
-  bool table = false; ///< write one stepped-sine table (fundamentals) instead of records
+  bool table = false;          ///< write one stepped-sine table (fundamentals) instead of records
+  std::string engine = "auto"; ///< modes of a large model: auto or slepc (MPI)
   std::filesystem::path output_dir;
 };
 
@@ -35,6 +36,7 @@ struct IdentifyOptions {
   std::vector<std::filesystem::path> records; ///< time records or stepped-sine tables
   std::filesystem::path output;
   std::vector<int> harmonics{1};
+  std::string engine = "auto"; ///< modes of a large model: auto or slepc (MPI)
 };
 
 /// Identifies the joints' non-fixed terms from the tests; writes the JSON result and prints
@@ -51,6 +53,7 @@ struct DiscoverOptions {
   std::vector<std::string> terms; ///< candidate terms; empty: the whole library
   bool substructure_damping = true;
   bool plots = true;
+  std::string engine = "auto"; ///< modes of a large model: auto or slepc (MPI)
 };
 
 /// Model discovery: writes DIR/discovery.json and DIR/report.md with its plots.
@@ -60,7 +63,8 @@ struct ModesOptions {
   std::filesystem::path model;
   std::filesystem::path output_dir;
   int count = 10;
-  int pictures = 4; ///< modes drawn in DIR/modes.png (0: no picture)
+  int pictures = 4;            ///< modes drawn in DIR/modes.png (0: no picture)
+  std::string engine = "auto"; ///< auto, dense, sparse or slepc (MPI, distributed)
 };
 
 /// Writes DIR/modes.json with the lowest `count` natural frequencies (and warnings about

@@ -1,6 +1,8 @@
 // jointid: the command line. Only parses arguments and calls the commands; every error ends
 // here as one line on stderr and exit status 1.
 #include "cli/commands.hpp"
+#include "cli/engine.hpp"
+#include "io/vtk_output.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -28,6 +30,7 @@ std::string one_line(std::string text) {
 // command again under `xvfb-run -a` (a virtual one), once; if that is impossible, carry on and
 // the picture is skipped with a warning.
 void rerun_with_display(char** argv) {
+  if (!jointid::io::vtk_available()) return; // nothing to draw with
   const char* display = std::getenv("DISPLAY");
   if ((display && *display) || std::getenv("JOINTID_UNDER_XVFB")) return;
   setenv("JOINTID_UNDER_XVFB", "1", 1);
@@ -186,15 +189,43 @@ int main(int argc, char** argv) {
   response->add_option("-o,--output", resp.output_dir, "Output directory (created if missing)")
       ->required();
 
+  // --engine: every command that computes modes. slepc runs under mpirun -np N.
+  const std::string large_help =
+      "Modes of models above the dense limit: auto (CHOLMOD on this machine) or slepc "
+      "(distributed, run under mpirun -np N; only rank 0 writes)";
+  simulate->add_option("--engine", sim.engine, large_help)
+      ->check(CLI::IsMember({"auto", "slepc"}))
+      ->capture_default_str();
+  identify->add_option("--engine", ident.engine, large_help)
+      ->check(CLI::IsMember({"auto", "slepc"}))
+      ->capture_default_str();
+  discover->add_option("--engine", disc.engine, large_help)
+      ->check(CLI::IsMember({"auto", "slepc"}))
+      ->capture_default_str();
+  modes
+      ->add_option("--engine", mod.engine,
+                   "auto (dense up to 1500 equations, else CHOLMOD), dense, sparse (CHOLMOD) or "
+                   "slepc (distributed, run under mpirun -np N; only rank 0 writes)")
+      ->check(CLI::IsMember({"auto", "dense", "sparse", "slepc"}))
+      ->capture_default_str();
+
   try {
     app.parse(argc, argv);
+    const std::string engine = simulate->parsed()   ? sim.engine
+                               : identify->parsed() ? ident.engine
+                               : discover->parsed() ? disc.engine
+                                                    : mod.engine;
+    // MPI for the distributed engine; no X display is looked for under it (a picture is
+    // then drawn only when one exists).
+    const cli::EngineSession session(cli::parse_engine(engine));
+    const bool distributed = engine == "slepc";
     if (simulate->parsed()) cli::simulate(sim);
     if (identify->parsed()) cli::identify(ident);
-    if (discover->parsed() && disc.plots) rerun_with_display(argv);
+    if (discover->parsed() && disc.plots && !distributed) rerun_with_display(argv);
     if (discover->parsed()) cli::discover(disc);
     if (response->parsed() && resp.plot) rerun_with_display(argv);
     if (response->parsed()) cli::response(resp);
-    if (modes->parsed() && mod.pictures > 0) rerun_with_display(argv);
+    if (modes->parsed() && mod.pictures > 0 && !distributed) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
     return 0;
   } catch (const CLI::ParseError& e) {

@@ -5,6 +5,8 @@
 
 #include <Eigen/SparseCore>
 
+#include <vector>
+
 namespace jointid::fem {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
@@ -17,5 +19,15 @@ struct Assembled {
 
 /// Validates the model, then assembles elements, point masses and springs.
 Assembled assemble(const Model& model);
+
+/// Triplets (row, column, value) of K and M, duplicates to be summed.
+struct Entries {
+  std::vector<Eigen::Triplet<double>> K, M;
+};
+
+/// The entries of K and M in rows first_row … last_row − 1 only (columns all), for a
+/// distributed assembly where each process owns a range of rows: elements that touch none of
+/// those rows are not computed. Does not validate the model (assemble() does).
+Entries assemble_rows(const Model& model, const DofMap& dofs, int first_row, int last_row);
 
 } // namespace jointid::fem

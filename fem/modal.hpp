@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <optional>
+#include <vector>
 
 namespace jointid::fem {
 
@@ -38,11 +39,29 @@ struct SparseModalStats {
   double lanczos_s = 0.0;           ///< whole Lanczos iteration, solves included
 };
 
+/// What the distributed engine (SLEPc, `fem/slepc_modal.hpp`) did; times in s, wall clock.
+struct DistributedModalStats {
+  int ranks = 1;                 ///< MPI processes
+  double assemble_s = 0.0;       ///< each rank's rows of K and M
+  double factorize_s = 0.0;      ///< MUMPS ordering and factorisation of K − σM
+  double solve_s = 0.0;          ///< Krylov–Schur iteration (its solves with the factor)
+  int restarts = 0;              ///< Krylov–Schur restarts (last pass for a band)
+  double factor_entries = 0.0;   ///< entries of the factor, all ranks (MUMPS INFOG(29))
+  double factor_flops = 0.0;     ///< flops of the factorisation (MUMPS RINFOG(3))
+  double factor_max_bytes = 0.0; ///< MUMPS memory of the largest rank (INFOG(21))
+  double factor_sum_bytes = 0.0; ///< MUMPS memory of all ranks (INFOG(22))
+};
+
 struct Modes {
   ModalStatus status = ModalStatus::success;
   Eigen::VectorXd omega; ///< circular frequencies ω_r, rad/s, ascending (rigid modes ≈ 0)
-  Eigen::MatrixXd phi;   ///< n_eq × n_modes, mass-normalised
+  /// n_eq × n_modes, mass-normalised; or |rows| × n_modes when `rows` is not empty.
+  Eigen::MatrixXd phi;
+  /// Empty: phi has a row for every equation. Otherwise row i of phi is equation rows[i]: an
+  /// engine asked for only the rows a synthesis needs (the distributed engine).
+  std::vector<int> rows;
   std::optional<SparseModalStats> sparse; ///< set by the sparse engine (last pass for a band)
+  std::optional<DistributedModalStats> distributed; ///< set by the distributed engine
   int num_modes() const { return static_cast<int>(omega.size()); }
   double frequency_hz(int r) const;
 };

@@ -22,8 +22,17 @@ ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& m
       throw std::invalid_argument("modal synthesis: equation " + std::to_string(e) +
                                   " out of range");
   phi_.resize(d, m);
-  for (int i = 0; i < d; ++i)
-    phi_.row(i) = modes.phi.row(dofs_[i]);
+  for (int i = 0; i < d; ++i) {
+    int row = dofs_[i];
+    if (!modes.rows.empty()) { // the engine kept only some rows
+      const auto at = std::find(modes.rows.begin(), modes.rows.end(), row);
+      if (at == modes.rows.end())
+        throw std::invalid_argument("modal synthesis: the modes lack the row of equation " +
+                                    std::to_string(row));
+      row = static_cast<int>(at - modes.rows.begin());
+    }
+    phi_.row(i) = modes.phi.row(row);
+  }
   omega_ = modes.omega;
   // Rayleigh damping gives 2 ζ_r ω_r = α + β ω_r² directly; going through ζ_r = α/2ω_r + βω_r/2
   // would lose α for a rigid mode whose computed ω_r is exactly 0.

@@ -112,7 +112,8 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
     fem::ModalOptions options;
     options.max_frequency_hz = f_max_hz;
     options.engine = fem::ModalEngine::sparse;
-    band = checked(fem::modal_analysis(*system_, options));
+    band = checked(band_solver_ ? band_solver_(*model_, *system_, options, dofs)
+                                : fem::modal_analysis(*system_, options));
   }
   const fem::Modes& modes = band ? *band : all_modes();
   ModalSynthesis synthesis(*system_, modes, damping_, std::move(dofs));

@@ -7,6 +7,7 @@
 #include "frf/modal_model.hpp"
 #include "frf/receptance.hpp"
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,6 +57,15 @@ public:
   /// std::logic_error for a modal model ("time integration needs a finite element model").
   fem::SparseMatrix damping_matrix() const;
 
+  /// Computes the band of modes a synthesis of an FE model above the dense limit needs:
+  /// (model, assembled system, options with max_frequency_hz set, equations whose rows of φ
+  /// are needed) → modes, which may hold only those rows (fem::Modes::rows). E.g. the
+  /// distributed engine (fem::slepc_modal_analysis), called on every MPI rank alike.
+  using BandSolver = std::function<fem::Modes(const fem::Model&, const fem::Assembled&,
+                                              const fem::ModalOptions&, const std::vector<int>&)>;
+  /// Replaces the default band solver (fem::modal_analysis, sparse engine); empty: default.
+  void set_band_solver(BandSolver solver) { band_solver_ = std::move(solver); }
+
 private:
   /// Every mode of the FE model (dense engine), computed once and kept.
   const fem::Modes& all_modes() const;
@@ -66,6 +76,7 @@ private:
   fem::Damping damping_; // of the FE model, or of the given matrices
   fem::DofMap modal_dofs_;
   mutable std::optional<fem::Modes> all_modes_; // a cache: not safe for concurrent first use
+  BandSolver band_solver_;
 };
 
 } // namespace jointid::frf

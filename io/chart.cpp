@@ -43,18 +43,6 @@ namespace {
 
 using Rgb = std::array<int, 3>;
 
-/// Matplotlib's "tab10" (Tableau 10): distinct, readable on white, known to every reader.
-constexpr std::array<Rgb, 10> palette{{{31, 119, 180},
-                                       {255, 127, 14},
-                                       {44, 160, 44},
-                                       {214, 39, 40},
-                                       {148, 103, 189},
-                                       {140, 86, 75},
-                                       {227, 119, 194},
-                                       {127, 127, 127},
-                                       {188, 189, 34},
-                                       {23, 190, 207}}};
-
 /// Markers are this many times a series' width: the default width of 2 px then gives 6 px
 /// markers, readable at 1200 × 800.
 constexpr double marker_per_width = 3.0;
@@ -314,7 +302,7 @@ struct YMap {
 void add_series(vtkChartXY* chart, const Chart& spec, const Series& series, std::size_t index,
                 const YMap& y_map) {
   using Style = Series::Style;
-  const Rgb rgb = series.color == Rgb{-1, -1, -1} ? palette[index % palette.size()] : series.color;
+  const Rgb rgb = series.color == Rgb{-1, -1, -1} ? Rgb(palette_color(index)) : series.color;
   const auto r = static_cast<unsigned char>(rgb[0]), g = static_cast<unsigned char>(rgb[1]),
              b = static_cast<unsigned char>(rgb[2]);
   const int type = series.style == Style::bars     ? vtkChart::BAR
@@ -484,10 +472,6 @@ void render_figure(const fs::path& png, const Figure& figure) {
 }
 
 } // namespace
-
-std::array<int, 3> palette_color(std::size_t i) {
-  return palette[i % palette.size()];
-}
 
 void write_chart_png(const fs::path& png, const Figure& figure) {
   check_figure(figure);

@@ -2,6 +2,7 @@
 
 #include "io/chart.hpp"
 #include "io/files.hpp"
+#include "io/vtk_output.hpp"
 
 #include <fmt/format.h>
 
@@ -155,7 +156,8 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   std::string why;
   const bool plots = context.plots && can_render_charts(&why);
   if (context.plots && !plots)
-    warnings.push_back("no plots in the report: " + why + " (run under xvfb-run -a)");
+    warnings.push_back("no plots in the report: " + why +
+                       (vtk_available() ? " (run under xvfb-run -a)" : ""));
   auto plot = [&](const std::string& name, const Figure& figure) -> std::string {
     if (!plots) return "";
     write_chart_png(dir / name, figure);

@@ -16,6 +16,7 @@ add_library(jointid_io_vtk ${CMAKE_CURRENT_LIST_DIR}/vtk_output.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/vtk_display.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/vtk_render.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/chart.cpp
+                           ${CMAKE_CURRENT_LIST_DIR}/palette.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/discovery_report.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/response_figure.cpp)
 target_link_libraries(jointid_io_vtk PUBLIC jointid_io PRIVATE ${VTK_LIBRARIES} fmt::fmt)

@@ -456,6 +456,10 @@ void add_axes(vtkRenderer* renderer, const View& view, double length, int font_s
 
 // -------------------------------------------------------------------------------------------------
 
+bool vtk_available() {
+  return true;
+}
+
 void write_modes_vtk(const fs::path& dir, const fem::Model& model, const fem::DofMap& dofs,
                      const fem::Modes& modes, const VtkOptions& options) {
   check_modes(model, dofs, modes);

@@ -10,6 +10,15 @@
 
 namespace jointid::io {
 
+/// What a build without VTK (-DJOINTID_WITH_VTK=OFF) says when asked for VTK files, pictures or
+/// charts.
+inline constexpr const char* no_vtk_message =
+    "this build has no VTK: rebuild with -DJOINTID_WITH_VTK=ON";
+
+/// False in a build without VTK: then the functions below, write_chart_png (chart.hpp) and
+/// can_render_charts report `no_vtk_message` (std::runtime_error; false with that reason).
+bool vtk_available();
+
 struct VtkOptions {
   /// Frames per mode period in the `mode_<r>.pvd` animations (frame k is displaced by
   /// scale · sin(2πk / frames) · φ_r).

@@ -6,7 +6,10 @@ packages=(build-essential cmake pkg-config libeigen3-dev libspectra-dev libsuite
   libbenchmark-dev libvtk9-dev xvfb xauth
   # OpenBLAS takes over libblas.so.3 (Debian's alternatives) from the reference BLAS, which
   # CHOLMOD's supernodal factorisation otherwise runs on: 8x faster on a 10^5-DOF frame.
-  libopenblas0-pthread)
+  libopenblas0-pthread
+  # The optional distributed modal engine (jointid_fem_slepc) and its tests under mpirun -np 2:
+  # PETSc with MUMPS, SLEPc, Open MPI. About 50 s to install here (issue 11).
+  petsc-dev libslepc-real-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -31,9 +31,11 @@ std::string quoted(const std::string& s) {
   return q + "'";
 }
 
-// Runs jointid with `args`, capturing stdout and stderr through files in `dir`.
-Outcome jointid(const std::vector<std::string>& args, const fs::path& dir) {
-  std::string command = quoted(JOINTID_EXE);
+// Runs jointid with `args`, capturing stdout and stderr through files in `dir`; `launcher`
+// (e.g. mpirun and its options, already quoted) goes in front.
+Outcome jointid(const std::vector<std::string>& args, const fs::path& dir,
+                const std::string& launcher = "") {
+  std::string command = launcher + quoted(JOINTID_EXE);
   for (const auto& a : args)
     command.append(" ").append(quoted(a));
   const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
@@ -208,6 +210,7 @@ TEST_F(CliTest, ModesMatchTheCantileverTheory) {
   }
 }
 
+#if JOINTID_WITH_VTK
 TEST_F(CliTest, ModesWriteParaViewFilesAndAPicture) {
   const fs::path out = dir() / "modes_vtk";
   const Outcome run =
@@ -220,6 +223,54 @@ TEST_F(CliTest, ModesWriteParaViewFilesAndAPicture) {
   ASSERT_TRUE(fs::exists(out / "modes.png")) << run.out << run.err;
   EXPECT_GT(fs::file_size(out / "modes.png"), 10000u);
 }
+#else
+TEST_F(CliTest, ModesWithoutVtkWriteTheFrequenciesAndSaySo) {
+  const fs::path out = dir() / "modes_novtk";
+  const Outcome run =
+      jointid({"modes", model().string(), "-o", out.string(), "--count", "4"}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(json::parse(test::read_text(out / "modes.json"))["modes"].size(), 4u);
+  EXPECT_FALSE(fs::exists(out / "modes.vtu"));
+  EXPECT_FALSE(fs::exists(out / "modes.png"));
+  EXPECT_NE(run.err.find("this build has no VTK: rebuild with -DJOINTID_WITH_VTK=ON"),
+            std::string::npos)
+      << run.err;
+}
+#endif
+
+#if JOINTID_WITH_SLEPC
+// Two MPI ranks (as root in CI, on 2 cores, one BLAS thread each) give the dense engine's
+// frequencies; only rank 0 prints and writes.
+TEST_F(CliTest, ModesWithTheSlepcEngineUnderMpirun) {
+  const fs::path dense = dir() / "modes_dense", slepc = dir() / "modes_slepc";
+  const Outcome reference = jointid({"modes", model().string(), "-o", dense.string(), "--count",
+                                     "5", "--pictures", "0", "--engine", "dense"},
+                                    dir());
+  ASSERT_EQ(reference.status, 0) << reference.err;
+  const std::string mpirun = "OPENBLAS_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 "
+                             "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 " +
+                             quoted(MPIEXEC) + " --oversubscribe -np 2 ";
+  const Outcome run = jointid({"modes", model().string(), "-o", slepc.string(), "--count", "5",
+                               "--pictures", "0", "--engine", "slepc"},
+                              dir(), mpirun);
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(std::count(run.out.begin(), run.out.end(), '\n'), 7) << run.out; // header, 5, wrote
+  const json a = json::parse(test::read_text(dense / "modes.json"));
+  const json b = json::parse(test::read_text(slepc / "modes.json"));
+  ASSERT_EQ(b["modes"].size(), 5u);
+  for (int r = 0; r < 5; ++r) {
+    const double f = a["modes"][r]["frequency_hz"].get<double>();
+    EXPECT_NEAR(b["modes"][r]["frequency_hz"].get<double>(), f, 1e-9 * f) << "mode " << r + 1;
+  }
+}
+#else
+TEST_F(CliTest, SlepcEngineIsRefusedWhenTheBuildHasNone) {
+  const Outcome run = jointid(
+      {"modes", model().string(), "-o", (dir() / "no_slepc").string(), "--engine", "slepc"}, dir());
+  expect_one_line_error(run, "this build has no SLEPc engine");
+  EXPECT_FALSE(fs::exists(dir() / "no_slepc"));
+}
+#endif
 
 TEST_F(CliTest, ModesOfAFreeStructureWarnAboutRigidBodyModes) {
   const fs::path free = dir() / "free.toml";
@@ -399,13 +450,20 @@ TEST_F(CliTest, DiscoverNamesAHiddenCubicStiffnessAndWritesItsReport) {
   EXPECT_TRUE(j["diagnosis"]["level_dependent"].get<bool>());
   EXPECT_EQ(j["diagnosis"]["nature"], "conservative");
   EXPECT_FALSE(j["diagnosis"]["findings"].empty());
-  // The report and its plots (jointid runs itself under xvfb-run when there is no display).
   const std::string report = test::read_text(out / "report.md");
+#if JOINTID_WITH_VTK
+  // The report and its plots (jointid runs itself under xvfb-run when there is no display).
   EXPECT_NE(report.find("gap.png"), std::string::npos);
   for (const char* png : {"gap.png", "response_1.png", "candidates_1.png"}) {
     ASSERT_TRUE(fs::exists(out / png)) << png << "\n" << run.err;
     EXPECT_GT(fs::file_size(out / png), 5000u) << png;
   }
+#else
+  // Without VTK: the report without its plots, and a warning saying why.
+  EXPECT_EQ(report.find("gap.png"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out / "gap.png"));
+  EXPECT_NE(run.err.find("this build has no VTK"), std::string::npos) << run.err;
+#endif
 }
 
 TEST_F(CliTest, SimulateWritesASteppedSineTableThatIdentifyReads) {

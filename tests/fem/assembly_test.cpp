@@ -77,6 +77,33 @@ TEST(Assembly, SpringBetweenNodesAndToGround) {
   EXPECT_EQ(Eigen::MatrixXd(s.M), Eigen::MatrixXd(M_expected));
 }
 
+TEST(Assembly, RowRangesTogetherGiveTheWholeMatrices) {
+  // A distributed assembly: each range's entries lie in its rows, and the three ranges summed
+  // give assemble()'s K and M (elements, point masses and a spring between two nodes).
+  const test::BeamProperties p;
+  fem::Model m = test::uniform_beam(6, p);
+  m.masses.push_back({4, 1.5, Eigen::Vector3d(0.0, 0.0, 0.2)});
+  m.springs.push_back({2, 6, Dof::uy, 800.0});
+  const fem::Assembled whole = fem::assemble(m);
+  const int n = whole.dofs.num_equations();
+  std::vector<Eigen::Triplet<double>> k, mass;
+  for (auto [first, last] : {std::pair{0, 3}, std::pair{3, 7}, std::pair{7, n}}) {
+    const fem::Entries part = fem::assemble_rows(m, whole.dofs, first, last);
+    for (const auto* list : {&part.K, &part.M})
+      for (const auto& t : *list) {
+        EXPECT_GE(t.row(), first);
+        EXPECT_LT(t.row(), last);
+      }
+    k.insert(k.end(), part.K.begin(), part.K.end());
+    mass.insert(mass.end(), part.M.begin(), part.M.end());
+  }
+  fem::SparseMatrix K(n, n), M(n, n);
+  K.setFromTriplets(k.begin(), k.end());
+  M.setFromTriplets(mass.begin(), mass.end());
+  EXPECT_EQ(Eigen::MatrixXd(K), Eigen::MatrixXd(whole.K));
+  EXPECT_EQ(Eigen::MatrixXd(M), Eigen::MatrixXd(whole.M));
+}
+
 TEST(Assembly, FreeLShapedFrameHasThreeRigidModes) {
   // Two frame2d members at a right angle: the assembled K must annihilate the planar rigid
   // motions expressed in global coordinates (this fails if element rotation or DOF scatter is
