@@ -442,7 +442,8 @@ void response(const ResponseOptions& o) {
   const io::ModelFile file = io::read_model(o.model);
   if (file.joints.empty())
     warn(o.model.string() + ": no [[joints]]: the response is the linear substructure's");
-  const frf::Substructure sub = file.substructure();
+  frf::Substructure sub = file.substructure();
+  use_engine(sub, parse_engine(o.engine));
   const fem::NodeDof force_at = resolve(file, sub, "--force", o.force);
   const fem::NodeDof shown =
       o.plot_dof.empty() ? force_at : resolve(file, sub, "--plot-dof", o.plot_dof);
@@ -457,7 +458,7 @@ void response(const ResponseOptions& o) {
   // 3. The curves (progress on a terminal only).
   frf::ContinuationOptions options;
   options.hb.harmonics = o.harmonics;
-  const bool terminal = isatty(STDERR_FILENO) == 1;
+  const bool terminal = isatty(STDERR_FILENO) == 1 && output_rank();
   std::function<void(std::size_t, double)> progress;
   if (terminal)
     progress = [&](std::size_t curve, double fraction) {
@@ -474,6 +475,7 @@ void response(const ResponseOptions& o) {
     throw io::Error(o.model.string() + ": " + e.what());
   }
   if (terminal) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
+  if (!output_rank()) return;
 
   // 4. Write.
   make_output_dir(o.output_dir);

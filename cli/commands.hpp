@@ -82,6 +82,7 @@ struct ResponseOptions {
   int harmonics = 9;              ///< harmonics 0 … K of the harmonic balance
   std::string plot_dof;           ///< NODE:DOF drawn in response.png; empty: the force DOF
   bool plot = true;
+  std::string engine = "auto"; ///< modes of large models: auto or slepc
   std::filesystem::path output_dir;
 };
 

@@ -202,6 +202,9 @@ int main(int argc, char** argv) {
   discover->add_option("--engine", disc.engine, large_help)
       ->check(CLI::IsMember({"auto", "slepc"}))
       ->capture_default_str();
+  response->add_option("--engine", resp.engine, large_help)
+      ->check(CLI::IsMember({"auto", "slepc"}))
+      ->capture_default_str();
   modes
       ->add_option("--engine", mod.engine,
                    "auto (dense up to 1500 equations, else CHOLMOD), dense, sparse (CHOLMOD) or "
@@ -214,6 +217,7 @@ int main(int argc, char** argv) {
     const std::string engine = simulate->parsed()   ? sim.engine
                                : identify->parsed() ? ident.engine
                                : discover->parsed() ? disc.engine
+                               : response->parsed() ? resp.engine
                                                     : mod.engine;
     // MPI for the distributed engine; no X display is looked for under it (a picture is
     // then drawn only when one exists).
@@ -223,7 +227,7 @@ int main(int argc, char** argv) {
     if (identify->parsed()) cli::identify(ident);
     if (discover->parsed() && disc.plots && !distributed) rerun_with_display(argv);
     if (discover->parsed()) cli::discover(disc);
-    if (response->parsed() && resp.plot) rerun_with_display(argv);
+    if (response->parsed() && resp.plot && !distributed) rerun_with_display(argv);
     if (response->parsed()) cli::response(resp);
     if (modes->parsed() && mod.pictures > 0 && !distributed) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
