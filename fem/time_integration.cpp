@@ -35,6 +35,48 @@ Newmark::Newmark(const Assembled& system, const SparseMatrix& C, const LocalForc
   }
   u_ = v_ = a_ = Eigen::VectorXd::Zero(n);
   y_ = lambda_ = g_total_ = Eigen::VectorXd::Zero(nc);
+  stuck_.assign(nc, 0);
+  stuck_before_.assign(nc, 0);
+}
+
+// The coordinates stuck after this step and the last one have ẏ = 0 over the step, so their
+// true acceleration is ÿ = 0. The step's acceleration satisfies the equation of motion with the
+// step's friction forces λ; with λ_S − δ on the stuck set S instead, ü changes by M⁻¹B_S δ, and
+// B_Sᵀü = 0 gives (B_SᵀM⁻¹B_S) δ = −B_Sᵀü.
+void Newmark::hold_stuck(Eigen::VectorXd& a_next) {
+  std::vector<int> S;
+  for (std::size_t i = 0; i < stuck_.size(); ++i)
+    if (stuck_[i] && stuck_before_[i]) S.push_back(static_cast<int>(i));
+  if (S.empty() || mass_singular_) return;
+  const SparseMatrix& B = forces_->coordinates();
+  if (mass_b_.size() == 0) {
+    Eigen::SimplicialLDLT<SparseMatrix> mass(system_.M);
+    const Eigen::MatrixXd Bd(B);
+    if (mass.info() == Eigen::Success) mass_b_ = mass.solve(Bd);
+    if (mass.info() != Eigen::Success || !mass_b_.allFinite() ||
+        (mass.vectorD().array() <= 0.0).any()) {
+      mass_singular_ = true;
+      return;
+    }
+  }
+  const int m = static_cast<int>(S.size());
+  Eigen::MatrixXd MB(a_next.size(), m), A(m, m);
+  Eigen::VectorXd ya(m);
+  for (int p = 0; p < m; ++p) {
+    MB.col(p) = mass_b_.col(S[p]);
+    ya(p) = B.col(S[p]).dot(a_next);
+  }
+  for (int p = 0; p < m; ++p)
+    for (int q = 0; q < m; ++q)
+      A(p, q) = B.col(S[p]).dot(MB.col(q));
+  const Eigen::VectorXd delta = A.ldlt().solve(-ya);
+  for (int p = 0; p < m; ++p)
+    if (!(std::abs(lambda_(S[p]) - delta(p)) <= friction_(S[p]))) return; // it slips
+  a_next += MB * delta;
+  for (int p = 0; p < m; ++p) {
+    lambda_(S[p]) -= delta(p);
+    g_total_(S[p]) -= delta(p);
+  }
 }
 
 void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
@@ -86,6 +128,7 @@ bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& 
         continue;
       }
       const double trial = lambda(i) + r(i) * ydot(i);
+      stuck_[i] = std::abs(trial) <= F;
       if (std::abs(trial) <= F) { // stick
         R(nc + i) = -r(i) * ydot(i);
         J(nc + i, i) = -r(i) * a1_;
@@ -122,11 +165,13 @@ StepStatus Newmark::step(const Eigen::VectorXd& f_next) {
     const Eigen::VectorXd y_pred = B.transpose() * u_next;
     // ẏ_{n+1} = a1 (y − y_n) − Bᵀ(a4 v_n + a5 a_n) = a1 y + e
     const Eigen::VectorXd e = -a1_ * y_ - B.transpose() * (a4_ * v_ + a5_ * a_);
+    stuck_before_ = stuck_;
     if (!solve_local(y_pred, e)) status = StepStatus::newton_failed;
     u_next -= S_ * g_total_;
   }
-  const Eigen::VectorXd a_next = a0_ * (u_next - u_) - a2_ * v_ - a3_ * a_;
-  v_ += h_ * ((1.0 - o_.gamma) * a_ + o_.gamma * a_next);
+  Eigen::VectorXd a_next = a0_ * (u_next - u_) - a2_ * v_ - a3_ * a_;
+  v_ += h_ * ((1.0 - o_.gamma) * a_ + o_.gamma * a_next);           // the scheme's (keeps ẏ = 0)
+  if (forces_ && status == StepStatus::success) hold_stuck(a_next); // the true ü, and λ, kept
   a_ = a_next;
   u_ = u_next;
   return status;

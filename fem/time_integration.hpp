@@ -5,7 +5,12 @@
 /// deformations), g is their smooth force law and λ their dry-friction force, set-valued:
 /// λ_i ∈ F_i·Sign(ẏ_i), i.e. |λ_i| ≤ F_i while the coordinate sticks (ẏ_i = 0). Each step is
 /// solved in the n_c local coordinates only (the linear part is condensed once), by a
-/// semi-smooth Newton method on y and λ — exact stick–slip, no regularisation.
+/// semi-smooth Newton method on y and λ — exact stick–slip, no regularisation. While a
+/// coordinate sticks (this step and the last), its acceleration is held at its true value,
+/// ÿ_i = 0: the trapezoidal rule alone would make ÿ_i alternate ±a* from step to step (and λ_i
+/// with it) after the jump at the onset of stick; the step's λ on the stuck coordinates is
+/// replaced by the one for which Bᵀü = 0 there (from M⁻¹B, factorised at the first stick; not
+/// done when M is singular or when that force would exceed a limit, i.e. the joint slips).
 #include "fem/assembly.hpp"
 
 #include <Eigen/Core>
@@ -13,6 +18,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <vector>
 
 namespace jointid::fem {
 
@@ -60,6 +66,7 @@ public:
 
 private:
   bool solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& e);
+  void hold_stuck(Eigen::VectorXd& a_next);
   const Assembled& system_;
   const SparseMatrix& C_;
   const LocalForces* forces_;
@@ -71,6 +78,9 @@ private:
   Eigen::MatrixXd W_; ///< Bᵀ K_eff⁻¹ B
   Eigen::VectorXd friction_;
   Eigen::VectorXd u_, v_, a_, y_, lambda_, g_total_;
+  std::vector<char> stuck_, stuck_before_; ///< per coordinate: sticking after this / last step
+  Eigen::MatrixXd mass_b_;     ///< M⁻¹ B, computed at the first stick (empty: not yet)
+  bool mass_singular_ = false; ///< M has no inverse (massless DOFs): no projection
 };
 
 /// A sinusoidal force F0·sin(2π f t) at one equation.
