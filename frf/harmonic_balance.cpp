@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <mutex>
 #include <numbers>
@@ -274,16 +275,31 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
   int iterations = 0;
   double residual = 0.0;
   bool converged = detail::newton(*P, z, 1.0, options_, iterations, residual);
+  std::string reason;
   if (!converged) { // load continuation from a small, nearly linear level
+    const double direct = residual;
+    const int direct_iterations = iterations;
     const int steps = std::max(1, options_.continuation_steps);
     z = z_start / steps;
     converged = true;
-    for (int s = 1; s <= steps && converged; ++s)
+    int s = 1;
+    for (; s <= steps && converged; ++s)
       converged =
           detail::newton(*P, z, static_cast<double>(s) / steps, options_, iterations, residual);
+    if (!converged) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "no convergence: relative residual %.3g after %d Newton iterations from %s; "
+                    "then load steps stalled at step %d of %d (relative residual %.3g; "
+                    "tolerance %.3g)",
+                    direct, direct_iterations, start ? "the given start" : "the linear response",
+                    s - 1, steps, residual, options_.tolerance);
+      reason = text;
+    }
   }
   HarmonicBalanceResult out = result(*P, z);
   out.converged = converged;
+  out.reason = std::move(reason);
   out.iterations = iterations;
   out.residual = residual;
   return out;

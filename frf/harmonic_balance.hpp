@@ -18,6 +18,7 @@
 #include "joints/joint.hpp"
 
 #include <memory>
+#include <string>
 
 namespace jointid::frf {
 
@@ -38,6 +39,10 @@ struct HarmonicBalanceOptions {
 
 struct HarmonicBalanceResult {
   bool converged = false;
+  /// Why not, when not converged (empty otherwise): the residual reached and how the solve
+  /// went, e.g. "no convergence: relative residual 3.2e-04 after 60 Newton iterations from the
+  /// linear response, then 20 load steps (stalled at step 7 of 20)".
+  std::string reason;
   int iterations = 0;
   double residual = 0.0;
   Eigen::MatrixXcd Y; ///< (K+1) × n_joints: harmonics of the joint deformations

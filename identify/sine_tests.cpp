@@ -225,9 +225,9 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
       if (!hb.converged && previous) hb = problem.solve(joints, F);
       if (!hb.converged)
         throw std::runtime_error(fmt::format(
-            "harmonic balance at {} Hz, {} N: no periodic solution found (relative residual "
-            "{:.3g} after {} iterations); simulate this test by time integration",
-            compact(plan.frequency_hz), compact(plan.amplitude), hb.residual, hb.iterations));
+            "harmonic balance at {} Hz, {} N: no periodic solution found ({}); simulate this "
+            "test by time integration",
+            compact(plan.frequency_hz), compact(plan.amplitude), hb.reason));
       previous = hb.Y;
       const int samples = o.periods * o.steps_per_period;
       const double h = 1.0 / (plan.frequency_hz * o.steps_per_period);

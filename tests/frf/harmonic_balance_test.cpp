@@ -176,6 +176,27 @@ TEST(HarmonicBalance, CubicJointAgreesWithTimeIntegration) {
   EXPECT_LT(error1_coarse / error1, 5.0);
 }
 
+TEST(HarmonicBalance, NonConvergenceSaysWhy) {
+  // Two Newton iterations cannot solve the strongly non-linear k3 case at 80 N, 3 Hz (it takes
+  // ≈ 8): the result is marked not converged, with the residual reached and how the solve went.
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{make("tip", 7, 0, {Term::k3}, {1.6e8})};
+  frf::HarmonicBalanceOptions o;
+  o.max_iterations = 2;
+  o.continuation_steps = 2;
+  const frf::HarmonicBalanceResult r = frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0,
+                                                             3.0, std::vector<int>{c.eq(7)}, o);
+  ASSERT_FALSE(r.converged);
+  EXPECT_GT(r.residual, o.tolerance);
+  EXPECT_NE(r.reason.find("no convergence: relative residual"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("from the linear response"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("of 2"), std::string::npos) << r.reason;
+  const frf::HarmonicBalanceResult ok =
+      frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0, 3.0, std::vector<int>{c.eq(7)});
+  ASSERT_TRUE(ok.converged);
+  EXPECT_TRUE(ok.reason.empty());
+}
+
 TEST(HarmonicBalance, BadOptionsThrow) {
   const PaperCantilever c;
   const std::vector<joints::Joint> js{make("tip", 7, 0, {Term::k3}, {1.6e8})};
