@@ -5,6 +5,7 @@
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
 #include "support/beam_models.hpp"
+#include "support/synthesised_cantilever.hpp"
 
 #include <gtest/gtest.h>
 
@@ -29,20 +30,7 @@ joints::Joint make(std::string name, int node, std::vector<Term> terms,
   return j;
 }
 
-// The METHOD.md cantilever (first mode 3.0 Hz), 6 elements, 1 % modal damping, every mode kept.
-struct PaperCantilever {
-  fem::Model model = [] {
-    fem::Model m = test::cantilever(6, {});
-    m.damping.kind = fem::Damping::Kind::modal;
-    m.damping.modal_ratio = 0.01;
-    return m;
-  }();
-  fem::Assembled system = fem::assemble(model);
-  fem::Modes modes =
-      fem::modal_analysis(system, {.num_modes = 0, .engine = fem::ModalEngine::dense});
-  frf::ModalSynthesis H{system, modes, model.damping, test::all_equations(system)};
-  int eq(int node) const { return system.dofs.equation({node, Dof::uy}); }
-};
+using PaperCantilever = test::SynthesisedCantilever;
 
 frf::ResponseBranch trace(const PaperCantilever& c, const std::vector<joints::Joint>& js, double F0,
                           double f0, double f1, frf::ContinuationOptions o = {}) {

@@ -4,6 +4,7 @@
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
 #include "support/beam_models.hpp"
+#include "support/synthesised_cantilever.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,21 +29,7 @@ joints::Joint make(std::string name, int node, int node_b, std::vector<Term> ter
   return j;
 }
 
-// The METHOD.md cantilever: steel, L = 2 m, 0.25 m × 14.3623 mm, 6 beam elements, clamped at
-// node 1, 1 % modal damping. Every mode kept, so the synthesis is exact for the FE model.
-struct PaperCantilever {
-  fem::Model model = [] {
-    fem::Model m = test::cantilever(6, {});
-    m.damping.kind = fem::Damping::Kind::modal;
-    m.damping.modal_ratio = 0.01;
-    return m;
-  }();
-  fem::Assembled system = fem::assemble(model);
-  fem::Modes modes =
-      fem::modal_analysis(system, {.num_modes = 0, .engine = fem::ModalEngine::dense});
-  frf::ModalSynthesis H{system, modes, model.damping, test::all_equations(system)};
-  int eq(int node) const { return system.dofs.equation({node, Dof::uy}); }
-};
+using PaperCantilever = test::SynthesisedCantilever;
 
 // Harmonic k of a periodic record sampled over whole periods: x = Re Σ X_k e^{ikωt}.
 Complex harmonic(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double omega, int k) {
