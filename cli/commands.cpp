@@ -145,6 +145,8 @@ void simulate(const SimulateOptions& o) {
   frf::Substructure sub = file.substructure();
   use_engine(sub, parse_engine(o.engine));
   const fem::NodeDof force_at = resolve(file, sub, "--force", o.force);
+  // Refused before the simulation, not after: the outputs never replace an input.
+  io::check_not_an_input(o.output_dir / "stepped_sine.csv");
   for (const auto& text : o.outputs)
     options.extra_outputs.push_back(resolve(file, sub, "--outputs", text));
   std::vector<identify::SineTestPlan> plans;
@@ -155,6 +157,7 @@ void simulate(const SimulateOptions& o) {
       if (!names.insert(identify::sine_test_name(plans.back())).second)
         throw io::Error(
             fmt::format("--freq, --amplitude: the test at {} Hz, {} N is listed twice", f, a));
+      io::check_not_an_input(o.output_dir / identify::sine_test_name(plans.back()));
     }
   options.method = o.method == "time" ? identify::SimulationMethod::time_integration
                                       : identify::SimulationMethod::harmonic_balance;
@@ -201,11 +204,14 @@ void simulate(const SimulateOptions& o) {
     for (const auto& t : tests)
       outputs.push_back({o.output_dir / t.record.source, io::record_csv(t.record, t.comments)});
   }
+  // Every record under a temporary name first, then all renamed into place together.
   make_output_dir(o.output_dir);
-  for (const auto& [path, text] : outputs) {
-    io::write_file_atomically(path, text);
+  io::OutputFiles files;
+  for (const auto& [path, text] : outputs)
+    files.add(path, text);
+  files.commit();
+  for (const auto& [path, text] : outputs)
     fmt::print("wrote {}\n", path.string());
-  }
 }
 
 void identify(const IdentifyOptions& o) {
@@ -216,6 +222,7 @@ void identify(const IdentifyOptions& o) {
   const io::ModelFile file = io::read_model(o.model);
   if (file.joints.empty()) throw io::Error(o.model.string() + ": no [[joints]] to identify");
   const std::vector<identify::SineTest> tests = io::read_tests(o.records);
+  io::check_not_an_input(o.output);
   identify::FitOptions options;
   options.harmonics = o.harmonics;
   const std::vector<identify::Measurement> measured =
@@ -283,6 +290,8 @@ void discover(const DiscoverOptions& o) {
   if (file.joints.empty())
     throw io::Error(o.model.string() + ": no [[joints]]: discovery starts from the joints' terms");
   const std::vector<identify::SineTest> tests = io::read_tests(o.records);
+  for (const char* name : {"discovery.json", "report.md"})
+    io::check_not_an_input(o.output_dir / name);
   const std::vector<identify::Measurement> measured = identify::measure(tests, {.harmonics = K});
   frf::Substructure sub = file.substructure();
   use_engine(sub, parse_engine(o.engine));
@@ -321,6 +330,8 @@ void modes(const ModesOptions& o) {
   if (o.count < 1) throw io::Error(fmt::format("--count: expected at least 1, got {}", o.count));
   check_output_dir(o.output_dir);
   const io::ModelFile file = io::read_model(o.model);
+  for (const char* name : {"modes.json", "mesh.vtu", "modes.vtu"})
+    io::check_not_an_input(o.output_dir / name);
   if (file.modal) {
     // A substructure given by its modes: report them; there is no mesh to draw.
     fem::Modes modes;

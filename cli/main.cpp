@@ -2,6 +2,7 @@
 // here as one line on stderr and exit status 1.
 #include "cli/commands.hpp"
 #include "cli/engine.hpp"
+#include "io/files.hpp"
 #include "io/vtk_output.hpp"
 
 #include <CLI/CLI.hpp>
@@ -52,6 +53,11 @@ void rerun_with_display(char** argv) {
 
 int main(int argc, char** argv) {
   namespace cli = jointid::cli;
+  // An interrupt (SIGINT, SIGTERM, SIGHUP) removes the temporary files of outputs in progress
+  // and exits with 128 + the signal; finished outputs are renamed into place whole, and never
+  // over a file this run reads.
+  jointid::io::install_interrupt_cleanup();
+  jointid::io::protect_inputs();
   CLI::App app{"jointid: identify non-linear joints of structures from measured responses",
                "jointid"};
   app.require_subcommand(1);

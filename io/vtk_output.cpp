@@ -1,5 +1,6 @@
 #include "io/vtk_output.hpp"
 
+#include "io/files.hpp"
 #include "io/vtk_display.hpp"
 #include "io/vtk_render.hpp"
 
@@ -37,6 +38,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -219,8 +221,11 @@ public:
     std::mt19937_64 random(seed());
     for (int attempt = 0; attempt < 100; ++attempt) {
       path_ = dir_ / (".jointid-vtk-" + std::to_string(random() % 1000000000));
+      // Registered before it exists: an interrupt removes it with whatever it holds.
+      registration_ = std::make_unique<InFlight>(path_, InFlight::Kind::directory);
       if (fs::create_directory(path_, ec)) return;
     }
+    registration_.reset();
     throw std::runtime_error("cannot create a temporary directory in " + dir_.string() + ": " +
                              ec.message());
   }
@@ -234,6 +239,10 @@ public:
 
   /// Moves staged entries (file or directory names, in this order) into the target directory.
   void commit(const std::vector<std::string>& names) {
+    for (const auto& name : names)
+      check_not_an_input(dir_ / name);
+    // An interrupt waits for the renames: an old directory moved aside is always replaced.
+    const CommitSection section;
     std::error_code ec;
     for (const auto& name : names) {
       const fs::path target = dir_ / name;
@@ -249,6 +258,7 @@ public:
 private:
   fs::path dir_;
   fs::path path_;
+  std::unique_ptr<InFlight> registration_;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -1,9 +1,12 @@
 #include "io/vtk_render.hpp"
 
+#include "io/files.hpp"
+
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <memory>
 #include <random>
 #include <stdexcept>
 
@@ -33,22 +36,37 @@ void render_to_png(vtkRenderWindow* window, const fs::path& png) {
   capture->SetInputBufferTypeToRGB();
   capture->ReadFrontBufferOff();
   capture->Update();
-  const fs::path tmp =
-      png.string() + ".tmp-" + std::to_string(std::random_device{}() % 1000000) + ".png";
+  // A hidden temporary name beside the picture, registered so that an interrupt removes it,
+  // then renamed over the picture: an old picture is replaced whole or kept.
+  check_not_an_input(png);
+  std::error_code ec;
+  fs::path tmp;
+  std::unique_ptr<InFlight> registration;
+  std::random_device seed;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    std::string name = ".";
+    name += png.filename().string();
+    name += ".tmp." + std::to_string(seed() % 1000000000) + ".png";
+    tmp = png.parent_path() / name;
+    if (!fs::exists(tmp, ec)) break;
+  }
+  registration = std::make_unique<InFlight>(tmp, InFlight::Kind::file);
   vtkNew<vtkPNGWriter> writer;
   vtkNew<ErrorCatcher> write_errors;
   writer->AddObserver(vtkCommand::ErrorEvent, write_errors);
   writer->SetFileName(tmp.c_str());
   writer->SetInputConnection(capture->GetOutputPort());
   writer->Write();
-  std::error_code ec;
   if (!write_errors->message.empty() || !fs::is_regular_file(tmp, ec)) {
     fs::remove(tmp, ec);
     throw std::runtime_error(
         "cannot write " + png.string() + ": " +
         (write_errors->message.empty() ? "PNG writer failed" : vtk_message(write_errors->message)));
   }
-  fs::rename(tmp, png, ec);
+  {
+    const CommitSection section;
+    fs::rename(tmp, png, ec);
+  }
   if (ec) {
     std::error_code ignored;
     fs::remove(tmp, ignored);

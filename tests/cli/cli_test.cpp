@@ -8,10 +8,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <numbers>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace jointid {
 namespace {
@@ -543,6 +547,163 @@ TEST_F(CliTest, DiscoverChecksItsOptionsBeforeReading) {
       jointid({"discover", model().string(), rec, "--terms", "k4", "-o", out.string()}, dir()),
       "--terms");
   EXPECT_FALSE(fs::exists(out));
+}
+
+// Files in `dir` whose names mark a temporary output (".<name>.tmp.*", ".jointid-vtk-*").
+std::vector<std::string> temporary_files(const fs::path& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.find(".tmp.") != std::string::npos || name.rfind(".jointid-vtk-", 0) == 0)
+      found.push_back(e.path().string());
+  }
+  return found;
+}
+
+TEST_F(CliTest, FailedRunKeepsAGoodResultByteForByte) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path out = dir() / "kept";
+  fs::create_directories(out);
+  const fs::path result = out / "result.json";
+  std::vector<std::string> args{"identify", model().string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"-o", result.string()});
+  ASSERT_EQ(jointid(args, dir()).status, 0);
+  const std::string good = test::read_text(result);
+  ASSERT_NE(good.find("\"joints\""), std::string::npos);
+
+  // A record cut off in the middle of a row, as a test system stopped half-way leaves it.
+  const std::string text = test::read_text(record_files()[1]);
+  const fs::path cut = dir() / "cut.csv";
+  test::write_text(cut, text.substr(0, text.size() / 2) + "0.1,");
+  args[3] = cut.string();
+  expect_one_line_error(jointid(args, dir()), "cut.csv");
+  // A model that does not parse.
+  const fs::path broken = dir() / "broken.toml";
+  test::write_text(broken, test::cantilever_toml().substr(0, 200));
+  std::vector<std::string> bad_model = args;
+  bad_model[1] = broken.string();
+  bad_model[3] = record_files()[1];
+  expect_one_line_error(jointid(bad_model, dir()), "broken.toml");
+  EXPECT_EQ(test::read_text(result), good);
+  EXPECT_TRUE(temporary_files(out).empty());
+}
+
+TEST_F(CliTest, OutputOverAnInputIsRefused) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path copy = dir() / "inputs";
+  fs::create_directories(copy);
+  const fs::path record = copy / "rec.csv", model_copy = copy / "model.toml";
+  fs::copy_file(record_files()[0], record, fs::copy_options::overwrite_existing);
+  fs::copy_file(model(), model_copy, fs::copy_options::overwrite_existing);
+  const std::string record_text = test::read_text(record), model_text = test::read_text(model());
+  std::vector<std::string> args{"identify",        model_copy.string(), record.string(),
+                                record_files()[1], record_files()[2],   "-o"};
+  // The record, under another spelling of its path; the model file.
+  for (const fs::path& target : {copy / "." / "rec.csv", model_copy}) {
+    std::vector<std::string> a = args;
+    a.push_back(target.string());
+    expect_one_line_error(jointid(a, dir()), "is an input of this run");
+  }
+  EXPECT_EQ(test::read_text(record), record_text);
+  EXPECT_EQ(test::read_text(model_copy), model_text);
+  // simulate into the directory of its model file named like one of its records.
+  const fs::path sim = dir() / "sim_over_model";
+  fs::create_directories(sim);
+  const fs::path trap = sim / "sine_f3Hz_F10N.csv";
+  test::write_text(trap, model_text);
+  expect_one_line_error(jointid({"simulate", trap.string(), "--force", "7:uy", "--freq", "3",
+                                 "--amplitude", "10", "-o", sim.string()},
+                                dir()),
+                        "is an input of this run");
+  EXPECT_EQ(test::read_text(trap), model_text);
+  EXPECT_TRUE(temporary_files(dir()).empty());
+}
+
+// SIGINT in the middle of a long simulation: status 130, the previous records of the same
+// tests byte for byte as they were, no temporary file. The signal is sent once the program has
+// installed its handler (seen in /proc/PID/status) and has run a little; the job is far longer
+// than the wait, so the signal always lands mid-run, however loaded the machine.
+TEST_F(CliTest, InterruptMidRunKeepsThePreviousOutputs) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path out = dir() / "interrupted";
+  fs::create_directories(out);
+  std::vector<std::string> previous;
+  for (const auto& f : record_files()) {
+    fs::copy_file(f, out / fs::path(f).filename(), fs::copy_options::overwrite_existing);
+    previous.push_back(test::read_text(f));
+  }
+  // 40 tests of 1000 periods of 512 steps each: minutes of work (the first three are the
+  // records above, so their files would be replaced).
+  std::string freqs = "3.4,4.2,5";
+  for (int i = 0; i < 37; ++i)
+    freqs.append(",").append(std::to_string(6 + i));
+  const std::vector<std::string> args{JOINTID_EXE,
+                                      "simulate",
+                                      model().string(),
+                                      "--force",
+                                      "7:uy",
+                                      "--freq",
+                                      freqs,
+                                      "--amplitude",
+                                      "10",
+                                      "--periods",
+                                      "1000",
+                                      "--steps-per-period",
+                                      "512",
+                                      "--samples-per-period",
+                                      "8",
+                                      "-o",
+                                      out.string()};
+  const fs::path log = dir() / "interrupted.log";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (const auto& a : args)
+      argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    std::FILE* f = std::freopen(log.c_str(), "w", stdout);
+    if (f == nullptr || ::dup2(::fileno(stdout), 2) < 0) ::_exit(120);
+    ::execv(argv[0], argv.data());
+    ::_exit(121);
+  }
+  // SigCgt: the signals the process catches, in hexadecimal; SIGINT is bit 1 (value 2).
+  auto catches_sigint = [&] {
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    std::string line;
+    while (std::getline(status, line))
+      if (line.rfind("SigCgt:", 0) == 0)
+        return (std::stoull(line.substr(7), nullptr, 16) & 2u) != 0;
+    return false;
+  };
+  int raw = 0;
+  bool caught = false;
+  for (int i = 0; i < 1200 && !caught; ++i) { // up to 2 minutes for the program to start
+    if (::waitpid(pid, &raw, WNOHANG) == pid) break;
+    caught = catches_sigint();
+    if (!caught) ::usleep(100000);
+  }
+  if (caught) {
+    ::usleep(500000); // reading the model, the simulation under way
+    ::kill(pid, SIGINT);
+    ASSERT_EQ(::waitpid(pid, &raw, 0), pid);
+  } else {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &raw, 0);
+  }
+  ASSERT_TRUE(caught) << "jointid never installed its SIGINT handler: " << test::read_text(log);
+  ASSERT_TRUE(WIFEXITED(raw)) << "killed by signal " << WTERMSIG(raw);
+  EXPECT_EQ(WEXITSTATUS(raw), 130) << test::read_text(log);
+  const auto files = record_files();
+  for (std::size_t i = 0; i < files.size(); ++i)
+    EXPECT_EQ(test::read_text(out / fs::path(files[i]).filename()), previous[i]) << files[i];
+  int count = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(out))
+    ++count;
+  EXPECT_EQ(count, 3); // no new record, no temporary file
+  EXPECT_TRUE(temporary_files(out).empty());
 }
 
 TEST_F(CliTest, UsageErrorsAreOneLine) {

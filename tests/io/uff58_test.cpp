@@ -507,7 +507,8 @@ TEST_F(Uff58Test, DirectionSignAndUnits) {
   std::string ms = time_response(7, 2, 8, 1, 0, "m");
   ms = test::replaced(ms, "Time                 s  ", "Time                 ms ");
   const auto path = write(ms, "ms.uff");
-  const auto& r = std::get<identify::Record>(uff58_tests(read_uff58(path), path)[0]);
+  const auto tests = uff58_tests(read_uff58(path), path); // kept: r refers into it
+  const auto& r = std::get<identify::Record>(tests[0]);
   EXPECT_DOUBLE_EQ(r.t(4), 4 * 0.0125e-3);
 }
 
