@@ -326,34 +326,47 @@ void discover(const DiscoverOptions& o) {
     warn(w);
 }
 
+namespace {
+
+// modes.json and the table of a substructure without a mesh ([modal], [matrices]).
+void write_modes_without_mesh(const ModesOptions& o, const fem::Modes& modes, int count,
+                              const std::string& why) {
+  make_output_dir(o.output_dir);
+  const fs::path out = o.output_dir / "modes.json";
+  io::write_json(out,
+                 io::modes_json(modes, count, {why + ": no mesh, so no VTK files or pictures"}));
+  fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
+  for (int r = 0; r < std::min(count, modes.num_modes()); ++r)
+    fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
+  fmt::print("wrote {}\n", out.string());
+}
+
+} // namespace
+
 void modes(const ModesOptions& o) {
   if (o.count < 1) throw io::Error(fmt::format("--count: expected at least 1, got {}", o.count));
   check_output_dir(o.output_dir);
   const io::ModelFile file = io::read_model(o.model);
   for (const char* name : {"modes.json", "mesh.vtu", "modes.vtu"})
     io::check_not_an_input(o.output_dir / name);
-  if (file.modal) {
-    // A substructure given by its modes: report them; there is no mesh to draw.
+  if (file.modal) { // a substructure given by its modes: report them; no mesh to draw
     fem::Modes modes;
     modes.omega = 2.0 * std::numbers::pi * file.modal->frequencies_hz;
-    const int count = std::min(o.count, modes.num_modes());
-    make_output_dir(o.output_dir);
-    const fs::path out = o.output_dir / "modes.json";
-    io::write_json(out, io::modes_json(modes, count,
-                                       {"the substructure is given by its modes ([modal]): "
-                                        "no mesh, so no VTK files or pictures"}));
-    fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
-    for (int r = 0; r < count; ++r)
-      fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
-    fmt::print("wrote {}\n", out.string());
+    write_modes_without_mesh(o, modes, std::min(o.count, modes.num_modes()),
+                             "the substructure is given by its modes ([modal])");
     return;
   }
   // The slepc engine assembles K and M distributed by rows: rank 0 assembles them whole only
   // afterwards, for the checks and the files.
   const Engine engine = parse_engine(o.engine);
+  if (file.matrices && engine == Engine::slepc)
+    throw io::Error(o.model.string() +
+                    ": --engine slepc assembles the finite elements by rows; a substructure "
+                    "given by its matrices ([matrices]) uses --engine auto, dense or sparse");
   std::optional<frf::Substructure> sub;
   if (engine != Engine::slepc) sub.emplace(file.substructure());
-  const int count = std::min(o.count, fem::DofMap(file.model).num_equations());
+  const int count = std::min(o.count, sub ? sub->dofs().num_equations()
+                                          : fem::DofMap(file.model).num_equations());
   fem::ModalOptions options;
   options.num_modes = count;
   const fem::Modes modes =
@@ -368,15 +381,8 @@ void modes(const ModesOptions& o) {
   const fem::Assembled& system = *sub->system();
   std::vector<std::string> warnings;
   if (file.matrices) { // K and M given: no mesh to draw, no element table for mechanisms
-    make_output_dir(o.output_dir);
-    const fs::path out = o.output_dir / "modes.json";
-    io::write_json(out, io::modes_json(modes, count,
-                                       {"the substructure is given by its matrices ([matrices]): "
-                                        "no mesh, so no VTK files or pictures"}));
-    fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
-    for (int r = 0; r < std::min(count, modes.num_modes()); ++r)
-      fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
-    fmt::print("wrote {}\n", out.string());
+    write_modes_without_mesh(o, modes, count,
+                             "the substructure is given by its matrices ([matrices])");
     return;
   }
   if (const fem::ZeroModes z = fem::zero_modes(file.model, system, modes); z.count > 0)

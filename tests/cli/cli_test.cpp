@@ -720,6 +720,39 @@ TEST_F(CliTest, UsageErrorsAreOneLine) {
       "missing.toml");
 }
 
+TEST_F(CliTest, ModesOfExportedMatricesEqualTheModelFiles) {
+  // examples/matrices holds the paper cantilever's K and M exported to MatrixMarket: `modes`
+  // must give examples/paper_cantilever's frequencies (same matrices: to 1e-10), and refuse
+  // the slepc engine, which assembles finite elements.
+  const fs::path root = fs::path(JOINTID_SOURCE_DIR) / "examples";
+  const fs::path a = dir() / "modes_fe", b = dir() / "modes_mm";
+  ASSERT_EQ(jointid({"modes", (root / "paper_cantilever" / "cantilever.toml").string(), "--count",
+                     "4", "--pictures", "0", "-o", a.string()},
+                    dir())
+                .status,
+            0);
+  const Outcome run = jointid({"modes", (root / "matrices" / "cantilever_matrices.toml").string(),
+                               "--count", "4", "-o", b.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json ja = json::parse(test::read_text(a / "modes.json")),
+             jb = json::parse(test::read_text(b / "modes.json"));
+  ASSERT_EQ(ja["modes"].size(), 4u);
+  ASSERT_EQ(jb["modes"].size(), 4u);
+  for (int r = 0; r < 4; ++r) {
+    const double fa = ja["modes"][r]["frequency_hz"].get<double>();
+    EXPECT_NEAR(jb["modes"][r]["frequency_hz"].get<double>(), fa, 1e-10 * fa) << r;
+  }
+  // (A build without the engine refuses it first, for that reason.)
+  const Outcome slepc = jointid({"modes", (root / "matrices" / "cantilever_matrices.toml").string(),
+                                 "--engine", "slepc", "-o", (dir() / "modes_slepc").string()},
+                                dir());
+  expect_one_line_error(slepc);
+  EXPECT_TRUE(slepc.err.find("[matrices]") != std::string::npos ||
+              slepc.err.find("no SLEPc engine") != std::string::npos)
+      << slepc.err;
+}
+
 TEST_F(CliTest, ResponseWritesTheContractWithFoldsAndStability) {
   // The README's hardening cantilever: at 10 N the curve is single-valued and stable; at 80 N it
   // overhangs: two folds, the points between them unstable, those outside stable. (The physics
