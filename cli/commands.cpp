@@ -6,6 +6,7 @@
 #include "fem/modal.hpp"
 #include "fem/zero_modes.hpp"
 #include "frf/substructure.hpp"
+#include "identify/design.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "identify/sine_tests.hpp"
@@ -526,6 +527,173 @@ void response(const ResponseOptions& o) {
   }
   for (const auto& n : curves.notes)
     fmt::print("note: {}\n", n);
+}
+
+namespace {
+
+// "3", "1.5e3" or a range "F0:STEP:F1" (F0, F0 + STEP, … up to F1 within a millionth of STEP),
+// every value finite and > 0.
+std::vector<double> parse_values(const std::string& option, const std::vector<std::string>& items,
+                                 const char* unit) {
+  auto number = [&](const std::string& text, const std::string& item) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v))
+      throw io::Error(fmt::format("{}: expected numbers ({}) or ranges START:STEP:STOP, got \"{}\"",
+                                  option, unit, item));
+    return v;
+  };
+  std::vector<double> out;
+  for (const auto& item : items) {
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    for (std::size_t c = item.find(':'); c != std::string::npos; c = item.find(':', start)) {
+      parts.push_back(item.substr(start, c - start));
+      start = c + 1;
+    }
+    parts.push_back(item.substr(start));
+    if (parts.size() == 1) {
+      out.push_back(number(parts[0], item));
+    } else if (parts.size() == 3) {
+      const double a = number(parts[0], item), step = number(parts[1], item),
+                   b = number(parts[2], item);
+      if (!(step > 0.0) || b < a)
+        throw io::Error(fmt::format("{} {}: expected START:STEP:STOP with STEP > 0 and STOP >= "
+                                    "START",
+                                    option, item));
+      const double n = std::floor((b - a) / step + 1e-6);
+      if (n > 10000)
+        throw io::Error(fmt::format("{} {}: more than 10000 values", option, item));
+      for (int i = 0; i <= static_cast<int>(n); ++i)
+        out.push_back(a + i * step);
+    } else {
+      throw io::Error(fmt::format(
+          "{}: expected numbers ({}) or ranges START:STEP:STOP, got \"{}\"", option, unit, item));
+    }
+  }
+  if (out.empty()) throw io::Error(fmt::format("{}: expected at least one value ({})", option, unit));
+  for (double v : out)
+    if (!(v > 0.0))
+      throw io::Error(fmt::format("{}: expected values > 0 {}, got {}", option, unit, v));
+  std::sort(out.begin(), out.end());
+  if (std::adjacent_find(out.begin(), out.end()) != out.end())
+    throw io::Error(fmt::format("{}: a value is listed twice", option));
+  return out;
+}
+
+} // namespace
+
+void design(const DesignOptions& o) {
+  // 1. The options.
+  const std::vector<double> freqs = parse_values("--freq", o.frequencies, "Hz");
+  const std::vector<double> amps = parse_values("--amplitude", o.amplitudes, "N or N m");
+  check_harmonics(o.harmonics, 0);
+  if (o.count < 1) throw io::Error(fmt::format("-n: expected at least 1 test, got {}", o.count));
+  if (!(o.noise > 0.0 && o.noise < 1.0))
+    throw io::Error(fmt::format("--noise: expected a fraction between 0 and 1 (e.g. 0.01), got {}",
+                                o.noise));
+  if (!(o.max_misfit > 0.0))
+    throw io::Error(fmt::format("--max-misfit: expected a number > 0 (noise standard deviations), "
+                                "got {}",
+                                o.max_misfit));
+  if (o.periods < 2 || o.periods > 100000)
+    throw io::Error(fmt::format("--periods: expected 2 to 100000, got {}", o.periods));
+  if (o.balance_harmonics < 1 || o.balance_harmonics > 200)
+    throw io::Error(
+        fmt::format("--balance-harmonics: expected 1 to 200, got {}", o.balance_harmonics));
+  if (*std::max_element(o.harmonics.begin(), o.harmonics.end()) > o.balance_harmonics)
+    throw io::Error(fmt::format("--harmonics: expected at most --balance-harmonics ({})",
+                                o.balance_harmonics));
+  const std::size_t n_candidates = freqs.size() * amps.size();
+  if (static_cast<std::size_t>(o.count) > n_candidates)
+    throw io::Error(fmt::format("-n {}: more than the {} candidates ({} frequencies x {} "
+                                "amplitudes)",
+                                o.count, n_candidates, freqs.size(), amps.size()));
+  check_output_dir(o.output_dir);
+
+  // 2. The model and its unknowns.
+  const io::ModelFile file = io::read_model(o.model);
+  if (file.joints.empty())
+    throw io::Error(o.model.string() + ": no [[joints]]: nothing to design tests for");
+  const std::vector<identify::DesignUnknown> unknowns = identify::design_unknowns(file.joints);
+  if (unknowns.empty())
+    throw io::Error(o.model.string() + ": every joint term is fixed; nothing to identify");
+  for (const auto& u : unknowns)
+    if (u.prior == 0.0)
+      warn(fmt::format("{}: joint '{}', term {}: its value (the prior guess) is 0; the prediction "
+                       "has no such force",
+                       o.model.string(), u.joint, joints::term_name(u.term)));
+  frf::Substructure sub = file.substructure();
+  use_engine(sub, parse_engine(o.engine));
+  const fem::NodeDof force_at = resolve(file, sub, "--force", o.force);
+
+  // 3. Predict the candidates, choose.
+  std::vector<identify::SineTestPlan> plans;
+  for (double f : freqs)
+    for (double a : amps)
+      plans.push_back({f, a});
+  identify::DesignOptions options;
+  options.harmonics = o.harmonics;
+  options.noise = o.noise;
+  options.periods = o.periods;
+  options.balance.harmonics = o.balance_harmonics;
+  options.samples_per_period = std::max(256, 8 * (o.balance_harmonics + 1));
+  options.max_misfit = o.max_misfit;
+  std::vector<identify::CandidateTest> candidates;
+  identify::Design chosen;
+  try {
+    candidates = identify::predict_candidates(sub, file.joints, force_at, plans, options);
+    int usable = 0;
+    for (const auto& c : candidates)
+      usable += c.usable;
+    if (usable < o.count)
+      throw io::Error(fmt::format("-n {}: only {} of the {} candidates can be predicted at the "
+                                  "model's values (no periodic solution, coexisting responses, "
+                                  "or equations the basis functions do not describe: --max-misfit)",
+                                  o.count, usable, candidates.size()));
+    chosen = identify::choose_tests(candidates, unknowns, o.count);
+  } catch (const std::invalid_argument& e) {
+    throw io::Error(o.model.string() + ": " + e.what());
+  }
+  if (!output_rank()) return;
+
+  // 4. Write and report.
+  make_output_dir(o.output_dir);
+  const fs::path json = o.output_dir / "design.json";
+  io::write_json(json, io::design_json(chosen, candidates, unknowns, options));
+  fmt::print("wrote {}\n", json.string());
+  int skipped = 0;
+  for (const auto& c : candidates)
+    skipped += !c.usable;
+  if (skipped > 0)
+    warn(fmt::format("{} of {} candidates left out: no periodic solution at the model's values, "
+                     "coexisting responses, or equations the basis functions do not describe, as "
+                     "where a friction joint sticks (design.json gives each reason)",
+                     skipped, candidates.size()));
+  fmt::print("D-optimal {} of {} candidates ({} exchanges after the greedy choice), noise {:g} % "
+             "RMS, {} periods a record, harmonics {}:\n",
+             o.count, candidates.size(), chosen.exchanges, 100.0 * o.noise, o.periods,
+             fmt::join(o.harmonics, ","));
+  fmt::print("  {:>12} {:>12}\n", "freq (Hz)", "force (N)");
+  for (int i : chosen.chosen)
+    fmt::print("  {:>12.6g} {:>12.6g}\n", plans[static_cast<std::size_t>(i)].frequency_hz,
+               plans[static_cast<std::size_t>(i)].amplitude);
+  fmt::print("expected standard deviations and bias:\n  {:<12} {:<6} {:>14} {:>14} {:>10} {:>10}\n",
+             "joint", "term", "prior", "std", "relative", "bias");
+  for (std::size_t u = 0; u < unknowns.size(); ++u) {
+    const double sd = chosen.std(static_cast<Eigen::Index>(u));
+    const double prior = std::abs(unknowns[u].prior);
+    fmt::print("  {:<12} {:<6} {:>14.6g} {:>14.4g} {:>9.3g}% {:>+9.2g}%\n", unknowns[u].joint,
+               joints::term_name(unknowns[u].term), unknowns[u].prior, sd, 100.0 * sd / prior,
+               100.0 * chosen.bias(static_cast<Eigen::Index>(u)) / prior);
+  }
+  for (const auto& w : chosen.warnings)
+    warn(w);
 }
 
 } // namespace jointid::cli

@@ -90,4 +90,24 @@ struct ResponseOptions {
 /// contract) and DIR/response.png. Progress on a terminal (stderr), nothing otherwise.
 void response(const ResponseOptions& options);
 
+struct DesignOptions {
+  std::filesystem::path model;
+  std::string force;                    ///< NODE:DOF of the sine force
+  std::vector<std::string> frequencies; ///< Hz: values or ranges F0:STEP:F1
+  std::vector<std::string> amplitudes;  ///< N or N·m (peak): values or ranges A0:STEP:A1
+  int count = 10;                       ///< tests to choose
+  std::vector<int> harmonics{1};        ///< harmonics the identification will use
+  double noise = 0.01;                  ///< expected noise RMS / channel RMS
+  int periods = 8;                      ///< periods in each record
+  int balance_harmonics = 9;            ///< harmonics 0 … K of the prediction
+  double max_misfit = 0.2; ///< leave out candidates whose equations miss by more (noise std)
+  std::string engine = "auto"; ///< modes of large models: auto or slepc
+  std::filesystem::path output_dir;
+};
+
+/// D-optimal experiment design: the `count` candidate tests (frequencies × amplitudes) that
+/// determine the joints' non-fixed terms best, predicted at the model's values; writes
+/// DIR/design.json and prints the chosen tests and the standard deviations to expect.
+void design(const DesignOptions& options);
+
 } // namespace jointid::cli

@@ -195,6 +195,53 @@ int main(int argc, char** argv) {
   response->add_option("-o,--output", resp.output_dir, "Output directory (created if missing)")
       ->required();
 
+  cli::DesignOptions des;
+  auto* design = app.add_subcommand(
+      "design", "Experiment design: choose the N sine tests (of candidate frequencies x force "
+                "levels) that determine the joints' terms best (D-optimal, predicted at the "
+                "model's values as prior guesses); writes DIR/design.json");
+  design->add_option("MODEL", des.model, "Model file (TOML); joint values = prior guesses")
+      ->required();
+  design->add_option("--force", des.force, "DOF of the sine force, NODE:DOF (e.g. 7:uy)")
+      ->required();
+  design
+      ->add_option("--freq", des.frequencies,
+                   "Candidate frequencies, Hz: values or ranges START:STEP:STOP (comma-separated)")
+      ->required()
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  design
+      ->add_option("--amplitude", des.amplitudes,
+                   "Candidate force amplitudes (peak), N or N m: values or ranges START:STEP:STOP")
+      ->required()
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  design->add_option("-n", des.count, "Number of tests to choose")->capture_default_str();
+  design
+      ->add_option("--harmonics", des.harmonics,
+                   "Harmonics whose equations the identification will use, e.g. 1,2,3")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->capture_default_str();
+  design
+      ->add_option("--noise", des.noise,
+                   "Expected measurement noise: RMS as a fraction of each channel's RMS, on "
+                   "force and response")
+      ->capture_default_str();
+  design->add_option("--periods", des.periods, "Periods in each record (averaged)")
+      ->capture_default_str();
+  design
+      ->add_option("--balance-harmonics", des.balance_harmonics,
+                   "Harmonics 0 … K of the harmonic balance that predicts the tests")
+      ->capture_default_str();
+  design
+      ->add_option("--max-misfit", des.max_misfit,
+                   "Leave out candidates whose equations, at the model's values, miss by more than "
+                   "this many noise standard deviations (e.g. where a friction joint sticks)")
+      ->capture_default_str();
+  design->add_option("-o,--output", des.output_dir, "Output directory (created if missing)")
+      ->required();
+
   // --engine: every command that computes modes. slepc runs under mpirun -np N.
   const std::string large_help =
       "Modes of models above the dense limit: auto (CHOLMOD on this machine) or slepc "
@@ -211,6 +258,9 @@ int main(int argc, char** argv) {
   response->add_option("--engine", resp.engine, large_help)
       ->check(CLI::IsMember({"auto", "slepc"}))
       ->capture_default_str();
+  design->add_option("--engine", des.engine, large_help)
+      ->check(CLI::IsMember({"auto", "slepc"}))
+      ->capture_default_str();
   modes
       ->add_option("--engine", mod.engine,
                    "auto (dense up to 1500 equations, else CHOLMOD), dense, sparse (CHOLMOD) or "
@@ -224,6 +274,7 @@ int main(int argc, char** argv) {
                                : identify->parsed() ? ident.engine
                                : discover->parsed() ? disc.engine
                                : response->parsed() ? resp.engine
+                               : design->parsed()   ? des.engine
                                                     : mod.engine;
     // MPI for the distributed engine; no X display is looked for under it (a picture is
     // then drawn only when one exists).
@@ -235,6 +286,7 @@ int main(int argc, char** argv) {
     if (discover->parsed()) cli::discover(disc);
     if (response->parsed() && resp.plot && !distributed) rerun_with_display(argv);
     if (response->parsed()) cli::response(resp);
+    if (design->parsed()) cli::design(des);
     if (modes->parsed() && mod.pictures > 0 && !distributed) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
     return 0;

@@ -420,6 +420,79 @@ std::vector<std::string> explain_identifiability(const FitResult& result,
   return out;
 }
 
+
+// The equations Q b = p of the tests (rows: real and imaginary parts per set-2 DOF, harmonic and
+// test) for the non-fixed terms, known terms moved to the right-hand side, and the receptances
+// each test's rows use (for their noise covariance).
+struct Equations {
+  Eigen::MatrixXd Q;
+  Eigen::VectorXd p;
+  std::vector<Row> rows;
+  std::vector<std::map<int, Receptances>> receptances; // per test, per harmonic
+};
+
+Equations equations(const ReceptanceFn& H, const std::vector<int>& set2, const Eigen::MatrixXd& B,
+                    const std::vector<joints::Joint>& joints,
+                    const std::vector<TestSpectrum>& tests, const std::vector<int>& harmonics) {
+  const auto unknowns = unknowns_of(joints);
+  const auto nu = static_cast<Eigen::Index>(unknowns.size());
+  const auto n2 = static_cast<Eigen::Index>(set2.size());
+  std::vector<Eigen::RowVectorXd> q_rows;
+  std::vector<double> rhs;
+  Equations eq;
+  eq.receptances.resize(tests.size());
+  for (std::size_t ti = 0; ti < tests.size(); ++ti) {
+    const auto& test = tests[ti];
+    for (int k : harmonics) {
+      if (test.fundamental_only && k != 1) continue;
+      if (k < 0 || k >= test.F.rows())
+        throw std::invalid_argument("identify: harmonic " + std::to_string(k) + " not extracted");
+      const double w = two_pi * test.frequency_hz * k;
+      const frf::CMatrix H22 = H(w, set2, set2), H2f = H(w, set2, test.force_equations);
+      eq.receptances[ti][k] = {H22 * B.cast<Complex>(), H2f};
+      frf::CVector R = test.X2.row(k).transpose() - H2f * test.F.row(k).transpose();
+      frf::CMatrix Qc(n2, nu);
+      for (Eigen::Index u = 0; u < nu; ++u) {
+        const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
+        Qc.col(u) = -H22 * B.col(i).cast<Complex>() * test.G[static_cast<std::size_t>(i)](k, t);
+      }
+      for (std::size_t i = 0; i < joints.size(); ++i) // known terms go to the right-hand side
+        for (std::size_t t = 0; t < joints[i].terms.size(); ++t)
+          if (joints[i].fixed[t])
+            R += H22 * B.col(static_cast<Eigen::Index>(i)).cast<Complex>() *
+                 test.G[i](k, static_cast<Eigen::Index>(t)) * joints[i].values[t];
+      for (int d = 0; d < n2; ++d) {
+        q_rows.push_back(Qc.row(d).real());
+        rhs.push_back(R(d).real());
+        eq.rows.push_back({static_cast<int>(ti), k, d, false});
+        if (k != 0) { // the mean has no imaginary part
+          q_rows.push_back(Qc.row(d).imag());
+          rhs.push_back(R(d).imag());
+          eq.rows.push_back({static_cast<int>(ti), k, d, true});
+        }
+      }
+    }
+  }
+  const auto m = static_cast<Eigen::Index>(q_rows.size());
+  eq.Q.resize(m, nu);
+  eq.p.resize(m);
+  for (Eigen::Index r = 0; r < m; ++r)
+    eq.Q.row(r) = q_rows[static_cast<std::size_t>(r)], eq.p(r) = rhs[static_cast<std::size_t>(r)];
+  return eq;
+}
+
+// The noise covariance C of one test's rows `idx` of `eq`, at the joints' values `at`,
+// regularised as the fit whitens with it.
+Eigen::MatrixXd test_covariance(const Equations& eq, const std::vector<int>& idx,
+                                const TestSpectrum& test, std::size_t ti,
+                                const std::vector<joints::Joint>& at, const Eigen::MatrixXd& B) {
+  std::vector<Row> these;
+  for (int r : idx)
+    these.push_back(eq.rows[static_cast<std::size_t>(r)]);
+  Eigen::MatrixXd C = equation_covariance(test, these, eq.receptances[ti], at, B);
+  C.diagonal().array() += 1e-12 * C.diagonal().mean() + 1e-300;
+  return C;
+}
 } // namespace
 
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
@@ -428,7 +501,6 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   if (joints.empty()) throw std::invalid_argument("identify: the model has no joints");
   if (tests.empty()) throw std::invalid_argument("identify: no tests");
   const std::vector<int> set2 = joint_dof_set(joints, dofs);
-  const int n2 = static_cast<int>(set2.size());
   // Unknowns: the non-fixed terms of every joint.
   struct Unknown {
     int joint, term;
@@ -448,50 +520,15 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   };
 
   // 1. The equations, row by row, and what their noise covariance needs.
-  std::vector<Eigen::RowVectorXd> q_rows;
-  std::vector<double> rhs;
-  std::vector<Row> rows;
-  std::vector<std::map<int, Receptances>> receptances(tests.size());
-  for (std::size_t ti = 0; ti < tests.size(); ++ti) {
-    const auto& test = tests[ti];
-    for (int k : o.harmonics) {
-      if (test.fundamental_only && k != 1) continue;
-      if (k < 0 || k >= test.F.rows())
-        throw std::invalid_argument("identify: harmonic " + std::to_string(k) + " not extracted");
-      const double w = two_pi * test.frequency_hz * k;
-      const frf::CMatrix H22 = H(w, set2, set2), H2f = H(w, set2, test.force_equations);
-      receptances[ti][k] = {H22 * B.cast<Complex>(), H2f};
-      frf::CVector R = test.X2.row(k).transpose() - H2f * test.F.row(k).transpose();
-      frf::CMatrix Qc(n2, nu);
-      for (int u = 0; u < nu; ++u) {
-        const auto [i, t] = unknowns[u];
-        Qc.col(u) = -H22 * B.col(i).cast<Complex>() * test.G[i](k, t);
-      }
-      for (std::size_t i = 0; i < joints.size(); ++i) // known terms go to the right-hand side
-        for (std::size_t t = 0; t < joints[i].terms.size(); ++t)
-          if (joints[i].fixed[t])
-            R += H22 * B.col(i).cast<Complex>() * test.G[i](k, t) * joints[i].values[t];
-      for (int d = 0; d < n2; ++d) {
-        q_rows.push_back(Qc.row(d).real());
-        rhs.push_back(R(d).real());
-        rows.push_back({static_cast<int>(ti), k, d, false});
-        if (k != 0) { // the mean has no imaginary part
-          q_rows.push_back(Qc.row(d).imag());
-          rhs.push_back(R(d).imag());
-          rows.push_back({static_cast<int>(ti), k, d, true});
-        }
-      }
-    }
-  }
-  const int m = static_cast<int>(q_rows.size());
+  Equations eq = equations(H, set2, B, joints, tests, o.harmonics);
+  const int m = static_cast<int>(eq.rows.size());
   if (m < nu)
     throw std::invalid_argument(
         "identify: " + std::to_string(m) + " equations for " + std::to_string(nu) +
         " unknowns; add tests at other frequencies or force levels, or more harmonics");
-  Eigen::MatrixXd Q(m, nu);
-  Eigen::VectorXd p(m);
-  for (int r = 0; r < m; ++r)
-    Q.row(r) = q_rows[static_cast<std::size_t>(r)], p(r) = rhs[static_cast<std::size_t>(r)];
+  const Eigen::MatrixXd& Q = eq.Q;
+  const Eigen::VectorXd& p = eq.p;
+  const std::vector<Row>& rows = eq.rows;
   for (int u = 0; u < nu; ++u)
     if (!(Q.col(u).norm() > 0.0))
       throw std::invalid_argument("identify: term " + name_of(u) +
@@ -551,12 +588,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
       for (std::size_t ti = 0; ti < tests.size(); ++ti) {
         const auto& idx = test_rows[ti];
         if (idx.empty()) continue;
-        std::vector<Row> these;
-        for (int r : idx)
-          these.push_back(rows[static_cast<std::size_t>(r)]);
-        Eigen::MatrixXd C = equation_covariance(tests[ti], these, receptances[ti], at, B);
-        C.diagonal().array() += 1e-12 * C.diagonal().mean() + 1e-300;
-        whiten[ti].compute(C);
+        whiten[ti].compute(test_covariance(eq, idx, tests[ti], ti, at, B));
         Eigen::MatrixXd Qi(static_cast<Eigen::Index>(idx.size()), nu);
         Eigen::VectorXd pi(static_cast<Eigen::Index>(idx.size()));
         for (std::size_t r = 0; r < idx.size(); ++r)
@@ -636,6 +668,36 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   }
   out.identifiability = explain_identifiability(out, joints, unknowns_of(joints), tests, B, b,
                                                 sol.scale.asDiagonal() * Vs, o);
+  return out;
+}
+
+TestInformation information(const ReceptanceFn& H, const fem::DofMap& dofs,
+                            const std::vector<joints::Joint>& joints, const TestSpectrum& test,
+                            const std::vector<int>& harmonics) {
+  if (!test.noise_known)
+    throw std::invalid_argument("information: the noise of test " + test.source +
+                                " is not known");
+  const std::vector<int> set2 = joint_dof_set(joints, dofs);
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
+  const std::vector<TestSpectrum> one{test};
+  const Equations eq = equations(H, set2, B, joints, one, harmonics);
+  std::vector<int> idx(eq.rows.size());
+  for (std::size_t r = 0; r < idx.size(); ++r)
+    idx[r] = static_cast<int>(r);
+  const auto unknowns = unknowns_of(joints);
+  Eigen::VectorXd b(static_cast<Eigen::Index>(unknowns.size()));
+  for (std::size_t u = 0; u < unknowns.size(); ++u)
+    b(static_cast<Eigen::Index>(u)) =
+        joints[static_cast<std::size_t>(unknowns[u].first)]
+            .values[static_cast<std::size_t>(unknowns[u].second)];
+  const Eigen::LLT<Eigen::MatrixXd> C(test_covariance(eq, idx, test, 0, joints, B));
+  const Eigen::MatrixXd W = C.matrixL().solve(eq.Q);                         // C^-1/2 Q
+  const Eigen::VectorXd w = C.matrixL().solve(Eigen::VectorXd(eq.p - eq.Q * b)); // C^-1/2 r
+  TestInformation out;
+  out.information = W.transpose() * W;
+  out.score = W.transpose() * w;
+  out.rows = static_cast<int>(idx.size());
+  out.misfit = out.rows > 0 ? std::sqrt(w.squaredNorm() / out.rows) : 0.0;
   return out;
 }
 

@@ -141,6 +141,27 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
 FitResult fit(const frf::Substructure& substructure, const std::vector<joints::Joint>& joints,
               const std::vector<Measurement>& measurements, const FitOptions& options = {});
 
+/// What one test tells about the joints' non-fixed terms (in the order of the joints and their
+/// terms, in the terms' units), with Qᵢ the test's equations at the harmonics given, Cᵢ their
+/// covariance from the test's measurement noise (errors in variables included) at the joints'
+/// values, and rᵢ = pᵢ − Qᵢ b their residual at those values.
+struct TestInformation {
+  /// Qᵢᵀ Cᵢ⁻¹ Qᵢ: what fit() weights the test with; the inverse of the sum over a set of tests
+  /// is the covariance fit() predicts for them.
+  Eigen::MatrixXd information;
+  /// Qᵢᵀ Cᵢ⁻¹ rᵢ: a set of tests' estimates are biased by (Σ Iᵢ)⁻¹ Σ scoreᵢ where the basis
+  /// functions do not describe the joints' forces in the test (0 where they do).
+  Eigen::VectorXd score;
+  /// √(rᵢᵀ Cᵢ⁻¹ rᵢ / rows): the test's misfit at the joints' values in units of its noise.
+  double misfit = 0.0;
+  int rows = 0;
+};
+
+/// Throws std::invalid_argument when the test's noise is not known.
+TestInformation information(const ReceptanceFn& H, const fem::DofMap& dofs,
+                            const std::vector<joints::Joint>& joints, const TestSpectrum& test,
+                            const std::vector<int>& harmonics);
+
 /// The options measure() needs for a fit with these options.
 MeasureOptions measure_options(const FitOptions& options);
 

@@ -216,13 +216,22 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     double previous_amplitude = -1.0;
     for (std::size_t i : order) {
       const SineTestPlan& plan = plans[i];
-      if (plan.amplitude != previous_amplitude) previous.reset();
+      if (plan.amplitude != previous_amplitude || !o.warm_start) previous.reset();
       previous_amplitude = plan.amplitude;
       const frf::HarmonicBalance problem(synthesis, joints, dofs, {force_equation}, outputs,
                                          plan.frequency_hz, o.balance);
       const Eigen::MatrixXcd F = frf::sine_force(plan.amplitude);
       frf::HarmonicBalanceResult hb = problem.solve(joints, F, previous ? &*previous : nullptr);
       if (!hb.converged && previous) hb = problem.solve(joints, F);
+      if (!hb.converged && o.skip_unconverged) {
+        SimulatedTest failed;
+        failed.plan = plan;
+        failed.record.source = sine_test_name(plan);
+        failed.warnings.push_back(fmt::format("{}: no periodic solution found ({})",
+                                              failed.record.source, hb.reason));
+        done[i] = std::move(failed);
+        continue;
+      }
       if (!hb.converged)
         throw std::runtime_error(fmt::format(
             "harmonic balance at {} Hz, {} N: no periodic solution found ({}); simulate this "
@@ -248,6 +257,7 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
           synthesis.has_residual() ? "; modal synthesis with residual flexibility" : ""));
       for (const auto& note : notes)
         test.comments.push_back(note);
+
       test.comments.push_back(fmt::format("harmonic balance: converged after {} iterations "
                                           "(relative residual {:.3g}); {} periods sampled from "
                                           "the harmonics",

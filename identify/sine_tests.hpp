@@ -35,6 +35,13 @@ struct SimulationOptions {
   std::vector<fem::NodeDof> extra_outputs;
   frf::HarmonicBalanceOptions balance{}; ///< harmonic balance
   double steady_tolerance = 1e-10;       ///< time integration: period-to-period change
+  /// Harmonic balance: a test without a periodic solution is returned with an empty record and
+  /// the reason in its warnings, instead of throwing.
+  bool skip_unconverged = false;
+  /// Harmonic balance: start each test from the solution of the one below it in frequency at
+  /// the same force (a sweep up, which follows a hardening joint's upper branch); false: every
+  /// test from the linear response.
+  bool warm_start = true;
 };
 
 struct SimulatedTest {

@@ -225,6 +225,61 @@ std::string modes_json(const fem::Modes& modes, int count,
   return text(out);
 }
 
+std::string design_json(const identify::Design& design,
+                        const std::vector<identify::CandidateTest>& candidates,
+                        const std::vector<identify::DesignUnknown>& unknowns,
+                        const identify::DesignOptions& options) {
+  Json out;
+  out["noise"] = options.noise;
+  out["periods"] = options.periods;
+  out["harmonics"] = options.harmonics;
+  Json list = Json::array();
+  for (std::size_t u = 0; u < unknowns.size(); ++u) {
+    Json j;
+    j["joint"] = unknowns[u].joint;
+    j["term"] = std::string(joints::term_name(unknowns[u].term));
+    j["prior"] = number(unknowns[u].prior);
+    const double sd = design.std(static_cast<Eigen::Index>(u));
+    j["std"] = number(sd);
+    j["relative_std"] =
+        unknowns[u].prior != 0.0 ? number(sd / std::abs(unknowns[u].prior)) : Json(nullptr);
+    j["bias"] = number(design.bias(static_cast<Eigen::Index>(u)));
+    list.push_back(std::move(j));
+  }
+  out["unknowns"] = std::move(list);
+  Json chosen = Json::array();
+  std::vector<bool> is_chosen(candidates.size(), false);
+  for (int i : design.chosen) {
+    const auto& plan = candidates[static_cast<std::size_t>(i)].plan;
+    is_chosen[static_cast<std::size_t>(i)] = true;
+    chosen.push_back({{"freq_hz", plan.frequency_hz},
+                      {"amplitude", plan.amplitude},
+                      {"record", identify::sine_test_name(plan)}});
+  }
+  out["chosen"] = std::move(chosen);
+  out["log_det"] = number(design.log_det);
+  out["exchanges"] = design.exchanges;
+  Json all = Json::array();
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const auto& c = candidates[i];
+    Json j;
+    j["freq_hz"] = c.plan.frequency_hz;
+    j["amplitude"] = c.plan.amplitude;
+    j["usable"] = c.usable;
+    j["misfit"] = number(c.misfit);
+    if (!c.usable) j["reason"] = c.reason;
+    Json amp = Json::array();
+    for (double a : c.joint_amplitude)
+      amp.push_back(number(a));
+    j["joint_amplitude"] = std::move(amp);
+    j["chosen"] = static_cast<bool>(is_chosen[i]);
+    all.push_back(std::move(j));
+  }
+  out["candidates"] = std::move(all);
+  out["warnings"] = design.warnings;
+  return text(out);
+}
+
 void write_json(const std::filesystem::path& path, const std::string& json) {
   write_file_atomically(path, json);
 }

@@ -2,6 +2,7 @@
 /// JSON results (DESIGN.md's contract): identification results and mode lists.
 #include "discover/discover.hpp"
 #include "fem/modal.hpp"
+#include "identify/design.hpp"
 #include "identify/fit.hpp"
 
 #include <filesystem>
@@ -33,6 +34,17 @@ std::string modes_json(const fem::Modes& modes, int count = -1,
 /// "final": [...]}, "warnings"}. The substructure's damping scale appears as joint
 /// "substructure", term "damping_scale". NaN and infinite numbers are written as null.
 std::string discovery_json(const discover::Result& result);
+
+/// An experiment design (README: "design.json"): {"noise", "periods", "harmonics",
+/// "unknowns": [{"joint", "term", "prior", "std", "relative_std", "bias"}], "chosen":
+/// [{"freq_hz", "amplitude", "record"}], "log_det", "exchanges", "candidates": [{"freq_hz",
+/// "amplitude", "usable", "misfit", "reason", "joint_amplitude": [...], "chosen"}],
+/// "warnings"}. `std` and `bias` are what fit() is predicted to show for the chosen tests
+/// (null: undetermined).
+std::string design_json(const identify::Design& design,
+                        const std::vector<identify::CandidateTest>& candidates,
+                        const std::vector<identify::DesignUnknown>& unknowns,
+                        const identify::DesignOptions& options);
 
 /// Writes JSON text atomically (see write_file_atomically).
 void write_json(const std::filesystem::path& path, const std::string& json);

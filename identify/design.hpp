@@ -1,0 +1,108 @@
+#pragma once
+/// Experiment design: which sine tests to run so that the joints' terms are best determined.
+///
+/// Each candidate test (a frequency and a force level at one DOF) is predicted with the joints
+/// at prior values (harmonic balance to the periodic steady state), "measured" with the noise
+/// expected — white, of RMS `noise` × each channel's RMS on every channel, force included, over
+/// `periods` periods averaged — and turned into the information it gives about the unknown terms:
+/// Iᵢ = Qᵢᵀ Cᵢ⁻¹ Qᵢ, the test's equations weighted by their noise covariance exactly as fit()
+/// weights them (identify::information). The inverse of the sum over a set of tests is the
+/// covariance fit() predicts for those tests, so its diagonal gives the standard deviations to
+/// expect. The design is D-optimal: it maximises det(Σ Iᵢ) over sets of N distinct candidates
+/// (greedy choice, then exchanges of one chosen test for one not chosen while the determinant
+/// grows). D-optimality does not depend on the parameters' units.
+#include "fem/dof.hpp"
+#include "frf/harmonic_balance.hpp"
+#include "frf/substructure.hpp"
+#include "identify/record.hpp"
+#include "identify/sine_tests.hpp"
+#include "joints/joint.hpp"
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace jointid::identify {
+
+struct DesignOptions {
+  std::vector<int> harmonics{1}; ///< the harmonics whose equations the fit will use
+  double noise = 0.01;           ///< noise RMS / channel RMS, every channel (force too)
+  int periods = 8;               ///< periods in each record, averaged before the fit
+  int samples_per_period = 256;  ///< samples of a period
+  /// Response channels recorded at the joints' DOFs and the force DOF.
+  std::vector<Quantity> quantities{Quantity::displacement, Quantity::velocity};
+  frf::HarmonicBalanceOptions balance{}; ///< the prediction (harmonics 0 … K)
+  /// Leave out candidates whose equations, at the prior values, miss by more than this many
+  /// noise standard deviations (CandidateTest::misfit): there the basis functions do not
+  /// describe the joints' forces (dry friction that sticks: sign(ẏ) says nothing of the stuck
+  /// force), so such a test biases the estimates beyond what its noise says. Infinite: keep all.
+  double max_misfit = 0.2;
+};
+
+/// One candidate test as predicted at the prior values.
+struct CandidateTest {
+  SineTestPlan plan;
+  bool usable = false; ///< predicted (the harmonic balance converged)
+  std::string reason;  ///< why not usable
+  /// Peak deformation (fundamental) of every joint, m or rad.
+  std::vector<double> joint_amplitude;
+  /// The information it gives about the unknowns (unknowns × unknowns, their units).
+  Eigen::MatrixXd information;
+  /// Its contribution to the bias (identify::TestInformation::score) and its misfit at the
+  /// prior values in noise standard deviations.
+  Eigen::VectorXd score;
+  double misfit = 0.0;
+};
+
+/// The unknown terms (the joints' non-fixed terms, in order) and their prior values.
+struct DesignUnknown {
+  std::string joint;
+  joints::Term term = joints::Term::k;
+  double prior = 0.0;
+};
+
+/// Predicts every candidate (in parallel). Throws std::invalid_argument for bad options
+/// (naming them), no unknowns, or a force DOF the model lacks.
+std::vector<CandidateTest> predict_candidates(const frf::Substructure& substructure,
+                                              const std::vector<joints::Joint>& joints,
+                                              const fem::NodeDof& force_at,
+                                              const std::vector<SineTestPlan>& candidates,
+                                              const DesignOptions& options = {});
+
+/// The unknowns of these joints, in the order of CandidateTest::information.
+std::vector<DesignUnknown> design_unknowns(const std::vector<joints::Joint>& joints);
+
+/// The standard deviations fit() predicts for the unknowns from these tests (indices into
+/// `candidates`): the square roots of the diagonal of (Σ Iᵢ)⁻¹; infinite where the tests
+/// leave an unknown undetermined.
+Eigen::VectorXd predicted_std(const std::vector<CandidateTest>& candidates,
+                              const std::vector<int>& tests);
+
+/// The bias of fit()'s estimates from these tests where the basis functions do not describe the
+/// joints' forces exactly: (Σ Iᵢ)⁻¹ Σ scoreᵢ (0 where they do; NaN where undetermined).
+Eigen::VectorXd predicted_bias(const std::vector<CandidateTest>& candidates,
+                               const std::vector<int>& tests);
+
+/// log det(Σ Iᵢ) of the tests with the unknowns scaled by `scale` (−∞ when singular).
+double log_det_information(const std::vector<CandidateTest>& candidates,
+                           const std::vector<int>& tests, const Eigen::VectorXd& scale);
+
+struct Design {
+  std::vector<int> chosen; ///< indices into the candidates, by frequency then force
+  double log_det = 0.0;    ///< of Σ Iᵢ over the chosen, unknowns scaled by their priors
+  Eigen::VectorXd std;     ///< predicted standard deviations of the unknowns
+  Eigen::VectorXd bias;    ///< predicted bias of the unknowns (predicted_bias)
+  int exchanges = 0;       ///< exchanges that improved on the greedy choice
+  std::vector<std::string> warnings;
+};
+
+/// The D-optimal set of `n` distinct usable candidates (list a candidate twice to allow it to
+/// be repeated). Throws std::invalid_argument when n is not positive or exceeds the usable
+/// candidates; warns, naming the term, when the best set leaves an unknown undetermined
+/// (singular information) or its predicted standard deviation above `poorly_determined` of its
+/// prior value.
+Design choose_tests(const std::vector<CandidateTest>& candidates,
+                    const std::vector<DesignUnknown>& unknowns, int n,
+                    double poorly_determined = 0.05);
+
+} // namespace jointid::identify
