@@ -567,16 +567,16 @@ std::vector<double> parse_values(const std::string& option, const std::vector<st
                                     "START",
                                     option, item));
       const double n = std::floor((b - a) / step + 1e-6);
-      if (n > 10000)
-        throw io::Error(fmt::format("{} {}: more than 10000 values", option, item));
+      if (n > 10000) throw io::Error(fmt::format("{} {}: more than 10000 values", option, item));
       for (int i = 0; i <= static_cast<int>(n); ++i)
         out.push_back(a + i * step);
     } else {
-      throw io::Error(fmt::format(
-          "{}: expected numbers ({}) or ranges START:STEP:STOP, got \"{}\"", option, unit, item));
+      throw io::Error(fmt::format("{}: expected numbers ({}) or ranges START:STEP:STOP, got \"{}\"",
+                                  option, unit, item));
     }
   }
-  if (out.empty()) throw io::Error(fmt::format("{}: expected at least one value ({})", option, unit));
+  if (out.empty())
+    throw io::Error(fmt::format("{}: expected at least one value ({})", option, unit));
   for (double v : out)
     if (!(v > 0.0))
       throw io::Error(fmt::format("{}: expected values > 0 {}, got {}", option, unit, v));
@@ -595,8 +595,8 @@ void design(const DesignOptions& o) {
   check_harmonics(o.harmonics, 0);
   if (o.count < 1) throw io::Error(fmt::format("-n: expected at least 1 test, got {}", o.count));
   if (!(o.noise > 0.0 && o.noise < 1.0))
-    throw io::Error(fmt::format("--noise: expected a fraction between 0 and 1 (e.g. 0.01), got {}",
-                                o.noise));
+    throw io::Error(
+        fmt::format("--noise: expected a fraction between 0 and 1 (e.g. 0.01), got {}", o.noise));
   if (!(o.max_misfit > 0.0))
     throw io::Error(fmt::format("--max-misfit: expected a number > 0 (noise standard deviations), "
                                 "got {}",
@@ -607,8 +607,8 @@ void design(const DesignOptions& o) {
     throw io::Error(
         fmt::format("--balance-harmonics: expected 1 to 200, got {}", o.balance_harmonics));
   if (*std::max_element(o.harmonics.begin(), o.harmonics.end()) > o.balance_harmonics)
-    throw io::Error(fmt::format("--harmonics: expected at most --balance-harmonics ({})",
-                                o.balance_harmonics));
+    throw io::Error(
+        fmt::format("--harmonics: expected at most --balance-harmonics ({})", o.balance_harmonics));
   const std::size_t n_candidates = freqs.size() * amps.size();
   if (static_cast<std::size_t>(o.count) > n_candidates)
     throw io::Error(fmt::format("-n {}: more than the {} candidates ({} frequencies x {} "

@@ -100,7 +100,7 @@ struct DesignOptions {
   double noise = 0.01;                  ///< expected noise RMS / channel RMS
   int periods = 8;                      ///< periods in each record
   int balance_harmonics = 9;            ///< harmonics 0 … K of the prediction
-  double max_misfit = 0.2; ///< leave out candidates whose equations miss by more (noise std)
+  double max_misfit = 0.2;     ///< leave out candidates whose equations miss by more (noise std)
   std::string engine = "auto"; ///< modes of large models: auto or slepc
   std::filesystem::path output_dir;
 };

@@ -56,8 +56,9 @@ Eigen::MatrixXd total_information(const std::vector<CandidateTest>& candidates,
   for (int i : tests) {
     const CandidateTest& c = candidates.at(static_cast<std::size_t>(i));
     if (!c.usable)
-      throw std::invalid_argument(fmt::format("design: the test at {} Hz, {} N was not predicted: {}",
-                                              c.plan.frequency_hz, c.plan.amplitude, c.reason));
+      throw std::invalid_argument(
+          fmt::format("design: the test at {} Hz, {} N was not predicted: {}", c.plan.frequency_hz,
+                      c.plan.amplitude, c.reason));
     if (A.size() == 0) A = Eigen::MatrixXd::Zero(c.information.rows(), c.information.cols());
     A += c.information;
   }
@@ -87,11 +88,10 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
         fmt::format("design: periods: expected at least 2 per record, got {}", o.periods));
   if (o.harmonics.empty()) throw std::invalid_argument("design: no harmonics asked");
   const int K = *std::max_element(o.harmonics.begin(), o.harmonics.end());
-  if (*std::min_element(o.harmonics.begin(), o.harmonics.end()) < 0 ||
-      K > o.balance.harmonics)
-    throw std::invalid_argument(fmt::format(
-        "design: harmonics: expected 0 to {} (the prediction's harmonics), got {}",
-        o.balance.harmonics, fmt::join(o.harmonics, ",")));
+  if (*std::min_element(o.harmonics.begin(), o.harmonics.end()) < 0 || K > o.balance.harmonics)
+    throw std::invalid_argument(
+        fmt::format("design: harmonics: expected 0 to {} (the prediction's harmonics), got {}",
+                    o.balance.harmonics, fmt::join(o.harmonics, ",")));
   if (o.samples_per_period < 4 * (o.balance.harmonics + 1))
     throw std::invalid_argument(fmt::format(
         "design: samples per period: expected at least {} for harmonics 0 to {}, got {}",
@@ -257,9 +257,9 @@ Design choose_tests(const std::vector<CandidateTest>& candidates,
   for (std::size_t i = 0; i < candidates.size(); ++i)
     if (candidates[i].usable) usable.push_back(static_cast<int>(i));
   if (n < 1 || n > static_cast<int>(usable.size()))
-    throw std::invalid_argument(fmt::format(
-        "design: -n: expected 1 to {} (the candidates that could be predicted), got {}",
-        usable.size(), n));
+    throw std::invalid_argument(
+        fmt::format("design: -n: expected 1 to {} (the candidates that could be predicted), got {}",
+                    usable.size(), n));
   const Eigen::VectorXd scale = unit_scale(candidates, nu);
   std::vector<Eigen::MatrixXd> I(candidates.size());
   for (int i : usable)

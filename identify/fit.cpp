@@ -420,7 +420,6 @@ std::vector<std::string> explain_identifiability(const FitResult& result,
   return out;
 }
 
-
 // The equations Q b = p of the tests (rows: real and imaginary parts per set-2 DOF, harmonic and
 // test) for the non-fixed terms, known terms moved to the right-hand side, and the receptances
 // each test's rows use (for their noise covariance).
@@ -675,8 +674,7 @@ TestInformation information(const ReceptanceFn& H, const fem::DofMap& dofs,
                             const std::vector<joints::Joint>& joints, const TestSpectrum& test,
                             const std::vector<int>& harmonics) {
   if (!test.noise_known)
-    throw std::invalid_argument("information: the noise of test " + test.source +
-                                " is not known");
+    throw std::invalid_argument("information: the noise of test " + test.source + " is not known");
   const std::vector<int> set2 = joint_dof_set(joints, dofs);
   const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
   const std::vector<TestSpectrum> one{test};
@@ -687,11 +685,10 @@ TestInformation information(const ReceptanceFn& H, const fem::DofMap& dofs,
   const auto unknowns = unknowns_of(joints);
   Eigen::VectorXd b(static_cast<Eigen::Index>(unknowns.size()));
   for (std::size_t u = 0; u < unknowns.size(); ++u)
-    b(static_cast<Eigen::Index>(u)) =
-        joints[static_cast<std::size_t>(unknowns[u].first)]
-            .values[static_cast<std::size_t>(unknowns[u].second)];
+    b(static_cast<Eigen::Index>(u)) = joints[static_cast<std::size_t>(unknowns[u].first)]
+                                          .values[static_cast<std::size_t>(unknowns[u].second)];
   const Eigen::LLT<Eigen::MatrixXd> C(test_covariance(eq, idx, test, 0, joints, B));
-  const Eigen::MatrixXd W = C.matrixL().solve(eq.Q);                         // C^-1/2 Q
+  const Eigen::MatrixXd W = C.matrixL().solve(eq.Q);                             // C^-1/2 Q
   const Eigen::VectorXd w = C.matrixL().solve(Eigen::VectorXd(eq.p - eq.Q * b)); // C^-1/2 r
   TestInformation out;
   out.information = W.transpose() * W;

@@ -227,8 +227,8 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
         SimulatedTest failed;
         failed.plan = plan;
         failed.record.source = sine_test_name(plan);
-        failed.warnings.push_back(fmt::format("{}: no periodic solution found ({})",
-                                              failed.record.source, hb.reason));
+        failed.warnings.push_back(
+            fmt::format("{}: no periodic solution found ({})", failed.record.source, hb.reason));
         done[i] = std::move(failed);
         continue;
       }

@@ -861,10 +861,26 @@ TEST_F(CliTest, DesignPredictsTheUncertaintyIdentifyThenReports) {
   std::vector<std::string> records;
   for (std::size_t i = 0; i < freqs.size(); ++i) {
     const fs::path rec = dir() / ("design_records_" + std::to_string(i));
-    const Outcome sim = jointid({"simulate", model.string(), "--force", "7:uy", "--freq",
-                                 freqs[i], "--amplitude", amps[i], "--method", "hb",
-                                 "--periods", "8", "--steps-per-period", "256", "--noise",
-                                 "0.01", "--seed", std::to_string(11 + i), "-o", rec.string()},
+    const Outcome sim = jointid({"simulate",
+                                 model.string(),
+                                 "--force",
+                                 "7:uy",
+                                 "--freq",
+                                 freqs[i],
+                                 "--amplitude",
+                                 amps[i],
+                                 "--method",
+                                 "hb",
+                                 "--periods",
+                                 "8",
+                                 "--steps-per-period",
+                                 "256",
+                                 "--noise",
+                                 "0.01",
+                                 "--seed",
+                                 std::to_string(11 + i),
+                                 "-o",
+                                 rec.string()},
                                 dir());
     ASSERT_EQ(sim.status, 0) << sim.err;
     records.push_back((rec / names[i]).string());
@@ -894,8 +910,7 @@ TEST_F(CliTest, DesignChecksItsOptionsBeforeWriting) {
       fs::path(JOINTID_SOURCE_DIR) / "examples" / "paper_cantilever" / "cantilever.toml";
   const fs::path out = dir() / "design_bad";
   auto run = [&](const std::vector<std::string>& extra) {
-    std::vector<std::string> args{"design", model.string(), "--force", "7:uy", "-o",
-                                  out.string()};
+    std::vector<std::string> args{"design", model.string(), "--force", "7:uy", "-o", out.string()};
     args.insert(args.end(), extra.begin(), extra.end());
     return jointid(args, dir());
   };

@@ -82,7 +82,8 @@ TEST(Design, PredictedStdIsTheMonteCarloScatter) {
     }
   }
   for (Eigen::Index u = 0; u < nu; ++u) {
-    const double scatter = std::sqrt(std::max(0.0, square(u) - sum(u) * sum(u)) * reps / (reps - 1));
+    const double scatter =
+        std::sqrt(std::max(0.0, square(u) - sum(u) * sum(u)) * reps / (reps - 1));
     const std::string name(joints::term_name(joints[0].terms[static_cast<std::size_t>(u)]));
     std::printf("  %-3s predicted std %.4g, Monte Carlo %.4g (ratio %.3f), fit's mean std %.4g\n",
                 name.c_str(), predicted(u), scatter, scatter / predicted(u), reported(u));
@@ -185,8 +186,8 @@ TEST(Design, TestsWhereFrictionSticksAreLeftOut) {
   const std::vector<identify::SineTestPlan> plans{{1.0, 10.0}, {19.0, 80.0}};
   const auto candidates = identify::predict_candidates(sub, joints, tip, plans);
   ASSERT_EQ(candidates.size(), 2u);
-  std::printf("  misfit: %.3g at 1 Hz, 10 N (sticks); %.3g at 19 Hz, 80 N\n",
-              candidates[0].misfit, candidates[1].misfit);
+  std::printf("  misfit: %.3g at 1 Hz, 10 N (sticks); %.3g at 19 Hz, 80 N\n", candidates[0].misfit,
+              candidates[1].misfit);
   EXPECT_FALSE(candidates[0].usable);
   EXPECT_NE(candidates[0].reason.find("noise standard deviations"), std::string::npos)
       << candidates[0].reason;
