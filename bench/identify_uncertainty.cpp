@@ -9,7 +9,8 @@
 // force's fundamental a nuisance parameter of every test, measured with its own noise).
 // Results: docs/identification_uncertainty.md.
 //
-//   bench_identify_uncertainty [repetitions (200)] [harmonics]   (harmonics: the harmonics study)
+//   bench_identify_uncertainty [repetitions (200)] [harmonics|two]   (harmonics: the harmonics
+//   study; two: the two-joint study alone)
 #include "frf/harmonic_balance.hpp"
 #include "identify/fit.hpp"
 #include "identify/sine_tests.hpp"
@@ -300,6 +301,7 @@ int main(int argc, char** argv) {
     harmonics_study(model_I, reps);
     return 0;
   }
-  report(model_I, reps);
+  const bool only_two = argc > 2 && std::string(argv[2]) == "two";
+  if (!only_two) report(model_I, reps);
   report(two, reps);
 }

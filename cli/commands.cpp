@@ -231,6 +231,7 @@ void identify(const IdentifyOptions& o) {
   frf::Substructure sub = file.substructure();
   use_engine(sub, parse_engine(o.engine));
   const identify::FitResult result = identify::fit(sub, file.joints, measured, options);
+  if (result.status != identify::FitStatus::ok) throw io::Error("identify: " + result.reason);
   if (!output_rank()) return;
   io::write_json(o.output, io::identify_result_json(result));
 

@@ -434,7 +434,11 @@ private:
     };
     identify::FitOptions fo;
     fo.harmonics = o_.harmonics;
-    return identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
+    identify::FitResult fit = identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
+    // Terms the tests cannot separate: this model cannot be identified (a refused candidate).
+    if (fit.status != identify::FitStatus::ok)
+      throw std::invalid_argument("identify: " + fit.reason);
+    return fit;
   }
 
   int parameters(const std::vector<joints::Joint>& joints, double scale) const {

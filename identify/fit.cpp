@@ -142,6 +142,7 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
 
 std::vector<joints::Joint>
 FitResult::identified(const std::vector<joints::Joint>& model_joints) const {
+  if (status != FitStatus::ok) throw std::invalid_argument("identify: " + reason);
   std::vector<joints::Joint> out = model_joints;
   for (std::size_t i = 0; i < out.size() && i < joints.size(); ++i)
     for (std::size_t t = 0; t < out[i].terms.size(); ++t)
@@ -538,6 +539,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     Eigen::VectorXd b, scale, sv;
     Eigen::MatrixXd V;
     double condition = 0.0;
+    std::string inseparable; // why the unknowns cannot be separated (empty: they can)
   };
   auto solve = [&](const Eigen::MatrixXd& A, const Eigen::VectorXd& y) {
     Solution sol;
@@ -553,13 +555,46 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     if (!(sol.condition < 1e13)) {
       Eigen::Index worst;
       svd.matrixV().col(nu - 1).cwiseAbs().maxCoeff(&worst);
-      throw std::invalid_argument(
-          "identify: the unknowns cannot be separated by these tests (condition number " +
-          std::to_string(sol.condition) + "); term " + name_of(static_cast<int>(worst)) +
-          " is a combination of the others: vary frequency and force level, or drop a term");
+      sol.inseparable = fmt::format(
+          "the unknowns cannot be separated by these tests (condition number {:.3g}); term {} is "
+          "a combination of the others: vary frequency and force level, or drop a term",
+          sol.condition, name_of(static_cast<int>(worst)));
+      sol.b = Eigen::VectorXd::Constant(nu, nan);
+      return sol;
     }
     sol.b = sol.scale.asDiagonal() * svd.solve(y);
     return sol;
+  };
+  // Unknowns that cannot be separated: a status, every value NaN (nothing is returned as if
+  // it were determined).
+  auto inseparable = [&](const Solution& sol) {
+    FitResult out;
+    out.status = FitStatus::not_separable;
+    out.reason = sol.inseparable;
+    out.warnings = warnings;
+    out.equations = m;
+    out.unknowns = nu;
+    out.condition_number = sol.condition;
+    out.singular_values.assign(sol.sv.data(), sol.sv.data() + sol.sv.size());
+    out.interval_method = "none";
+    out.chi2_per_dof = nan;
+    out.residual_rms = out.residual_relative = nan;
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      JointEstimate je{joints[i].name, {}};
+      for (std::size_t t = 0; t < joints[i].terms.size(); ++t) {
+        TermEstimate te;
+        te.term = joints[i].terms[t];
+        te.fixed = joints[i].fixed[t];
+        te.value = te.fixed ? joints[i].values[t] : nan;
+        te.std = te.fixed ? 0.0 : nan;
+        te.ci_low = te.ci_high = te.value;
+        te.determined = te.fixed;
+        je.terms.push_back(te);
+      }
+      out.joints.push_back(std::move(je));
+    }
+    out.identifiability.push_back(sol.inseparable);
+    return out;
   };
   auto with_values = [&](const Eigen::VectorXd& b) {
     std::vector<joints::Joint> js = joints;
@@ -569,6 +604,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     return js;
   };
   Solution sol = solve(Q, p);
+  if (!sol.inseparable.empty()) return inseparable(sol);
 
   // 3. With the noise known everywhere: generalised least squares, its covariance at the
   //    ordinary estimate first, then once more at the weighted one.
@@ -600,6 +636,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
           pw(idx[r]) = pi(static_cast<Eigen::Index>(r));
       }
       sol = solve(Qw, pw);
+      if (!sol.inseparable.empty()) return inseparable(sol);
     }
   }
 

@@ -60,7 +60,17 @@ struct JointEstimate {
   std::vector<TermEstimate> terms;
 };
 
+/// The outcome of a fit (Spectra's rule: bad input throws; a numerical outcome is a status).
+enum class FitStatus {
+  ok,
+  /// The equations do not separate the unknowns (condition number of the column-scaled Q at
+  /// least 1e13): every non-fixed value, std and interval is NaN; `reason` names the term.
+  not_separable
+};
+
 struct FitResult {
+  FitStatus status = FitStatus::ok;
+  std::string reason; ///< why not ok (empty when ok)
   std::vector<JointEstimate> joints;
   int equations = 0;
   int unknowns = 0;
@@ -76,7 +86,8 @@ struct FitResult {
   std::vector<double> singular_values;      ///< of the column-scaled (weighted) Q, largest first
   std::vector<std::string> identifiability; ///< what the tests do not determine, in words
   std::vector<std::string> warnings;
-  /// The joints with their identified values (fixed terms unchanged).
+  /// The joints with their identified values (fixed terms unchanged). Throws
+  /// std::invalid_argument with `reason` when the status is not ok.
   std::vector<joints::Joint> identified(const std::vector<joints::Joint>& model_joints) const;
 };
 
@@ -116,7 +127,9 @@ TestSpectrum spectrum(const Measurement& measurement, const fem::DofMap& dofs,
                       const std::vector<joints::Joint>& joints, std::vector<std::string>& warnings);
 
 /// Identifies the non-fixed terms of every joint from the tests. Throws std::invalid_argument
-/// when there are fewer equations than unknowns or the unknowns are not separable. Tests from
+/// for bad input: no joints or tests, a term whose basis function is zero in every test, fewer
+/// equations than unknowns. Unknowns the tests cannot separate give FitStatus::not_separable
+/// with its reason (no values). Tests from
 /// stepped-sine tables contribute harmonic 1 only (with a warning if others were asked).
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
               const std::vector<joints::Joint>& joints, const std::vector<TestSpectrum>& tests,

@@ -254,8 +254,11 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
       const double allowance =
           std::isfinite(sigma) ? 4.0 * 2.0 * sigma / std::sqrt(half) / size : 0.0;
       if (change > o.steady_tolerance + allowance)
-        m.warnings.push_back(r.source + ": not a steady state (first and last half differ by " +
-                             percent(change) + ")");
+        m.warnings.push_back(r.source + ": " + best[big]->name() +
+                             ": not a steady state (the fundamental of the first and last half "
+                             "differ by " +
+                             percent(change) + "; limit " +
+                             percent(o.steady_tolerance + allowance) + " with the noise)");
     }
   }
   return m;

@@ -149,6 +149,7 @@ int main(int argc, char** argv) {
           try {
             const identify::FitResult fit = identify::fit(
                 sub, joints, identify::measure(tests, identify::measure_options(fo)), fo);
+            if (fit.status != identify::FitStatus::ok) throw std::invalid_argument(fit.reason);
             for (Eigen::Index u = 0; u < scale.size(); ++u)
               square(u) += std::pow(
                   fit.joints[0].terms[static_cast<std::size_t>(u)].value / scale(u) - 1.0, 2);

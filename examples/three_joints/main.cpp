@@ -73,6 +73,10 @@ int main(int argc, char** argv) {
 
   // 2. One realisation.
   const identify::FitResult one = identify_once(0);
+  if (one.status != identify::FitStatus::ok) {
+    fmt::print(stderr, "three_joints: {}\n", one.reason);
+    return 1;
+  }
   fmt::print("Frame of examples/three_joints/frame.toml, 12 sine tests at corner:ux, noise {:g} % "
              "RMS on every channel, harmonics 1-3\n\n",
              100.0 * noise);

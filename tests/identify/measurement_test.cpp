@@ -425,6 +425,13 @@ TEST(Measure, SteadyStateWarningIgnoresNoiseButNotGrowth) {
   const Measurement m = measure(growing);
   EXPECT_TRUE(has_warning(m, "not a steady state"));
   EXPECT_TRUE(has_warning(m, "synthetic.csv"));
+  // It names the channel, the change and the limit (≈ 0.5 % against ≈ 0.15 %).
+  std::string text;
+  for (const auto& w : m.warnings)
+    if (w.find("not a steady state") != std::string::npos) text = w;
+  EXPECT_EQ(text.rfind("synthetic.csv: x@", 0), 0u) << text;
+  EXPECT_NE(text.find("differ by 0.49"), std::string::npos) << text;
+  EXPECT_NE(text.find("limit 0.15"), std::string::npos) << text;
   EXPECT_FALSE(has_warning(measure(clean), "not a steady state"));
 }
 
