@@ -33,6 +33,7 @@
 #include <set>
 #include <span>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include <unistd.h>
@@ -132,53 +133,67 @@ identify::TransientRoute parse_route(const std::string& text) {
   throw io::Error(fmt::format("--route: expected modal or full, got \"{}\"", text));
 }
 
-// simulate --excitation random|sweep|multisine: one record under that force history.
+// simulate --excitation random|sweep|multisine|record: one record under that force history.
 void simulate_signal(const SimulateOptions& o) {
   // 1. The options.
   const std::string& kind = o.excitation;
-  if (kind != "random" && kind != "sweep" && kind != "multisine")
-    throw io::Error(
-        fmt::format("--excitation: expected sine, random, sweep or multisine, got \"{}\"", kind));
+  if (kind != "random" && kind != "sweep" && kind != "multisine" && kind != "record")
+    throw io::Error(fmt::format(
+        "--excitation: expected sine, random, sweep, multisine or record, got \"{}\"", kind));
+  const bool from_record = kind == "record";
   if (!o.frequencies.empty())
-    throw io::Error(
-        fmt::format("--freq: only for sine tests; --excitation {} takes --band F0:F1", kind));
+    throw io::Error(fmt::format("--freq: only for sine tests, not --excitation {}", kind));
   if (o.method != "time")
     throw io::Error(fmt::format("--method {}: --excitation {} is simulated in time (see --route)",
                                 o.method, kind));
   if (o.table) throw io::Error("--table: only for sine tests");
-  if (o.band.empty())
-    throw io::Error(fmt::format("--band: expected F0:F1 in Hz for --excitation {}", kind));
-  const auto [f0, f1] = parse_band("--band", o.band);
-  if (!(std::isfinite(o.duration) && o.duration > 0.0))
-    throw io::Error(fmt::format("--duration: expected a duration > 0 s, got {}", o.duration));
-  if (!(std::isfinite(o.sample_rate) && o.sample_rate > 0.0))
-    throw io::Error(
-        fmt::format("--sample-rate: expected a sample rate > 0 Hz, got {}", o.sample_rate));
-  if (!(f1 < 0.5 * o.sample_rate))
-    throw io::Error(fmt::format("--band {}: expected F1 below half the sample rate ({} Hz)", o.band,
-                                0.5 * o.sample_rate));
-  double level = 0.0;
-  if (kind == "sweep") {
-    if (o.amplitudes.size() != 1 || !(std::isfinite(o.amplitudes[0]) && o.amplitudes[0] > 0.0))
-      throw io::Error("--amplitude: expected one amplitude > 0 (N, peak) for the sweep");
-    if (o.rms != 0.0) throw io::Error("--rms: not for a sweep (give --amplitude, the peak)");
-    level = o.amplitudes[0];
+  double f0 = 0.0, f1 = 0.0, level = 0.0;
+  if (from_record) {
+    if (o.force_from.empty())
+      throw io::Error("--force-from: expected the record (CSV) whose force channels drive the "
+                      "model, for --excitation record");
+    if (!o.force.empty())
+      throw io::Error("--force: not with --excitation record (the forces act where the record's "
+                      "f@NODE:DOF channels say)");
+    if (!o.band.empty() || o.rms != 0.0 || !o.amplitudes.empty() || o.duration != 0.0 ||
+        o.sample_rate != 0.0)
+      throw io::Error(
+          "--band, --rms, --amplitude, --duration, --sample-rate: not with --excitation "
+          "record (the record gives the force and its sampling)");
   } else {
-    if (!o.amplitudes.empty())
-      throw io::Error(fmt::format("--amplitude: not for --excitation {} (give --rms)", kind));
-    if (!(std::isfinite(o.rms) && o.rms > 0.0))
-      throw io::Error(fmt::format("--rms: expected an RMS force > 0 (N), got {}", o.rms));
-    level = o.rms;
+    if (!o.force_from.empty()) throw io::Error("--force-from: only with --excitation record");
+    if (o.force.empty()) throw io::Error("--force: expected NODE:DOF of the force, e.g. 7:uy");
+    if (o.band.empty())
+      throw io::Error(fmt::format("--band: expected F0:F1 in Hz for --excitation {}", kind));
+    std::tie(f0, f1) = parse_band("--band", o.band);
+    if (!(std::isfinite(o.duration) && o.duration > 0.0))
+      throw io::Error(fmt::format("--duration: expected a duration > 0 s, got {}", o.duration));
+    if (!(std::isfinite(o.sample_rate) && o.sample_rate > 0.0))
+      throw io::Error(
+          fmt::format("--sample-rate: expected a sample rate > 0 Hz, got {}", o.sample_rate));
+    if (!(f1 < 0.5 * o.sample_rate))
+      throw io::Error(fmt::format("--band {}: expected F1 below half the sample rate ({} Hz)",
+                                  o.band, 0.5 * o.sample_rate));
+    if (kind == "sweep") {
+      if (o.amplitudes.size() != 1 || !(std::isfinite(o.amplitudes[0]) && o.amplitudes[0] > 0.0))
+        throw io::Error("--amplitude: expected one amplitude > 0 (N, peak) for the sweep");
+      if (o.rms != 0.0) throw io::Error("--rms: not for a sweep (give --amplitude, the peak)");
+      level = o.amplitudes[0];
+    } else {
+      if (!o.amplitudes.empty())
+        throw io::Error(fmt::format("--amplitude: not for --excitation {} (give --rms)", kind));
+      if (!(std::isfinite(o.rms) && o.rms > 0.0))
+        throw io::Error(fmt::format("--rms: expected an RMS force > 0 (N), got {}", o.rms));
+      level = o.rms;
+    }
   }
   const identify::TransientRoute route = parse_route(o.route);
   if (o.substeps < 1)
     throw io::Error(fmt::format("--substeps: expected at least 1, got {}", o.substeps));
   if (!(std::isfinite(o.modal_cutoff) && o.modal_cutoff >= 0.0))
     throw io::Error(fmt::format("--modal-cutoff: expected >= 0 Hz, got {}", o.modal_cutoff));
-  const double fade = o.fade_in < 0.0 ? 0.05 * o.duration : o.fade_in;
-  if (!(std::isfinite(fade) && fade < o.duration))
-    throw io::Error(
-        fmt::format("--fade-in: expected less than the duration ({} s), got {}", o.duration, fade));
+  if (!std::isfinite(o.fade_in))
+    throw io::Error(fmt::format("--fade-in: expected seconds >= 0, got {}", o.fade_in));
   if (!(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise < 1.0))
     throw io::Error(fmt::format(
         "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", o.noise));
@@ -195,41 +210,63 @@ void simulate_signal(const SimulateOptions& o) {
   options.route = route;
   options.modal_cutoff_hz = o.modal_cutoff;
   options.substeps = o.substeps;
-  options.fade_in_s = fade;
   check_output_dir(o.output_dir);
 
   // 2. The force history.
   identify::ForceInput input;
-  input.sample_rate_hz = o.sample_rate;
-  const fem::Sampling sampling{o.duration, o.sample_rate};
-  try {
-    if (kind == "random") {
-      input.samples = fem::band_limited_random({f0, f1, level, o.seed}, sampling);
-      input.description = fmt::format("excitation: band-limited Gaussian random, flat {}-{} Hz, "
-                                      "RMS {} N, seed {}",
-                                      f0, f1, level, o.seed);
-    } else if (kind == "sweep") {
-      input.samples = fem::sine_sweep({f0, f1, level, false}, sampling);
-      input.description = fmt::format(
-          "excitation: linear sine sweep {}-{} Hz, amplitude {} N (peak)", f0, f1, level);
-    } else {
-      input.samples = fem::multisine({f0, f1, level}, sampling);
-      input.description =
-          fmt::format("excitation: multisine, lines k/T in {}-{} Hz, Schroeder phases, RMS {} N",
-                      f0, f1, level);
+  std::string name;
+  double duration = o.duration;
+  if (from_record) {
+    const identify::Record record = io::read_record(o.force_from);
+    try {
+      input = identify::force_input(record);
+    } catch (const std::invalid_argument& e) {
+      throw io::Error(std::string("--force-from ") + e.what());
     }
-  } catch (const std::invalid_argument& e) {
-    throw io::Error(std::string("--band, --duration, --sample-rate: ") + e.what());
+    duration = static_cast<double>(record.t.size()) / input.sample_rate_hz;
+    name = o.force_from.stem().string() + "_simulated.csv";
+  } else {
+    input.sample_rate_hz = o.sample_rate;
+    const fem::Sampling sampling{o.duration, o.sample_rate};
+    try {
+      if (kind == "random") {
+        input.samples = fem::band_limited_random({f0, f1, level, o.seed}, sampling);
+        input.description = fmt::format("excitation: band-limited Gaussian random, flat {}-{} Hz, "
+                                        "RMS {} N, seed {}",
+                                        f0, f1, level, o.seed);
+      } else if (kind == "sweep") {
+        input.samples = fem::sine_sweep({f0, f1, level, false}, sampling);
+        input.description = fmt::format(
+            "excitation: linear sine sweep {}-{} Hz, amplitude {} N (peak)", f0, f1, level);
+      } else {
+        input.samples = fem::multisine({f0, f1, level}, sampling);
+        input.description =
+            fmt::format("excitation: multisine, lines k/T in {}-{} Hz, Schroeder phases, RMS {} N",
+                        f0, f1, level);
+      }
+    } catch (const std::invalid_argument& e) {
+      throw io::Error(std::string("--band, --duration, --sample-rate: ") + e.what());
+    }
+    input.description += fmt::format("; {} s at {} Hz", o.duration, o.sample_rate);
+    name = fmt::format("{}_{}-{}Hz_{}N{}.csv", kind, f0, f1, level,
+                       kind == "random" ? fmt::format("_seed{}", o.seed) : "");
   }
-  input.description += fmt::format("; {} s at {} Hz", o.duration, o.sample_rate);
-  const std::string name = fmt::format("{}_{}-{}Hz_{}N{}.csv", kind, f0, f1, level,
-                                       kind == "random" ? fmt::format("_seed{}", o.seed) : "");
+  // Default: 5 % of the duration, none for a record's force that already starts at zero.
+  const bool starts_at_zero =
+      input.samples.row(0).cwiseAbs().maxCoeff() <= 1e-9 * input.samples.cwiseAbs().maxCoeff();
+  const double fade = o.fade_in >= 0.0                ? o.fade_in
+                      : from_record && starts_at_zero ? 0.0
+                                                      : 0.05 * duration;
+  if (!(fade >= 0.0 && fade < duration))
+    throw io::Error(
+        fmt::format("--fade-in: expected 0 to below the duration ({} s), got {}", duration, fade));
+  options.fade_in_s = fade;
 
   // 3. The model and the simulation.
   const io::ModelFile file = io::read_model(o.model);
   frf::Substructure sub = file.substructure();
   use_engine(sub, parse_engine(o.engine));
-  input.at = {resolve(file, sub, "--force", o.force)};
+  if (!from_record) input.at = {resolve(file, sub, "--force", o.force)};
   for (const auto& text : o.outputs)
     options.extra_outputs.push_back(resolve(file, sub, "--outputs", text));
   io::check_not_an_input(o.output_dir / name);
@@ -267,9 +304,11 @@ void simulate(const SimulateOptions& o) {
     simulate_signal(o);
     return;
   }
-  if (!o.band.empty() || o.rms != 0.0 || o.duration != 0.0 || o.sample_rate != 0.0)
-    throw io::Error("--band, --rms, --duration, --sample-rate: only with --excitation random, "
-                    "sweep or multisine");
+  if (!o.band.empty() || o.rms != 0.0 || o.duration != 0.0 || o.sample_rate != 0.0 ||
+      !o.force_from.empty())
+    throw io::Error("--band, --rms, --duration, --sample-rate, --force-from: only with "
+                    "--excitation random, sweep, multisine or record");
+  if (o.force.empty()) throw io::Error("--force: expected NODE:DOF of the sine force, e.g. 7:uy");
   // 1. The options, before anything is read or computed.
   if (o.frequencies.empty()) throw io::Error("--freq: expected at least one frequency (Hz)");
   if (o.amplitudes.empty()) throw io::Error("--amplitude: expected at least one amplitude (N)");

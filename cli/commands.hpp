@@ -26,20 +26,22 @@ struct SimulateOptions {
   std::string engine = "auto"; ///< modes of a large model: auto or slepc (MPI)
   std::filesystem::path output_dir;
   // Any other force history (one record): --excitation random|sweep|multisine.
-  std::string excitation = "sine"; ///< sine (steady state, the options above), random, sweep,
-                                   ///< multisine
-  std::string band;                ///< F0:F1, Hz (random, multisine; sweep: from F0 to F1)
-  double rms = 0.0;                ///< N or N·m (random, multisine); sweep: --amplitude
-  double duration = 0.0;           ///< s
-  double sample_rate = 0.0;        ///< Hz
-  std::string route = "modal";     ///< modal (retained modes + static correction) or full
-  double modal_cutoff = 0.0;       ///< Hz; 0: the Nyquist frequency
-  int substeps = 4;                ///< Newmark steps per sample
-  double fade_in = -1.0;           ///< s; < 0: 5 % of the duration
+  std::string excitation = "sine";  ///< sine (steady state, the options above), random, sweep,
+                                    ///< multisine, record (the force channels of --force-from)
+  std::string band;                 ///< F0:F1, Hz (random, multisine; sweep: from F0 to F1)
+  double rms = 0.0;                 ///< N or N·m (random, multisine); sweep: --amplitude
+  double duration = 0.0;            ///< s
+  double sample_rate = 0.0;         ///< Hz
+  std::string route = "modal";      ///< modal (retained modes + static correction) or full
+  double modal_cutoff = 0.0;        ///< Hz; 0: the Nyquist frequency
+  int substeps = 4;                 ///< Newmark steps per sample
+  double fade_in = -1.0;            ///< s; < 0: 5 % of the duration
+  std::filesystem::path force_from; ///< --excitation record: the record whose f@ channels drive
 };
 
 /// One record per frequency × amplitude: DIR/sine_f<freq>Hz_F<amp>N.csv; or, with `table`,
-/// DIR/stepped_sine.csv. Other excitations: one record DIR/<excitation>_<F0>-<F1>Hz_....csv.
+/// DIR/stepped_sine.csv. Other excitations: one record DIR/<excitation>_<F0>-<F1>Hz_....csv, or
+/// DIR/<record stem>_simulated.csv for --excitation record.
 void simulate(const SimulateOptions& options);
 
 struct CompareOptions {

@@ -67,10 +67,10 @@ int main(int argc, char** argv) {
       "simulate", "Simulate sine tests of the model with its joints at their values; "
                   "one record (CSV) per frequency x amplitude");
   simulate->add_option("MODEL", sim.model, "Model file (TOML)")->required();
-  simulate
-      ->add_option("--force", sim.force,
-                   "NODE:DOF of the sine force, e.g. 7:uy; NODE may be a one-node Gmsh group")
-      ->required();
+  simulate->add_option(
+      "--force", sim.force,
+      "NODE:DOF of the force, e.g. 7:uy; NODE may be a one-node Gmsh group (not with "
+      "--excitation record)");
   simulate
       ->add_option("--freq", sim.frequencies,
                    "Excitation frequencies, Hz (comma-separated; sine tests)")
@@ -122,8 +122,9 @@ int main(int argc, char** argv) {
       ->add_option("--excitation", sim.excitation,
                    "sine: steady-state sine tests (--freq, --amplitude); random: band-limited "
                    "Gaussian (--band, --rms); sweep: linear sine sweep over --band "
-                   "(--amplitude); multisine: --band, --rms. The last three need --duration and "
-                   "--sample-rate and write one record")
+                   "(--amplitude); multisine: --band, --rms (these three need --duration and "
+                   "--sample-rate); record: the force channels of --force-from. All but sine "
+                   "write one record")
       ->capture_default_str();
   simulate->add_option("--band", sim.band, "F0:F1 in Hz (random, sweep, multisine)");
   simulate->add_option("--rms", sim.rms, "RMS force, N or N m (random, multisine)");
@@ -140,8 +141,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   simulate->add_option("--substeps", sim.substeps, "Newmark steps per sample (random, ...)")
       ->capture_default_str();
-  simulate->add_option("--fade-in", sim.fade_in,
-                       "Force faded in over this time from rest, s (default: 5 % of --duration)");
+  simulate->add_option("--force-from", sim.force_from,
+                       "--excitation record: a record (CSV) whose f@NODE:DOF channels drive the "
+                       "model");
+  simulate->add_option(
+      "--fade-in", sim.fade_in,
+      "Force faded in over this time from rest, s (default: 5 % of --duration; none "
+      "for a record's force that starts at zero)");
 
   cli::CompareOptions cmp;
   auto* compare = app.add_subcommand(

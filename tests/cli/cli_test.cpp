@@ -845,6 +845,19 @@ TEST_F(CliTest, RandomRecordComparesAtZeroDecibelsAndADifferentJointDoesNot) {
   const std::string text = test::read_text(record);
   EXPECT_NE(text.find("band-limited Gaussian random"), std::string::npos);
 
+  // The record's force channel drives the model again (--excitation record): the same response.
+  const Outcome again =
+      jointid({"simulate", model().string(), "--excitation", "record", "--force-from",
+               record.string(), "--channels", "x,a", "-o", (dir() / "again").string()},
+              dir());
+  ASSERT_EQ(again.status, 0) << again.err;
+  const identify::Record r2 =
+      io::read_record(dir() / "again" / "random_2-40Hz_40N_seed1_simulated.csv");
+  ASSERT_EQ(r2.channels.size(), 3u);
+  EXPECT_EQ(r2.channels[1].name(), "x@7:uy");
+  EXPECT_LT((r2.channels[1].samples - r.channels[1].samples).cwiseAbs().maxCoeff(),
+            1e-9 * r.channels[1].samples.cwiseAbs().maxCoeff());
+
   const fs::path out = dir() / "compare_same";
   std::vector<std::string> args{"compare", model().string(), record.string(), "--band", "2:40",
                                 "-o",      out.string()};
@@ -900,7 +913,7 @@ TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
     return extra;
   };
   expect_one_line_error(simulate(with({"--excitation", "noise", "--band", "2:40", "--rms", "1"})),
-                        "--excitation: expected sine, random, sweep or multisine");
+                        "--excitation: expected sine, random, sweep, multisine or record");
   expect_one_line_error(simulate(with({"--excitation", "random", "--rms", "1"})), "--band");
   expect_one_line_error(simulate(with({"--excitation", "random", "--band", "40:2", "--rms", "1"})),
                         "--band: expected 0 <= F0 < F1");
@@ -920,6 +933,15 @@ TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
       "--duration");
   expect_one_line_error(simulate({"--freq", "3", "--amplitude", "10", "--band", "2:40"}),
                         "only with --excitation");
+  expect_one_line_error(simulate({"--excitation", "record"}), "--force-from");
+  expect_one_line_error(
+      simulate({"--excitation", "record", "--force-from", record_files()[0], "--rms", "3"}),
+      "not with --excitation record");
+  expect_one_line_error(
+      jointid({"simulate", model().string(), "--excitation", "record", "--force-from",
+               (dir() / "missing.csv").string(), "-o", out.string()},
+              dir()),
+      "missing.csv");
   EXPECT_FALSE(fs::exists(out));
 
   // compare: a record without a force channel, a bad band, a bad segment.
