@@ -67,7 +67,7 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
   Comparison out;
   try {
     out.prediction = simulate_forced(sub, joints, input, sim);
-  } catch (const std::out_of_range& e) { // a DOF the model lacks
+  } catch (const std::invalid_argument& e) { // e.g. a channel at a DOF the model lacks
     throw std::invalid_argument(fmt::format("{}: {}", name, e.what()));
   }
 
@@ -82,7 +82,7 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
     if (!p) throw std::logic_error("compare: a predicted channel is missing");
     Eigen::MatrixXd both(kept, 2);
     both << c->samples.tail(kept), p->samples.tail(kept);
-    const Spectra s = welch(both, fs, welch_options);
+    const WelchSpectra s = welch(both, fs, welch_options);
     out.averages = s.averages;
     out.resolution_hz = s.resolution_hz;
     ChannelComparison cc;

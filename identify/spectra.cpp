@@ -10,13 +10,13 @@
 
 namespace jointid::identify {
 
-Eigen::VectorXd Spectra::psd(int i) const {
+Eigen::VectorXd WelchSpectra::psd(int i) const {
   if (i < 0 || i >= static_cast<int>(G.size()))
     throw std::invalid_argument(fmt::format("spectra: no column {}", i));
   return G[static_cast<std::size_t>(i)].col(i).real();
 }
 
-Spectra welch(const Eigen::MatrixXd& signals, double fs, const WelchOptions& o) {
+WelchSpectra welch(const Eigen::MatrixXd& signals, double fs, const WelchOptions& o) {
   if (!(std::isfinite(fs) && fs > 0.0))
     throw std::invalid_argument(fmt::format("Welch: expected a sample rate > 0 Hz, got {}", fs));
   if (o.segment < 8)
@@ -38,7 +38,7 @@ Spectra welch(const Eigen::MatrixXd& signals, double fs, const WelchOptions& o) 
   const double scale = 1.0 / (fs * window.squaredNorm());
   const int bins = N / 2 + 1;
 
-  Spectra s;
+  WelchSpectra s;
   s.frequency_hz = Eigen::VectorXd::LinSpaced(bins, 0.0, (bins - 1) * fs / N);
   s.resolution_hz = fs / N;
   s.noise_bandwidth_hz = 1.5 * fs / N;
@@ -64,7 +64,7 @@ Spectra welch(const Eigen::MatrixXd& signals, double fs, const WelchOptions& o) 
 }
 
 PowerSpectrum power_spectrum(const Eigen::VectorXd& x, double fs, const WelchOptions& o) {
-  const Spectra s = welch(x, fs, o);
+  const WelchSpectra s = welch(x, fs, o);
   return {s.frequency_hz, s.psd(0), s.averages};
 }
 
@@ -75,7 +75,7 @@ FrfEstimate h1_estimate(const Eigen::VectorXd& force, const Eigen::VectorXd& res
                                             force.size(), response.size()));
   Eigen::MatrixXd both(force.size(), 2);
   both << force, response;
-  const Spectra s = welch(both, fs, o);
+  const WelchSpectra s = welch(both, fs, o);
   FrfEstimate e;
   e.frequency_hz = s.frequency_hz;
   e.averages = s.averages;

@@ -9,7 +9,8 @@
 ///     G_xy(f_k) = c_k · conj(X_k) Y_k / (fs Σ w_n²),   c_k = 2 (1 at DC and, N even, Nyquist),
 /// in (unit of x)(unit of y)/Hz; G_xx is the one-sided PSD, real, e.g. N²/Hz for a force, so
 /// that ∫ G_xx df over 0 … fs/2 is the variance (Parseval) and a sine of amplitude A gives a
-/// peak whose integral is A²/2. Records shorter than one segment are refused.
+/// peak whose integral is A²/2. Only whole segments are used (samples after the last one are
+/// not); records shorter than one segment are refused.
 #include <Eigen/Core>
 #include <vector>
 
@@ -21,7 +22,7 @@ struct WelchOptions {
 };
 
 /// Every auto and cross spectrum of the columns of a record.
-struct Spectra {
+struct WelchSpectra {
   Eigen::VectorXd frequency_hz; ///< f_k, k = 0 … N/2
   /// G[i](k, j): column i against column j at f_k (G_ij = average of c·conj(X_i) X_j /(fs Σw²)).
   std::vector<Eigen::MatrixXcd> G;
@@ -36,8 +37,8 @@ struct Spectra {
 
 /// Throws std::invalid_argument (naming the value) for a sample rate <= 0, bad options, or a
 /// record shorter than one segment.
-Spectra welch(const Eigen::MatrixXd& signals, double sample_rate_hz,
-              const WelchOptions& options = {});
+WelchSpectra welch(const Eigen::MatrixXd& signals, double sample_rate_hz,
+                   const WelchOptions& options = {});
 
 /// One-sided PSD of one signal (its unit²/Hz), with frequencies.
 struct PowerSpectrum {
