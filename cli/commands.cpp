@@ -27,6 +27,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <numbers>
 #include <optional>
@@ -126,6 +127,22 @@ std::pair<double, double> parse_band(const std::string& option, const std::strin
     throw io::Error(fmt::format("{}: expected 0 <= F0 < F1 (Hz), got {} and {}", option, f0, f1));
   return {f0, f1};
 }
+
+// Progress of a time simulation on stderr when it is a terminal (nothing otherwise); clear()
+// wipes the line.
+struct TerminalProgress {
+  std::string label;
+  bool on = isatty(STDERR_FILENO) == 1 && output_rank();
+  std::function<void(double)> callback() const {
+    if (!on) return {};
+    return [label = label](double fraction) {
+      std::cerr << fmt::format("\r{}: {:3.0f} %", label, 100.0 * fraction) << std::flush;
+    };
+  }
+  void clear() const {
+    if (on) std::cerr << "\r" << std::string(label.size() + 8, ' ') << "\r" << std::flush;
+  }
+};
 
 identify::TransientRoute parse_route(const std::string& text) {
   if (text == "modal") return identify::TransientRoute::modal;
@@ -271,11 +288,15 @@ void simulate_signal(const SimulateOptions& o) {
     options.extra_outputs.push_back(resolve(file, sub, "--outputs", text));
   io::check_not_an_input(o.output_dir / name);
   identify::ForcedTest test;
+  const TerminalProgress progress{"jointid simulate: time simulation"};
+  options.progress = progress.callback();
   try {
     test = identify::simulate_forced(sub, file.joints, input, options);
   } catch (const std::invalid_argument& e) {
+    progress.clear();
     throw io::Error(o.model.string() + ": " + e.what());
   }
+  progress.clear();
   test.record.source = name;
   test.comments.insert(test.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
   if (o.noise > 0.0) {
@@ -771,11 +792,15 @@ void compare(const CompareOptions& o) {
 
   // 3. Predict and compare.
   identify::Comparison result;
+  const TerminalProgress progress{"jointid compare: predicting"};
+  options.simulation.progress = progress.callback();
   try {
     result = identify::compare_spectra(sub, file.joints, record, options);
   } catch (const std::invalid_argument& e) {
+    progress.clear();
     throw io::Error(fmt::format("{} with {}: {}", o.record.string(), o.model.string(), e.what()));
   }
+  progress.clear();
 
   // 4. Write.
   make_output_dir(o.output_dir);

@@ -105,6 +105,8 @@ integrate(const Assembled& system, const SparseMatrix& C, const LocalForces* for
       }
     record(integrator, out, i + 1);
     out.samples_done = static_cast<int>(i + 2);
+    if (o.progress && (i + 2) % std::max<Eigen::Index>(1, n / 100) == 0)
+      o.progress(static_cast<double>(i + 2) / static_cast<double>(n));
   }
   return out;
 }

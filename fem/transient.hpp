@@ -22,6 +22,7 @@
 #include "fem/time_integration.hpp"
 
 #include <Eigen/Core>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -40,6 +41,8 @@ struct TransientOptions {
   /// from rest is smooth; 0: the force acts from the first sample.
   double fade_in_s = 0.0;
   NewmarkOptions newmark;
+  /// Called with the fraction done (0 … 1), about every 1 % of the samples; empty: not called.
+  std::function<void(double)> progress;
 };
 
 enum class TransientStatus { success, newton_failed };

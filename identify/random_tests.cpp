@@ -98,6 +98,7 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
   fem::TransientOptions options;
   options.substeps = o.substeps;
   options.fade_in_s = o.fade_in_s;
+  options.progress = o.progress;
 
   // 3. Simulate.
   ForcedTest test;

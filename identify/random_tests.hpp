@@ -8,6 +8,7 @@
 #include "identify/record.hpp"
 #include "joints/joint.hpp"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,8 @@ struct ForcedOptions {
   std::vector<Quantity> quantities{Quantity::displacement, Quantity::velocity};
   /// Outputs beyond the joints' DOFs and the force DOFs.
   std::vector<fem::NodeDof> extra_outputs;
+  /// Called with the fraction of the time simulation done (0 … 1); empty: not called.
+  std::function<void(double)> progress;
 };
 
 /// Forces at one or more DOFs, sampled at sample_rate_hz from t = 0.
