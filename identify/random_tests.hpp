@@ -23,7 +23,11 @@ struct ForcedOptions {
   TransientRoute route = TransientRoute::modal;
   /// Modal route: modes below this frequency are integrated (Hz); 0: below the record's
   /// Nyquist frequency. The rest enter through their static flexibility at the forced and the
-  /// joints' DOFs (see fem::modal_reduction) unless static_correction is false.
+  /// joints' DOFs (see fem::modal_reduction) unless static_correction is false. Models of up to
+  /// 200 equations get every mode from the dense eigensolver; larger ones only the band below
+  /// the cutoff (sparse engine). Modes above the cutoff that a non-linear joint's harmonics
+  /// excite are missing from the response (velocity and acceleration most): raise the cutoff
+  /// when those matter.
   double modal_cutoff_hz = 0.0;
   bool static_correction = true;
   int substeps = 4;       ///< Newmark steps per sample interval
