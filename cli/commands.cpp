@@ -798,7 +798,7 @@ void compare(const CompareOptions& o) {
     result = identify::compare_spectra(sub, file.joints, record, options);
   } catch (const std::invalid_argument& e) {
     progress.clear();
-    throw io::Error(fmt::format("{} with {}: {}", o.record.string(), o.model.string(), e.what()));
+    throw io::Error(fmt::format("{} (model {})", e.what(), o.model.string()));
   }
   progress.clear();
 

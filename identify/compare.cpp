@@ -19,6 +19,13 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
   if (responses.empty())
     throw std::invalid_argument(
         fmt::format("{}: no response channel (expected x@, v@ or a@NODE:DOF columns)", name));
+  for (const auto& c : measured.channels)
+    try {
+      sub.dofs().equation(c.at);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(
+          fmt::format("{}: channel {}: {} in the model", name, c.name(), e.what()));
+    }
   const double fs = input.sample_rate_hz, nyquist = 0.5 * fs;
   const Eigen::Index n = measured.t.size();
   const double duration = static_cast<double>(n) / fs;
@@ -29,6 +36,11 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
   const auto first = static_cast<Eigen::Index>(std::ceil(skip * fs - 1e-9));
   const Eigen::Index kept = n - first;
   int segment = o.segment;
+  if (segment == 0 && kept < 64)
+    throw std::invalid_argument(fmt::format(
+        "{}: {} samples after the first {} s, fewer than the smallest automatic segment (64): "
+        "ask for a shorter segment, or give a longer record",
+        name, kept, skip));
   if (segment == 0) {
     segment = 64;
     while (2 * segment <= kept / 8) // 50 % overlap: about 2 kept / segment − 1 averages
