@@ -964,6 +964,16 @@ TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
                                  "--no-plot", "-o", cmp.string()},
                                 dir()),
                         "Nyquist");
+  std::string text = test::read_text(record_files()[0]);
+  const auto at = text.find("x@7:uy");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 6, "x@9:uy");
+  const fs::path bad_node = dir() / "bad_node.csv";
+  test::write_text(bad_node, text);
+  expect_one_line_error(
+      jointid({"compare", model().string(), bad_node.string(), "--no-plot", "-o", cmp.string()},
+              dir()),
+      "bad_node.csv: channel x@9:uy: node 9 does not exist");
   EXPECT_FALSE(fs::exists(cmp));
 }
 
