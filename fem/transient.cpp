@@ -164,11 +164,14 @@ ModalReduction modal_reduction(const Assembled& system, const Modes& modes, cons
     for (Eigen::Index j = 0; j < s; ++j)
       E(static_dofs[j], j) = 1.0;
     const Eigen::MatrixXd flexibility = stiffness.solve(E); // K⁻¹ E_S
-    Eigen::MatrixXd phi_s(s, m);
-    for (Eigen::Index j = 0; j < s; ++j)
-      phi_s.row(j) = modes.phi.row(static_dofs[j]);
-    const Eigen::VectorXd inv_w2 = modes.omega.array().square().inverse();
-    const Eigen::MatrixXd R = flexibility - modes.phi * inv_w2.asDiagonal() * phi_s.transpose();
+    // R E_S = P K⁻¹ Pᵀ E_S with P = I − ΦΦᵀM (equal to K⁻¹E_S − ΦΛ⁻¹Φ_Sᵀ, since
+    // ΦᵀM K⁻¹ = Λ⁻¹Φᵀ): the kept modes' share is taken out of the load before the solve and out
+    // of the result after it, instead of subtracting two nearly equal flexibilities — the
+    // rounding of an ill-conditioned K lies mostly in the lowest modes, which P removes.
+    const Eigen::MatrixXd Mphi = system.M * modes.phi;
+    const Eigen::MatrixXd load = E - Mphi * modes.phi.transpose() * E;
+    Eigen::MatrixXd R = stiffness.solve(load);
+    R -= modes.phi * (Mphi.transpose() * R);
     Eigen::MatrixXd R_ss(s, s), K_inv_ss(s, s);
     for (Eigen::Index j = 0; j < s; ++j) {
       R_ss.row(j) = R.row(static_dofs[j]);
