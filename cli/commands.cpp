@@ -300,10 +300,13 @@ void simulate_signal(const SimulateOptions& o) {
   test.record.source = name;
   test.comments.insert(test.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
   if (o.noise > 0.0) {
-    identify::add_noise(test.record, o.noise, o.seed);
+    // Not the random force's own seed: the same generator state would make the noise the very
+    // white sequence the force was filtered from, correlated with it.
+    const unsigned long long noise_seed = o.seed + 1000003ULL;
+    identify::add_noise(test.record, o.noise, noise_seed);
     test.comments.push_back(fmt::format(
         "noise: white Gaussian, RMS {} of each channel's RMS, on every channel (seed {})", o.noise,
-        o.seed));
+        noise_seed));
   }
   for (const auto& w : test.warnings)
     warn(w);
