@@ -3,12 +3,15 @@
 #include "cli/engine.hpp"
 
 #include "discover/discover.hpp"
+#include "fem/excitation.hpp"
 #include "fem/modal.hpp"
 #include "fem/zero_modes.hpp"
 #include "frf/substructure.hpp"
 #include "identify/design.hpp"
+#include "identify/compare.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
+#include "identify/random_tests.hpp"
 #include "identify/sine_tests.hpp"
 #include "io/chart.hpp"
 #include "io/discovery_report.hpp"
@@ -17,6 +20,7 @@
 #include "io/record_csv.hpp"
 #include "io/response_curves.hpp"
 #include "io/results_json.hpp"
+#include "io/spectra_comparison.hpp"
 #include "io/vtk_output.hpp"
 #include "joints/joint.hpp"
 
@@ -24,12 +28,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <numbers>
 #include <optional>
 #include <set>
 #include <span>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include <unistd.h>
 
@@ -99,9 +106,234 @@ identify::Quantity parse_quantity(const std::string& text) {
   throw io::Error(fmt::format("--channels: expected x, v or a, got \"{}\"", text));
 }
 
+// "F0:F1" in Hz, two finite numbers 0 <= F0 < F1; io::Error naming the option otherwise.
+std::pair<double, double> parse_band(const std::string& option, const std::string& text) {
+  double f0 = 0.0, f1 = 0.0;
+  const auto colon = text.find(':');
+  bool ok = colon != std::string::npos;
+  if (ok) {
+    try {
+      std::size_t n0 = 0, n1 = 0;
+      const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+      f0 = std::stod(a, &n0);
+      f1 = std::stod(b, &n1);
+      ok = n0 == a.size() && n1 == b.size();
+    } catch (const std::exception&) {
+      ok = false;
+    }
+  }
+  if (!ok)
+    throw io::Error(fmt::format("{}: expected F0:F1 in Hz, e.g. 2:40, got \"{}\"", option, text));
+  if (!(std::isfinite(f0) && std::isfinite(f1) && f0 >= 0.0 && f1 > f0))
+    throw io::Error(fmt::format("{}: expected 0 <= F0 < F1 (Hz), got {} and {}", option, f0, f1));
+  return {f0, f1};
+}
+
+// Progress of a time simulation on stderr when it is a terminal (nothing otherwise); clear()
+// wipes the line.
+struct TerminalProgress {
+  std::string label;
+  bool on = isatty(STDERR_FILENO) == 1 && output_rank();
+  std::function<void(double)> callback() const {
+    if (!on) return {};
+    return [label = label](double fraction) {
+      std::cerr << fmt::format("\r{}: {:3.0f} %", label, 100.0 * fraction) << std::flush;
+    };
+  }
+  void clear() const {
+    if (on) std::cerr << "\r" << std::string(label.size() + 8, ' ') << "\r" << std::flush;
+  }
+};
+
+identify::TransientRoute parse_route(const std::string& text) {
+  if (text == "modal") return identify::TransientRoute::modal;
+  if (text == "full") return identify::TransientRoute::full;
+  throw io::Error(fmt::format("--route: expected modal or full, got \"{}\"", text));
+}
+
+// simulate --excitation random|sweep|multisine|record: one record under that force history.
+void simulate_signal(const SimulateOptions& o) {
+  // 1. The options.
+  const std::string& kind = o.excitation;
+  if (kind != "random" && kind != "sweep" && kind != "multisine" && kind != "record")
+    throw io::Error(fmt::format(
+        "--excitation: expected sine, random, sweep, multisine or record, got \"{}\"", kind));
+  const bool from_record = kind == "record";
+  if (!o.frequencies.empty())
+    throw io::Error(fmt::format("--freq: only for sine tests, not --excitation {}", kind));
+  if (o.method != "time")
+    throw io::Error(fmt::format("--method {}: --excitation {} is simulated in time (see --route)",
+                                o.method, kind));
+  if (o.table) throw io::Error("--table: only for sine tests");
+  double f0 = 0.0, f1 = 0.0, level = 0.0;
+  if (from_record) {
+    if (o.force_from.empty())
+      throw io::Error("--force-from: expected the record (CSV) whose force channels drive the "
+                      "model, for --excitation record");
+    if (!o.force.empty())
+      throw io::Error("--force: not with --excitation record (the forces act where the record's "
+                      "f@NODE:DOF channels say)");
+    if (!o.band.empty() || o.rms != 0.0 || !o.amplitudes.empty() || o.duration != 0.0 ||
+        o.sample_rate != 0.0)
+      throw io::Error(
+          "--band, --rms, --amplitude, --duration, --sample-rate: not with --excitation "
+          "record (the record gives the force and its sampling)");
+  } else {
+    if (!o.force_from.empty()) throw io::Error("--force-from: only with --excitation record");
+    if (o.force.empty()) throw io::Error("--force: expected NODE:DOF of the force, e.g. 7:uy");
+    if (o.band.empty())
+      throw io::Error(fmt::format("--band: expected F0:F1 in Hz for --excitation {}", kind));
+    std::tie(f0, f1) = parse_band("--band", o.band);
+    if (!(std::isfinite(o.duration) && o.duration > 0.0))
+      throw io::Error(fmt::format("--duration: expected a duration > 0 s, got {}", o.duration));
+    if (!(std::isfinite(o.sample_rate) && o.sample_rate > 0.0))
+      throw io::Error(
+          fmt::format("--sample-rate: expected a sample rate > 0 Hz, got {}", o.sample_rate));
+    if (!(f1 < 0.5 * o.sample_rate))
+      throw io::Error(fmt::format("--band {}: expected F1 below half the sample rate ({} Hz)",
+                                  o.band, 0.5 * o.sample_rate));
+    if (kind == "sweep") {
+      if (o.amplitudes.size() != 1 || !(std::isfinite(o.amplitudes[0]) && o.amplitudes[0] > 0.0))
+        throw io::Error("--amplitude: expected one amplitude > 0 (N, peak) for the sweep");
+      if (o.rms != 0.0) throw io::Error("--rms: not for a sweep (give --amplitude, the peak)");
+      level = o.amplitudes[0];
+    } else {
+      if (!o.amplitudes.empty())
+        throw io::Error(fmt::format("--amplitude: not for --excitation {} (give --rms)", kind));
+      if (!(std::isfinite(o.rms) && o.rms > 0.0))
+        throw io::Error(fmt::format("--rms: expected an RMS force > 0 (N), got {}", o.rms));
+      level = o.rms;
+    }
+  }
+  const identify::TransientRoute route = parse_route(o.route);
+  if (o.substeps < 1)
+    throw io::Error(fmt::format("--substeps: expected at least 1, got {}", o.substeps));
+  if (!(std::isfinite(o.modal_cutoff) && o.modal_cutoff >= 0.0))
+    throw io::Error(fmt::format("--modal-cutoff: expected >= 0 Hz, got {}", o.modal_cutoff));
+  if (!std::isfinite(o.fade_in))
+    throw io::Error(fmt::format("--fade-in: expected seconds >= 0, got {}", o.fade_in));
+  if (!(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise < 1.0))
+    throw io::Error(fmt::format(
+        "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", o.noise));
+  identify::ForcedOptions options;
+  options.quantities.clear();
+  for (const auto& c : o.channels) {
+    const identify::Quantity q = parse_quantity(c);
+    if (std::find(options.quantities.begin(), options.quantities.end(), q) !=
+        options.quantities.end())
+      throw io::Error(fmt::format("--channels: {} is listed twice", c));
+    options.quantities.push_back(q);
+  }
+  if (options.quantities.empty()) throw io::Error("--channels: expected x, v and/or a");
+  options.route = route;
+  options.modal_cutoff_hz = o.modal_cutoff;
+  options.substeps = o.substeps;
+  check_output_dir(o.output_dir);
+
+  // 2. The force history.
+  identify::ForceInput input;
+  std::string name;
+  double duration = o.duration;
+  if (from_record) {
+    const identify::Record record = io::read_record(o.force_from);
+    try {
+      input = identify::force_input(record);
+    } catch (const std::invalid_argument& e) {
+      throw io::Error(std::string("--force-from ") + e.what());
+    }
+    duration = static_cast<double>(record.t.size()) / input.sample_rate_hz;
+    name = o.force_from.stem().string() + "_simulated.csv";
+  } else {
+    input.sample_rate_hz = o.sample_rate;
+    const fem::Sampling sampling{o.duration, o.sample_rate};
+    try {
+      if (kind == "random") {
+        input.samples = fem::band_limited_random({f0, f1, level, o.seed}, sampling);
+        input.description = fmt::format("excitation: band-limited Gaussian random, flat {}-{} Hz, "
+                                        "RMS {} N, seed {}",
+                                        f0, f1, level, o.seed);
+      } else if (kind == "sweep") {
+        input.samples = fem::sine_sweep({f0, f1, level, false}, sampling);
+        input.description = fmt::format(
+            "excitation: linear sine sweep {}-{} Hz, amplitude {} N (peak)", f0, f1, level);
+      } else {
+        input.samples = fem::multisine({f0, f1, level}, sampling);
+        input.description =
+            fmt::format("excitation: multisine, lines k/T in {}-{} Hz, Schroeder phases, RMS {} N",
+                        f0, f1, level);
+      }
+    } catch (const std::invalid_argument& e) {
+      throw io::Error(std::string("--band, --duration, --sample-rate: ") + e.what());
+    }
+    input.description += fmt::format("; {} s at {} Hz", o.duration, o.sample_rate);
+    name = fmt::format("{}_{}-{}Hz_{}N{}.csv", kind, f0, f1, level,
+                       kind == "random" ? fmt::format("_seed{}", o.seed) : "");
+  }
+  // Default: 5 % of the duration, none for a record's force that already starts at zero.
+  const bool starts_at_zero =
+      input.samples.row(0).cwiseAbs().maxCoeff() <= 1e-9 * input.samples.cwiseAbs().maxCoeff();
+  const double fade = o.fade_in >= 0.0                ? o.fade_in
+                      : from_record && starts_at_zero ? 0.0
+                                                      : 0.05 * duration;
+  if (!(fade >= 0.0 && fade < duration))
+    throw io::Error(
+        fmt::format("--fade-in: expected 0 to below the duration ({} s), got {}", duration, fade));
+  options.fade_in_s = fade;
+
+  // 3. The model and the simulation.
+  const io::ModelFile file = io::read_model(o.model);
+  frf::Substructure sub = file.substructure();
+  use_engine(sub, parse_engine(o.engine));
+  if (!from_record) input.at = {resolve(file, sub, "--force", o.force)};
+  for (const auto& text : o.outputs)
+    options.extra_outputs.push_back(resolve(file, sub, "--outputs", text));
+  io::check_not_an_input(o.output_dir / name);
+  identify::ForcedTest test;
+  const TerminalProgress progress{"jointid simulate: time simulation"};
+  options.progress = progress.callback();
+  try {
+    test = identify::simulate_forced(sub, file.joints, input, options);
+  } catch (const std::invalid_argument& e) {
+    progress.clear();
+    throw io::Error(o.model.string() + ": " + e.what());
+  }
+  progress.clear();
+  test.record.source = name;
+  test.comments.insert(test.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
+  if (o.noise > 0.0) {
+    // Not the random force's own seed: the same generator state would make the noise the very
+    // white sequence the force was filtered from, correlated with it.
+    const unsigned long long noise_seed = o.seed + 1000003ULL;
+    identify::add_noise(test.record, o.noise, noise_seed);
+    test.comments.push_back(fmt::format(
+        "noise: white Gaussian, RMS {} of each channel's RMS, on every channel (seed {})", o.noise,
+        noise_seed));
+  }
+  for (const auto& w : test.warnings)
+    warn(w);
+
+  // 4. Write.
+  if (!output_rank()) return;
+  make_output_dir(o.output_dir);
+  const fs::path path = o.output_dir / name;
+  io::OutputFiles files;
+  files.add(path, io::record_csv(test.record, test.comments));
+  files.commit();
+  fmt::print("wrote {}\n", path.string());
+}
+
 } // namespace
 
 void simulate(const SimulateOptions& o) {
+  if (o.excitation != "sine") {
+    simulate_signal(o);
+    return;
+  }
+  if (!o.band.empty() || o.rms != 0.0 || o.duration != 0.0 || o.sample_rate != 0.0 ||
+      !o.force_from.empty())
+    throw io::Error("--band, --rms, --duration, --sample-rate, --force-from: only with "
+                    "--excitation random, sweep, multisine or record");
+  if (o.force.empty()) throw io::Error("--force: expected NODE:DOF of the sine force, e.g. 7:uy");
   // 1. The options, before anything is read or computed.
   if (o.frequencies.empty()) throw io::Error("--freq: expected at least one frequency (Hz)");
   if (o.amplitudes.empty()) throw io::Error("--amplitude: expected at least one amplitude (N)");
@@ -695,6 +927,76 @@ void design(const DesignOptions& o) {
   }
   for (const auto& w : chosen.warnings)
     warn(w);
+}
+
+void compare(const CompareOptions& o) {
+  // 1. The options.
+  identify::CompareOptions options;
+  if (!o.band.empty()) {
+    const auto [f0, f1] = parse_band("--band", o.band);
+    options.f0_hz = f0;
+    options.f1_hz = f1;
+  }
+  if (o.segment != 0 && o.segment < 8)
+    throw io::Error(
+        fmt::format("--segment: expected at least 8 samples (or 0: automatic), got {}", o.segment));
+  options.segment = o.segment;
+  if (!std::isfinite(o.skip))
+    throw io::Error(fmt::format("--skip: expected seconds >= 0, got {}", o.skip));
+  options.skip_s = o.skip;
+  options.simulation.route = parse_route(o.route);
+  if (o.substeps < 1)
+    throw io::Error(fmt::format("--substeps: expected at least 1, got {}", o.substeps));
+  options.simulation.substeps = o.substeps;
+  if (!(std::isfinite(o.modal_cutoff) && o.modal_cutoff >= 0.0))
+    throw io::Error(fmt::format("--modal-cutoff: expected >= 0 Hz, got {}", o.modal_cutoff));
+  options.simulation.modal_cutoff_hz = o.modal_cutoff;
+  check_output_dir(o.output_dir);
+
+  // 2. The inputs.
+  const io::ModelFile file = io::read_model(o.model);
+  if (file.joints.empty())
+    warn(o.model.string() + ": no [[joints]]: the prediction is the linear substructure's");
+  const identify::Record record = io::read_record(o.record);
+  for (const char* name : {"compare.json", "compare.png"})
+    io::check_not_an_input(o.output_dir / name);
+  frf::Substructure sub = file.substructure();
+
+  // 3. Predict and compare.
+  identify::Comparison result;
+  const TerminalProgress progress{"jointid compare: predicting"};
+  options.simulation.progress = progress.callback();
+  try {
+    result = identify::compare_spectra(sub, file.joints, record, options);
+  } catch (const std::invalid_argument& e) {
+    progress.clear();
+    throw io::Error(fmt::format("{} (model {})", e.what(), o.model.string()));
+  }
+  progress.clear();
+
+  // 4. Write.
+  make_output_dir(o.output_dir);
+  const fs::path json = o.output_dir / "compare.json";
+  io::write_json(json, io::compare_json(result));
+  fmt::print("{:<12} {:>18} {:>18}\n", "channel", "RMS difference dB", "max difference dB");
+  for (const auto& c : result.channels)
+    fmt::print("{:<12} {:>18.3f} {:>18.3f}\n", c.channel, c.rms_db, c.max_db);
+  fmt::print("band {:g}-{:g} Hz; {} averages, so two independent spectra would differ by about "
+             "{:.2f} dB (one standard deviation)\n",
+             result.f0_hz, result.f1_hz, result.averages, result.statistical_db);
+  for (const auto& n : result.notes)
+    fmt::print("note: {}\n", n);
+  fmt::print("wrote {}\n", json.string());
+  if (o.plot) {
+    std::string why;
+    if (io::can_render_charts(&why)) {
+      const fs::path png = o.output_dir / "compare.png";
+      io::write_chart_png(png, io::compare_figure(result));
+      fmt::print("wrote {}\n", png.string());
+    } else {
+      warn("no compare.png: " + why + " (run under xvfb-run -a)");
+    }
+  }
 }
 
 } // namespace jointid::cli

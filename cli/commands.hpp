@@ -25,11 +25,40 @@ struct SimulateOptions {
   bool table = false;          ///< write one stepped-sine table (fundamentals) instead of records
   std::string engine = "auto"; ///< modes of a large model: auto or slepc (MPI)
   std::filesystem::path output_dir;
+  // Any other force history (one record): --excitation random|sweep|multisine.
+  std::string excitation = "sine";  ///< sine (steady state, the options above), random, sweep,
+                                    ///< multisine, record (the force channels of --force-from)
+  std::string band;                 ///< F0:F1, Hz (random, multisine; sweep: from F0 to F1)
+  double rms = 0.0;                 ///< N or N·m (random, multisine); sweep: --amplitude
+  double duration = 0.0;            ///< s
+  double sample_rate = 0.0;         ///< Hz
+  std::string route = "modal";      ///< modal (retained modes + static correction) or full
+  double modal_cutoff = 0.0;        ///< Hz; 0: the Nyquist frequency
+  int substeps = 4;                 ///< Newmark steps per sample
+  double fade_in = -1.0;            ///< s; < 0: 5 % of the duration
+  std::filesystem::path force_from; ///< --excitation record: the record whose f@ channels drive
 };
 
 /// One record per frequency × amplitude: DIR/sine_f<freq>Hz_F<amp>N.csv; or, with `table`,
-/// DIR/stepped_sine.csv.
+/// DIR/stepped_sine.csv. Other excitations: one record DIR/<excitation>_<F0>-<F1>Hz_....csv, or
+/// DIR/<record stem>_simulated.csv for --excitation record.
 void simulate(const SimulateOptions& options);
+
+struct CompareOptions {
+  std::filesystem::path model;
+  std::filesystem::path record;
+  std::string band;            ///< F0:F1, Hz; empty: the whole spectrum
+  int segment = 0;             ///< Welch segment, samples; 0: automatic
+  double skip = -1.0;          ///< s left out at the start; < 0: 10 % of the record
+  std::string route = "modal"; ///< modal or full
+  double modal_cutoff = 0.0;   ///< Hz; 0: the Nyquist frequency
+  int substeps = 4;
+  bool plot = true;
+  std::filesystem::path output_dir;
+};
+
+/// Measured vs predicted response spectra: DIR/compare.json and DIR/compare.png.
+void compare(const CompareOptions& options);
 
 struct IdentifyOptions {
   std::filesystem::path model;

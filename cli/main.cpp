@@ -67,18 +67,18 @@ int main(int argc, char** argv) {
       "simulate", "Simulate sine tests of the model with its joints at their values; "
                   "one record (CSV) per frequency x amplitude");
   simulate->add_option("MODEL", sim.model, "Model file (TOML)")->required();
+  simulate->add_option(
+      "--force", sim.force,
+      "NODE:DOF of the force, e.g. 7:uy; NODE may be a one-node Gmsh group (not with "
+      "--excitation record)");
   simulate
-      ->add_option("--force", sim.force,
-                   "NODE:DOF of the sine force, e.g. 7:uy; NODE may be a one-node Gmsh group")
-      ->required();
-  simulate->add_option("--freq", sim.frequencies, "Excitation frequencies, Hz (comma-separated)")
-      ->required()
+      ->add_option("--freq", sim.frequencies,
+                   "Excitation frequencies, Hz (comma-separated; sine tests)")
       ->delimiter(',')
       ->allow_extra_args(false);
   simulate
       ->add_option("--amplitude", sim.amplitudes,
-                   "Force amplitudes (peak), N or N m (comma-separated)")
-      ->required()
+                   "Force amplitudes (peak), N or N m (comma-separated; one for a sweep)")
       ->delimiter(',')
       ->allow_extra_args(false);
   simulate
@@ -117,6 +117,66 @@ int main(int argc, char** argv) {
                      "Write one stepped-sine table (the fundamentals) DIR/stepped_sine.csv "
                      "instead of time records");
   simulate->add_option("-o,--output", sim.output_dir, "Output directory (created if missing)")
+      ->required();
+  simulate
+      ->add_option("--excitation", sim.excitation,
+                   "sine: steady-state sine tests (--freq, --amplitude); random: band-limited "
+                   "Gaussian (--band, --rms); sweep: linear sine sweep over --band "
+                   "(--amplitude); multisine: --band, --rms (these three need --duration and "
+                   "--sample-rate); record: the force channels of --force-from. All but sine "
+                   "write one record")
+      ->capture_default_str();
+  simulate->add_option("--band", sim.band, "F0:F1 in Hz (random, sweep, multisine)");
+  simulate->add_option("--rms", sim.rms, "RMS force, N or N m (random, multisine)");
+  simulate->add_option("--duration", sim.duration, "Record length, s (random, sweep, multisine)");
+  simulate->add_option("--sample-rate", sim.sample_rate,
+                       "Samples per second of the record, Hz (random, sweep, multisine)");
+  simulate
+      ->add_option("--route", sim.route,
+                   "modal: retained modes + static correction (fast); full: the whole FE model")
+      ->capture_default_str();
+  simulate
+      ->add_option("--modal-cutoff", sim.modal_cutoff,
+                   "Modal route: modes below this are integrated, Hz (0: the Nyquist frequency)")
+      ->capture_default_str();
+  simulate->add_option("--substeps", sim.substeps, "Newmark steps per sample (random, ...)")
+      ->capture_default_str();
+  simulate->add_option("--force-from", sim.force_from,
+                       "--excitation record: a record (CSV) whose f@NODE:DOF channels drive the "
+                       "model");
+  simulate->add_option(
+      "--fade-in", sim.fade_in,
+      "Force faded in over this time from rest, s (default: 5 % of --duration; none "
+      "for a record's force that starts at zero)");
+
+  cli::CompareOptions cmp;
+  auto* compare = app.add_subcommand(
+      "compare", "Measured vs predicted response spectra: drive the model (joints at their "
+                 "values) with a record's measured force, compare the Welch PSD of every "
+                 "response channel; writes DIR/compare.json and DIR/compare.png");
+  compare->add_option("MODEL", cmp.model, "Model file (TOML)")->required();
+  compare->add_option("RECORD", cmp.record, "Measurement record (CSV) with force and responses")
+      ->required();
+  compare->add_option("--band", cmp.band, "F0:F1 in Hz compared (default: the whole spectrum)");
+  compare
+      ->add_option("--segment", cmp.segment,
+                   "Welch segment, samples (0: largest power of two giving >= 16 averages)")
+      ->capture_default_str();
+  compare->add_option("--skip", cmp.skip,
+                      "Seconds left out at the start of both records (default: 10 % of the "
+                      "record; the simulation starts from rest)");
+  compare
+      ->add_option("--route", cmp.route,
+                   "modal: retained modes + static correction (fast); full: the whole FE model")
+      ->capture_default_str();
+  compare
+      ->add_option("--modal-cutoff", cmp.modal_cutoff,
+                   "Modal route: modes below this are integrated, Hz (0: the Nyquist frequency)")
+      ->capture_default_str();
+  compare->add_option("--substeps", cmp.substeps, "Newmark steps per sample")
+      ->capture_default_str();
+  compare->add_flag("!--no-plot", cmp.plot, "Write no compare.png");
+  compare->add_option("-o,--output", cmp.output_dir, "Output directory (created if missing)")
       ->required();
 
   cli::IdentifyOptions ident;
@@ -289,6 +349,8 @@ int main(int argc, char** argv) {
     if (design->parsed()) cli::design(des);
     if (modes->parsed() && mod.pictures > 0 && !distributed) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
+    if (compare->parsed() && cmp.plot) rerun_with_display(argv);
+    if (compare->parsed()) cli::compare(cmp);
     return 0;
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e); // --help

@@ -38,6 +38,8 @@ public:
   const fem::Model* model() const { return model_ ? &*model_ : nullptr; } ///< nullptr: modal, K/M
   const fem::Assembled* system() const { return system_ ? &*system_ : nullptr; } ///< ditto
   const ModalModel* modal() const { return modal_ ? &*modal_ : nullptr; }        ///< nullptr: FE
+  /// The FE model's (or the given matrices') damping; none for a modal model.
+  const fem::Damping& damping() const { return damping_; }
 
   /// Receptance over `dofs` (equation numbers) for excitation frequencies up to f_max_hz:
   /// an FE model with at most fem::ModalOptions{}.dense_limit equations uses every mode (exact;

@@ -4,6 +4,8 @@ set -euo pipefail
 packages=(build-essential cmake pkg-config libeigen3-dev libspectra-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev libgmock-dev
   libbenchmark-dev libvtk9-dev xvfb xauth
+  # FFTW (pkg-config fftw3): random excitation signals and Welch spectra (fem/fft.hpp).
+  libfftw3-dev
   # OpenBLAS takes over libblas.so.3 (Debian's alternatives) from the reference BLAS, which
   # CHOLMOD's supernodal factorisation otherwise runs on: 8x faster on a 10^5-DOF frame.
   libopenblas0-pthread

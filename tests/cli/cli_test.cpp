@@ -105,7 +105,8 @@ TEST_F(CliTest, EveryCommandHasHelp) {
                                                {"discover", "--help"},
                                                {"modes", "--help"},
                                                {"response", "--help"},
-                                               {"design", "--help"}}) {
+                                               {"design", "--help"},
+                                               {"compare", "--help"}}) {
     const Outcome run = jointid(args, dir());
     EXPECT_EQ(run.status, 0) << args[0];
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << run.out;
@@ -925,6 +926,157 @@ TEST_F(CliTest, DesignChecksItsOptionsBeforeWriting) {
   expect_one_line_error(run({"--freq", "2,3", "--amplitude", "10", "-n", "1", "--periods", "1"}),
                         "--periods");
   EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(CliTest, RandomRecordComparesAtZeroDecibelsAndADifferentJointDoesNot) {
+  // A band-limited random record of the cantilever (modal route, as compare's prediction):
+  // compare finds ≈ 0 dB. The same record against the model without its cubic stiffness: off
+  // by more than the statistical scale.
+  const fs::path records = dir() / "random_records";
+  const Outcome made =
+      jointid({"simulate", model().string(), "--force", "7:uy", "--excitation", "random", "--band",
+               "2:40", "--rms", "40", "--duration", "24", "--sample-rate", "256", "--channels",
+               "x,a", "-o", records.string()},
+              dir());
+  ASSERT_EQ(made.status, 0) << made.err;
+  const fs::path record = records / "random_2-40Hz_40N_seed1.csv";
+  ASSERT_TRUE(fs::exists(record)) << made.out;
+  const identify::Record r = io::read_record(record);
+  EXPECT_EQ(r.t.size(), 24 * 256);
+  EXPECT_EQ(r.channels.size(), 3u); // f, x and a at the tip (the joint's and the force's DOF)
+  const std::string text = test::read_text(record);
+  EXPECT_NE(text.find("band-limited Gaussian random"), std::string::npos);
+
+  // The record's force channel drives the model again (--excitation record): the same response.
+  const Outcome again =
+      jointid({"simulate", model().string(), "--excitation", "record", "--force-from",
+               record.string(), "--channels", "x,a", "-o", (dir() / "again").string()},
+              dir());
+  ASSERT_EQ(again.status, 0) << again.err;
+  const identify::Record r2 =
+      io::read_record(dir() / "again" / "random_2-40Hz_40N_seed1_simulated.csv");
+  ASSERT_EQ(r2.channels.size(), 3u);
+  EXPECT_EQ(r2.channels[1].name(), "x@7:uy");
+  EXPECT_LT((r2.channels[1].samples - r.channels[1].samples).cwiseAbs().maxCoeff(),
+            1e-9 * r.channels[1].samples.cwiseAbs().maxCoeff());
+
+  const fs::path out = dir() / "compare_same";
+  std::vector<std::string> args{"compare", model().string(), record.string(), "--band", "2:40",
+                                "-o",      out.string()};
+  if (!JOINTID_WITH_VTK) args.push_back("--no-plot");
+  const Outcome same = jointid(args, dir());
+  ASSERT_EQ(same.status, 0) << same.err;
+  const json j = json::parse(test::read_text(out / "compare.json"));
+  ASSERT_EQ(j["channels"].size(), 2u);
+  EXPECT_EQ(j["channels"][0]["channel"], "x@7:uy");
+  EXPECT_EQ(j["band_hz"][0], 2.0);
+  const double statistical = j["statistical_db"];
+  for (const auto& c : j["channels"]) {
+    EXPECT_LT(c["max_difference_db"].get<double>(), 1e-6) << c["channel"];
+    EXPECT_EQ(c["frequency_hz"].size(), c["measured"].size());
+    EXPECT_EQ(c["frequency_hz"].size(), c["difference_db"].size());
+  }
+  if (JOINTID_WITH_VTK) {
+    EXPECT_TRUE(fs::exists(out / "compare.png")) << same.err;
+    if (fs::exists(out / "compare.png")) {
+      EXPECT_GT(fs::file_size(out / "compare.png"), 10000u);
+    }
+  }
+
+  std::string stiffer = test::cantilever_toml();
+  const auto at = stiffer.find("k3 = 1.6e8");
+  ASSERT_NE(at, std::string::npos);
+  stiffer.replace(at, 10, "k3 = 0.0");
+  const fs::path stiffer_model = dir() / "stiffer.toml";
+  test::write_text(stiffer_model, stiffer);
+  const fs::path off_dir = dir() / "compare_off";
+  const Outcome off = jointid({"compare", stiffer_model.string(), record.string(), "--band", "2:40",
+                               "--no-plot", "-o", off_dir.string()},
+                              dir());
+  ASSERT_EQ(off.status, 0) << off.err;
+  const json k = json::parse(test::read_text(off_dir / "compare.json"));
+  for (const auto& c : k["channels"]) {
+    EXPECT_GT(c["rms_difference_db"].get<double>(), statistical) << c["channel"];
+    EXPECT_GT(c["max_difference_db"].get<double>(), 3.0 * statistical) << c["channel"];
+  }
+}
+
+TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
+  const fs::path out = dir() / "random_bad";
+  auto simulate = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"simulate", model().string(), "--force", "7:uy",
+                                  "-o",       out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  const std::vector<std::string> ok{"--duration", "2", "--sample-rate", "256"};
+  auto with = [&](std::vector<std::string> extra) {
+    extra.insert(extra.end(), ok.begin(), ok.end());
+    return extra;
+  };
+  expect_one_line_error(simulate(with({"--excitation", "noise", "--band", "2:40", "--rms", "1"})),
+                        "--excitation: expected sine, random, sweep, multisine or record");
+  expect_one_line_error(simulate(with({"--excitation", "random", "--rms", "1"})), "--band");
+  expect_one_line_error(simulate(with({"--excitation", "random", "--band", "40:2", "--rms", "1"})),
+                        "--band: expected 0 <= F0 < F1");
+  expect_one_line_error(simulate(with({"--excitation", "random", "--band", "2:200", "--rms", "1"})),
+                        "below half the sample rate");
+  expect_one_line_error(simulate(with({"--excitation", "random", "--band", "2:40"})), "--rms");
+  expect_one_line_error(simulate(with({"--excitation", "sweep", "--band", "2:40", "--rms", "1"})),
+                        "--amplitude");
+  expect_one_line_error(
+      simulate(with({"--excitation", "random", "--band", "2:40", "--rms", "1", "--freq", "3"})),
+      "--freq: only for sine tests");
+  expect_one_line_error(
+      simulate(with({"--excitation", "random", "--band", "2:40", "--rms", "1", "--route", "x"})),
+      "--route");
+  expect_one_line_error(
+      simulate({"--excitation", "random", "--band", "2:40", "--rms", "1", "--sample-rate", "256"}),
+      "--duration");
+  expect_one_line_error(simulate({"--freq", "3", "--amplitude", "10", "--band", "2:40"}),
+                        "only with --excitation");
+  expect_one_line_error(simulate({"--excitation", "record"}), "--force-from");
+  expect_one_line_error(
+      simulate({"--excitation", "record", "--force-from", record_files()[0], "--rms", "3"}),
+      "not with --excitation record");
+  expect_one_line_error(
+      jointid({"simulate", model().string(), "--excitation", "record", "--force-from",
+               (dir() / "missing.csv").string(), "-o", out.string()},
+              dir()),
+      "missing.csv");
+  EXPECT_FALSE(fs::exists(out));
+
+  // compare: a record without a force channel, a bad band, a bad segment.
+  const fs::path no_force = dir() / "no_force.csv";
+  test::write_text(no_force, "t,x@7:uy\n0,0\n0.01,1\n0.02,0\n0.03,1\n0.04,0\n");
+  const fs::path cmp = dir() / "compare_bad";
+  expect_one_line_error(
+      jointid({"compare", model().string(), no_force.string(), "--no-plot", "-o", cmp.string()},
+              dir()),
+      "no force channel");
+  expect_one_line_error(jointid({"compare", model().string(), record_files()[0], "--band", "2-40",
+                                 "--no-plot", "-o", cmp.string()},
+                                dir()),
+                        "--band: expected F0:F1");
+  expect_one_line_error(jointid({"compare", model().string(), record_files()[0], "--segment", "4",
+                                 "--no-plot", "-o", cmp.string()},
+                                dir()),
+                        "--segment");
+  expect_one_line_error(jointid({"compare", model().string(), record_files()[0], "--band", "2:5000",
+                                 "--no-plot", "-o", cmp.string()},
+                                dir()),
+                        "Nyquist");
+  std::string text = test::read_text(record_files()[0]);
+  const auto at = text.find("x@7:uy");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 6, "x@9:uy");
+  const fs::path bad_node = dir() / "bad_node.csv";
+  test::write_text(bad_node, text);
+  expect_one_line_error(
+      jointid({"compare", model().string(), bad_node.string(), "--no-plot", "-o", cmp.string()},
+              dir()),
+      "bad_node.csv: channel x@9:uy: node 9 does not exist");
+  EXPECT_FALSE(fs::exists(cmp));
 }
 
 } // namespace

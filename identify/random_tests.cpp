@@ -1,0 +1,193 @@
+#include "identify/random_tests.hpp"
+
+#include "fem/modal.hpp"
+#include "fem/transient.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace jointid::identify {
+
+namespace {
+
+void add_unique(std::vector<int>& list, int value) {
+  if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
+}
+
+std::string describe(const joints::Joint& j) {
+  std::string text =
+      fmt::format("joint '{}': {}:{} {}", j.name, j.node, fem::dof_name(j.dof),
+                  j.to_ground() ? std::string("to ground") : fmt::format("to node {}", j.node_b));
+  for (std::size_t t = 0; t < j.terms.size(); ++t)
+    text +=
+        fmt::format("{} {} = {}", t == 0 ? ";" : ",", joints::term_name(j.terms[t]), j.values[t]);
+  return text;
+}
+
+} // namespace
+
+ForceInput force_input(const Record& record) {
+  ForceInput in;
+  const auto forces = record.all(Quantity::force);
+  if (forces.empty())
+    throw std::invalid_argument(
+        fmt::format("{}: no force channel (expected a column f@NODE:DOF)", record.source));
+  const double dt = record.dt();
+  if (!(dt > 0.0))
+    throw std::invalid_argument(fmt::format("{}: expected at least 2 samples", record.source));
+  in.sample_rate_hz = 1.0 / dt;
+  in.samples.resize(record.t.size(), static_cast<Eigen::Index>(forces.size()));
+  for (std::size_t j = 0; j < forces.size(); ++j) {
+    in.at.push_back(forces[j]->at);
+    in.samples.col(static_cast<Eigen::Index>(j)) = forces[j]->samples;
+  }
+  in.description = fmt::format(
+      "force: the channels {} of {}",
+      [&] {
+        std::string names;
+        for (const Channel* c : forces)
+          names += (names.empty() ? "" : ", ") + c->name();
+        return names;
+      }(),
+      record.source);
+  return in;
+}
+
+ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joints::Joint>& joints,
+                           const ForceInput& in, const ForcedOptions& o) {
+  // 1. Checks.
+  if (!sub.system())
+    throw std::invalid_argument("time simulation needs a finite element model; this substructure "
+                                "is given by its modes");
+  if (!(std::isfinite(in.sample_rate_hz) && in.sample_rate_hz > 0.0))
+    throw std::invalid_argument(
+        fmt::format("force history: expected a sample rate > 0 Hz, got {}", in.sample_rate_hz));
+  if (in.at.empty() || static_cast<Eigen::Index>(in.at.size()) != in.samples.cols())
+    throw std::invalid_argument("force history: expected one column of samples per force DOF");
+  if (in.samples.rows() < 2)
+    throw std::invalid_argument("force history: expected at least 2 samples");
+  if (o.substeps < 1)
+    throw std::invalid_argument(fmt::format("substeps: expected at least 1, got {}", o.substeps));
+  if (!(o.modal_cutoff_hz >= 0.0))
+    throw std::invalid_argument(
+        fmt::format("modal cutoff: expected >= 0 Hz, got {}", o.modal_cutoff_hz));
+  if (o.quantities.empty()) throw std::invalid_argument("no response quantity asked (x, v or a)");
+  for (Quantity q : o.quantities)
+    if (q == Quantity::force)
+      throw std::invalid_argument("force is always written; responses are x, v or a");
+  const fem::DofMap& dofs = sub.dofs();
+  joints::validate_joints(joints, dofs);
+
+  // 2. Where the forces act and what is recorded.
+  fem::ForceHistory history;
+  history.dt = 1.0 / in.sample_rate_hz;
+  history.samples = in.samples;
+  for (const auto& at : in.at)
+    history.equations.push_back(dofs.equation(at));
+  std::vector<int> outputs = joints::joint_dof_set(joints, dofs);
+  for (int e : history.equations)
+    add_unique(outputs, e);
+  for (const auto& at : o.extra_outputs)
+    add_unique(outputs, dofs.equation(at));
+  const joints::JointForces forces(joints, dofs);
+  const fem::LocalForces* local = joints.empty() ? nullptr : &forces;
+  fem::TransientOptions options;
+  options.substeps = o.substeps;
+  options.fade_in_s = o.fade_in_s;
+  options.progress = o.progress;
+
+  // 3. Simulate.
+  ForcedTest test;
+  fem::TransientResponse r;
+  const fem::Assembled& system = *sub.system();
+  std::string method;
+  if (o.route == TransientRoute::full) {
+    r = fem::transient_response(system, sub.damping_matrix(), local, history, outputs, options);
+    method = fmt::format("method: time, full model (Newmark, average acceleration, {} equations, "
+                         "{} steps per sample)",
+                         dofs.num_equations(), o.substeps);
+  } else {
+    const double cutoff = o.modal_cutoff_hz > 0.0 ? o.modal_cutoff_hz : 0.5 * in.sample_rate_hz;
+    // Small models: every mode (dense); others: only the band below the cutoff (shift-invert
+    // Lanczos on a sparse factorisation) — a dense eigensolution of 1000 equations alone takes
+    // longer than the whole simulation.
+    constexpr int every_mode_limit = 200;
+    fem::ModalOptions mo;
+    mo.num_modes = 0;
+    if (dofs.num_equations() <= every_mode_limit) {
+      mo.engine = fem::ModalEngine::dense;
+    } else {
+      mo.engine = fem::ModalEngine::sparse;
+      mo.max_frequency_hz = cutoff;
+    }
+    fem::Modes modes = fem::modal_analysis(system, mo);
+    if (modes.status != fem::ModalStatus::success)
+      throw std::runtime_error("modal analysis failed (not converging, or a mass matrix that is "
+                               "not positive definite)");
+    int kept = 0;
+    while (kept < modes.num_modes() && modes.frequency_hz(kept) < cutoff)
+      ++kept;
+    const bool all = kept == dofs.num_equations();
+    modes.omega.conservativeResize(kept);
+    modes.phi.conservativeResize(Eigen::NoChange, kept);
+    std::vector<int> loaded = history.equations;
+    for (int e : joints::joint_dof_set(joints, dofs))
+      add_unique(loaded, e);
+    if (!o.static_correction || all) loaded.clear();
+    const fem::ModalReduction reduction =
+        fem::modal_reduction(system, modes, sub.damping(), loaded);
+    test.modes_kept = reduction.kept_modes;
+    test.static_columns = reduction.static_columns;
+    r = fem::transient_response(reduction, local, history, outputs, options);
+    method =
+        fmt::format("method: time, modal coordinates (Newmark, average acceleration, {} modes "
+                    "below {} Hz of {} equations{}, {} steps per sample)",
+                    kept, cutoff, dofs.num_equations(),
+                    reduction.static_columns > 0
+                        ? fmt::format(", static correction at {} DOFs", reduction.static_columns)
+                        : std::string(all ? ", every mode" : ", no static correction"),
+                    o.substeps);
+  }
+  if (r.status != fem::TransientStatus::success)
+    throw std::runtime_error(
+        fmt::format("time simulation: the joints' Newton iteration failed after t = {:.6g} s",
+                    (r.samples_done - 1) * history.dt));
+
+  // 4. The record.
+  Record& rec = test.record;
+  rec.t = r.t;
+  for (std::size_t j = 0; j < in.at.size(); ++j) {
+    Eigen::VectorXd applied = in.samples.col(static_cast<Eigen::Index>(j));
+    for (Eigen::Index i = 0; i < applied.size(); ++i) {
+      const double t = r.t(i);
+      if (t < o.fade_in_s) // + 0.0: no "-0" in the record
+        applied(i) = applied(i) * 0.5 * (1.0 - std::cos(std::numbers::pi * t / o.fade_in_s)) + 0.0;
+    }
+    rec.channels.push_back({Quantity::force, in.at[j], applied});
+  }
+  for (std::size_t j = 0; j < outputs.size(); ++j) {
+    const auto c = static_cast<Eigen::Index>(j);
+    const fem::NodeDof at = dofs.node_dof(outputs[j]);
+    for (Quantity q : o.quantities) {
+      if (q == Quantity::displacement) rec.channels.push_back({q, at, r.u.col(c)});
+      if (q == Quantity::velocity) rec.channels.push_back({q, at, r.v.col(c)});
+      if (q == Quantity::acceleration) rec.channels.push_back({q, at, r.a.col(c)});
+    }
+  }
+  if (!in.description.empty()) test.comments.push_back(in.description);
+  if (o.fade_in_s > 0.0)
+    test.comments.push_back(
+        fmt::format("force faded in over the first {} s (half-cosine); from rest", o.fade_in_s));
+  else
+    test.comments.push_back("from rest");
+  for (const auto& j : joints)
+    test.comments.push_back(describe(j));
+  test.comments.push_back(method);
+  return test;
+}
+
+} // namespace jointid::identify

@@ -1,0 +1,71 @@
+#pragma once
+/// Virtual tests under any force history (band-limited random, sine sweep, multisine, or a force
+/// channel of a measured record): the finite element model with its joints at their values,
+/// simulated in time (fem/transient.hpp) — in full (the reference) or in modal coordinates with
+/// a static correction (fast) — and written as a measurement record (DESIGN.md's CSV contract).
+/// SI units; the record's sample rate is the force history's.
+#include "frf/substructure.hpp"
+#include "identify/record.hpp"
+#include "joints/joint.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace jointid::identify {
+
+enum class TransientRoute {
+  full, ///< Newmark on the whole finite element model
+  modal ///< Newmark on the retained modes, the rest as static flexibility at the loaded DOFs
+};
+
+struct ForcedOptions {
+  TransientRoute route = TransientRoute::modal;
+  /// Modal route: modes below this frequency are integrated (Hz); 0: below the record's
+  /// Nyquist frequency. The rest enter through their static flexibility at the forced and the
+  /// joints' DOFs (see fem::modal_reduction) unless static_correction is false. Models of up to
+  /// 200 equations get every mode from the dense eigensolver; larger ones only the band below
+  /// the cutoff (sparse engine). Modes above the cutoff that a non-linear joint's harmonics
+  /// excite are missing from the response (velocity and acceleration most): raise the cutoff
+  /// when those matter.
+  double modal_cutoff_hz = 0.0;
+  bool static_correction = true;
+  int substeps = 4;       ///< Newmark steps per sample interval
+  double fade_in_s = 0.0; ///< the force is faded in over this time (half-cosine), s
+  /// Response channels written at every output DOF: displacement, velocity, acceleration.
+  std::vector<Quantity> quantities{Quantity::displacement, Quantity::velocity};
+  /// Outputs beyond the joints' DOFs and the force DOFs.
+  std::vector<fem::NodeDof> extra_outputs;
+  /// Called with the fraction of the time simulation done (0 … 1); empty: not called.
+  std::function<void(double)> progress;
+};
+
+/// Forces at one or more DOFs, sampled at sample_rate_hz from t = 0.
+struct ForceInput {
+  std::vector<fem::NodeDof> at;
+  Eigen::MatrixXd samples; ///< n_samples × |at|, N or N·m
+  double sample_rate_hz = 0.0;
+  std::string description; ///< how it was made, for the record's comments
+};
+
+struct ForcedTest {
+  Record record; ///< the force channels as applied (faded in), then x/v/a at every output
+  std::vector<std::string> comments; ///< how it was made, for the CSV's comment lines
+  std::vector<std::string> warnings;
+  int modes_kept = 0;     ///< modal route: modes integrated
+  int static_columns = 0; ///< modal route: static-correction coordinates
+};
+
+/// Simulates the structure from rest under the forces. Outputs: every joint DOF, then the force
+/// DOFs, then extra_outputs (each once). Throws std::invalid_argument for bad options or a
+/// modal substructure (time integration needs a finite element model), std::runtime_error when
+/// the joints' iteration fails at a step (naming the time) or the modal analysis fails.
+ForcedTest simulate_forced(const frf::Substructure& substructure,
+                           const std::vector<joints::Joint>& joints, const ForceInput& input,
+                           const ForcedOptions& options = {});
+
+/// The force channels of a record as a ForceInput (every `f@` channel; std::invalid_argument
+/// naming the record when it has none or its sampling is not uniform).
+ForceInput force_input(const Record& record);
+
+} // namespace jointid::identify

@@ -1,0 +1,71 @@
+// compare_json(): part of jointid_io.
+#include "io/spectra_comparison.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
+namespace jointid::io {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json numbers(const Eigen::VectorXd& v) {
+  Json a = Json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    a.push_back(std::isfinite(v(i)) ? Json(v(i)) : Json(nullptr));
+  return a;
+}
+
+Json number(double value) {
+  return std::isfinite(value) ? Json(value) : Json(nullptr);
+}
+
+const char* psd_unit(identify::Quantity q) {
+  switch (q) {
+  case identify::Quantity::displacement:
+    return "m^2/Hz (rad^2/Hz for rotations)";
+  case identify::Quantity::velocity:
+    return "(m/s)^2/Hz";
+  case identify::Quantity::acceleration:
+    return "(m/s^2)^2/Hz";
+  case identify::Quantity::force:
+    return "N^2/Hz";
+  }
+  return "";
+}
+
+} // namespace
+
+std::string compare_json(const identify::Comparison& c) {
+  Json j;
+  j["record"] = c.source;
+  j["band_hz"] = Json::array({number(c.f0_hz), number(c.f1_hz)});
+  j["sample_rate_hz"] = number(c.sample_rate_hz);
+  j["segment"] = c.segment;
+  j["averages"] = c.averages;
+  j["resolution_hz"] = number(c.resolution_hz);
+  j["skip_s"] = number(c.skip_s);
+  j["statistical_db"] = number(c.statistical_db);
+  j["psd_convention"] = "one-sided PSD per Hz (Welch: Hann window, 50 % overlap, segment mean "
+                        "removed); difference_db = 10 log10(predicted / measured)";
+  j["notes"] = c.notes;
+  Json channels = Json::array();
+  for (const auto& ch : c.channels) {
+    Json o;
+    o["channel"] = ch.channel;
+    o["unit"] = psd_unit(identify::parse_channel_name(ch.channel).quantity);
+    o["rms_difference_db"] = number(ch.rms_db);
+    o["max_difference_db"] = number(ch.max_db);
+    o["frequency_hz"] = numbers(ch.frequency_hz);
+    o["measured"] = numbers(ch.measured);
+    o["predicted"] = numbers(ch.predicted);
+    o["difference_db"] = numbers(ch.difference_db);
+    channels.push_back(std::move(o));
+  }
+  j["channels"] = std::move(channels);
+  return j.dump(1) + "\n";
+}
+
+} // namespace jointid::io

@@ -1,0 +1,22 @@
+#pragma once
+/// `jointid compare`'s outputs: the JSON of identify::Comparison and its figure (measured vs
+/// predicted response PSD, log y, one chart per channel).
+#include "identify/compare.hpp"
+#include "io/chart.hpp"
+
+#include <string>
+
+namespace jointid::io {
+
+/// {"record": "...", "band_hz": [F0, F1], "sample_rate_hz": fs, "segment": N, "averages": n,
+///  "resolution_hz": df, "skip_s": s, "statistical_db": e, "psd_convention": "...",
+///  "notes": [...], "channels": [{"channel": "x@7:uy", "unit": "m^2/Hz",
+///  "rms_difference_db": r, "max_difference_db": m, "frequency_hz": [...], "measured": [...],
+///  "predicted": [...], "difference_db": [...]}]}. Non-finite numbers are written as null.
+std::string compare_json(const identify::Comparison& comparison);
+
+/// One chart per channel: measured and predicted PSD over the band (log y), titled with the
+/// channel and its RMS difference in dB. Part of jointid_io_output (the chart writer's library).
+Figure compare_figure(const identify::Comparison& comparison);
+
+} // namespace jointid::io

@@ -1,0 +1,141 @@
+// Measured vs predicted spectra: a record made by the same model compares at ≈ 0 dB (and
+// within the Welch statistical scale once noise is added), one made with a different joint
+// does not.
+#include "identify/compare.hpp"
+
+#include "fem/excitation.hpp"
+#include "identify/sine_tests.hpp"
+#include "support/cantilever.hpp"
+
+#include <gtest/gtest.h>
+
+#include <utility>
+
+using namespace jointid;
+using namespace jointid::identify;
+
+namespace {
+const fem::NodeDof tip{7, fem::Dof::uy};
+
+joints::Joint joint(double k, double k3 = 1.6e8) {
+  joints::Joint j{
+      "tip",         7,  0, fem::Dof::uy, {joints::Term::k, joints::Term::c, joints::Term::k3},
+      {k, 20.0, k3}, {}, {}};
+  j.fixed.assign(3, true);
+  return j;
+}
+
+const frf::Substructure& cantilever() {
+  static const frf::Substructure s(test::paper_cantilever());
+  return s;
+}
+
+// A "measured" record: the model with this joint, band-limited random force at the tip
+// (2–40 Hz, 40 N RMS), 40 s at 256 Hz, written as x and a at the tip.
+Record measured(double k, TransientRoute route, double k3 = 1.6e8) {
+  ForceInput in;
+  in.at = {tip};
+  in.sample_rate_hz = 256.0;
+  in.samples = fem::band_limited_random({2.0, 40.0, 40.0, 21}, {40.0, 256.0});
+  ForcedOptions o;
+  o.route = route;
+  o.fade_in_s = 1.0;
+  o.quantities = {Quantity::displacement, Quantity::acceleration};
+  Record r = simulate_forced(cantilever(), {joint(k, k3)}, in, o).record;
+  r.source = "measured.csv";
+  return r;
+}
+
+CompareOptions band_2_40() {
+  CompareOptions o;
+  o.f0_hz = 2.0;
+  o.f1_hz = 40.0;
+  return o;
+}
+} // namespace
+
+TEST(Compare, SameModelGivesZeroDecibels) {
+  // The same force (the record's starts at zero, so it is not faded in again), the same joint
+  // and the same route: the prediction is the record, 0 dB to rounding. With 1 % white noise
+  // on the measured responses the difference stays within the statistical scale of two Welch
+  // estimates, 10 log10(e) sqrt(2/n) = 1.49 dB for n = 17 averages (segment 1024, 36 s after
+  // the 4 s skipped): the noise adds a little power where the response is weak.
+  Record r = measured(4800.0, TransientRoute::modal);
+  const Comparison c = compare_spectra(cantilever(), {joint(4800.0)}, r, band_2_40());
+  ASSERT_EQ(c.channels.size(), 2u);
+  EXPECT_EQ(c.channels[0].channel, "x@7:uy");
+  EXPECT_EQ(c.channels[1].channel, "a@7:uy");
+  EXPECT_EQ(c.segment, 1024);
+  EXPECT_EQ(c.averages, 17);
+  EXPECT_NEAR(c.statistical_db, 1.4894, 1e-3);
+  EXPECT_NEAR(c.skip_s, 4.0, 1e-9);
+  for (const auto& ch : c.channels) {
+    EXPECT_LT(ch.max_db, 1e-6) << ch.channel;
+    EXPECT_GE(ch.frequency_hz(0), 2.0);
+    EXPECT_LE(ch.frequency_hz(ch.frequency_hz.size() - 1), 40.0);
+    EXPECT_EQ(ch.frequency_hz.size(), 153); // 2–40 Hz every 0.25 Hz
+  }
+  add_noise(r, 0.01, 3, false);
+  const Comparison noisy = compare_spectra(cantilever(), {joint(4800.0)}, r, band_2_40());
+  for (const auto& ch : noisy.channels) {
+    std::printf("same model, 1 %% noise, %s: difference %.3g dB RMS, %.3g dB max (statistical "
+                "scale %.3g dB)\n",
+                ch.channel.c_str(), ch.rms_db, ch.max_db, noisy.statistical_db);
+    EXPECT_LT(ch.rms_db, noisy.statistical_db) << ch.channel;
+    EXPECT_GT(ch.rms_db, 1e-4) << ch.channel; // the noise is seen
+  }
+}
+
+TEST(Compare, FullModelRecordAgreesWithTheModalPrediction) {
+  // The record made by the full model (all 12 modes), predicted in modal coordinates (the 4
+  // modes below the 128 Hz Nyquist frequency and the static correction): the displacement
+  // spectra agree to 0.15 dB RMS (measured 0.076). The acceleration agrees less well (measured
+  // 1.3 dB RMS): the full model's modes above the Nyquist frequency, excited by the joint's
+  // harmonics, alias into the band in a record sampled without an anti-aliasing filter, and
+  // the modal route leaves them out.
+  const Comparison c = compare_spectra(cantilever(), {joint(4800.0)},
+                                       measured(4800.0, TransientRoute::full), band_2_40());
+  std::printf("full-model record vs modal prediction: x %.3g dB RMS (%.3g max), a %.3g dB RMS\n",
+              c.channels[0].rms_db, c.channels[0].max_db, c.channels[1].rms_db);
+  EXPECT_LT(c.channels[0].rms_db, 0.15);
+  EXPECT_LT(c.channels[0].max_db, 0.6);
+}
+
+TEST(Compare, DifferentJointIsClearlyOff) {
+  // Records made with another joint, predicted with model I's k = 4800 N/m, k3 = 1.6e8 N/m³:
+  // (1) without the cubic stiffness (k3 = 0): the hardening that, at 40 N RMS, stiffens the tip
+  // is missing, the resonances move; (2) with k doubled. Either way the difference is far from
+  // the 0 dB of the same model (to rounding): at least the statistical scale in RMS and three
+  // times it at the worst line (measured for x: 4.0 and 1.6 dB RMS, 15 and 6.8 dB max).
+  for (const auto& [k, k3] : {std::pair{4800.0, 0.0}, std::pair{9600.0, 1.6e8}}) {
+    const Comparison c = compare_spectra(cantilever(), {joint(4800.0)},
+                                         measured(k, TransientRoute::modal, k3), band_2_40());
+    for (const auto& ch : c.channels) {
+      std::printf("record with k = %g, k3 = %g, %s: difference %.3g dB RMS, %.3g dB max\n", k, k3,
+                  ch.channel.c_str(), ch.rms_db, ch.max_db);
+      EXPECT_GT(ch.rms_db, c.statistical_db) << ch.channel;
+      EXPECT_GT(ch.max_db, 3.0 * c.statistical_db) << ch.channel;
+    }
+  }
+}
+
+TEST(Compare, BadBandOrSegmentIsRefused) {
+  const Record r = measured(4800.0, TransientRoute::modal);
+  CompareOptions o;
+  o.f0_hz = 10.0;
+  o.f1_hz = 500.0; // above Nyquist (128 Hz)
+  try {
+    compare_spectra(cantilever(), {joint(4800.0)}, r, o);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("measured.csv: band 10:500 Hz"), std::string::npos)
+        << e.what();
+  }
+  o = {};
+  o.segment = 1 << 20;
+  EXPECT_THROW(compare_spectra(cantilever(), {joint(4800.0)}, r, o), std::invalid_argument);
+  Record no_response = r;
+  no_response.channels.resize(1);
+  EXPECT_THROW(compare_spectra(cantilever(), {joint(4800.0)}, no_response, {}),
+               std::invalid_argument);
+}

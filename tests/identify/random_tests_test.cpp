@@ -1,0 +1,163 @@
+// Virtual tests under arbitrary forces: the record's layout, the modal and full routes on the
+// same joint model, a measured record's force channels as input, and errors.
+#include "identify/random_tests.hpp"
+
+#include "fem/excitation.hpp"
+#include "support/cantilever.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <utility>
+#include <vector>
+
+using namespace jointid;
+using namespace jointid::identify;
+
+namespace {
+const fem::NodeDof tip{7, fem::Dof::uy}, mid{4, fem::Dof::uy};
+
+joints::Joint model_one() {
+  joints::Joint j{"tip",
+                  7,
+                  0,
+                  fem::Dof::uy,
+                  {joints::Term::k, joints::Term::c, joints::Term::c2, joints::Term::k3},
+                  {4800.0, 20.0, 500.0, 1.6e8},
+                  {},
+                  {}};
+  j.fixed.assign(4, true);
+  return j;
+}
+
+const frf::Substructure& cantilever() {
+  static const frf::Substructure s(test::paper_cantilever());
+  return s;
+}
+
+ForceInput random_input() {
+  ForceInput in;
+  in.at = {mid};
+  in.sample_rate_hz = 256.0;
+  in.samples = fem::band_limited_random({2.0, 40.0, 30.0, 9}, {8.0, 256.0});
+  in.description = "band-limited random";
+  return in;
+}
+} // namespace
+
+TEST(RandomTests, RecordLayoutAndRoutesAgree) {
+  ForcedOptions o;
+  o.fade_in_s = 0.5;
+  o.quantities = {Quantity::displacement, Quantity::velocity, Quantity::acceleration};
+  o.route = TransientRoute::full;
+  const ForcedTest full = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  o.route = TransientRoute::modal; // modes below 128 Hz (4 of 12) and a static correction
+  const ForcedTest modal = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  EXPECT_EQ(modal.modes_kept, 4);
+  EXPECT_EQ(modal.static_columns, 2); // the force DOF and the joint DOF
+  // force, then x v a at the joint DOF (7:uy) and at the force DOF (4:uy)
+  ASSERT_EQ(full.record.channels.size(), 7u);
+  EXPECT_EQ(full.record.channels[0].name(), "f@4:uy");
+  EXPECT_EQ(full.record.channels[1].name(), "x@7:uy");
+  EXPECT_EQ(full.record.channels[6].name(), "a@4:uy");
+  EXPECT_EQ(full.record.t.size(), 2048);
+  EXPECT_DOUBLE_EQ(full.record.dt(), 1.0 / 256.0);
+  EXPECT_EQ(full.record.channels[0].samples(0), 0.0); // faded in
+  EXPECT_DOUBLE_EQ(full.record.channels[0].samples(1000), random_input().samples(1000, 0));
+  // Displacements to 1e-3 of their peak (the truncation; 4 modes for a 2–40 Hz force), the
+  // velocity at the joint to 2e-2. The acceleration weighs the left-out modes by ω²: the
+  // joint's harmonics excite the modes above the cutoff (128 Hz), which the full model has and
+  // the modal route leaves out — 15 % of the peak (measured); below 1 % (measured 0.1 %) once
+  // the cutoff takes every mode below 1 kHz.
+  const std::vector<std::pair<std::size_t, double>> checks{
+      {1, 1e-3}, {4, 1e-3}, {2, 2e-2}, {3, 0.3}};
+  for (const auto& [c, tolerance] : checks) {
+    const Eigen::VectorXd& a = full.record.channels[c].samples;
+    const Eigen::VectorXd& b = modal.record.channels[c].samples;
+    const double error = (a - b).cwiseAbs().maxCoeff() / a.cwiseAbs().maxCoeff();
+    std::printf("full vs modal, %s: %.3g of the peak\n", full.record.channels[c].name().c_str(),
+                error);
+    EXPECT_LT(error, tolerance) << full.record.channels[c].name();
+  }
+  o.modal_cutoff_hz = 1000.0;
+  const ForcedTest more = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const Eigen::VectorXd& a = full.record.channels[3].samples;
+  const double error =
+      (a - more.record.channels[3].samples).cwiseAbs().maxCoeff() / a.cwiseAbs().maxCoeff();
+  std::printf("full vs modal below 1 kHz (%d modes), a@7:uy: %.3g of the peak\n", more.modes_kept,
+              error);
+  EXPECT_LT(error, 1e-2);
+}
+
+TEST(RandomTests, ForceChannelsOfARecordDriveTheModel) {
+  ForcedOptions o;
+  o.route = TransientRoute::full;
+  o.fade_in_s = 0.5;
+  const ForcedTest made = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  Record measured = made.record;
+  measured.source = "made.csv";
+  const ForceInput in = force_input(measured);
+  ASSERT_EQ(in.at.size(), 1u);
+  EXPECT_EQ(in.at[0], mid);
+  EXPECT_NEAR(in.sample_rate_hz, 256.0, 1e-9);
+  o.fade_in_s = 0.0; // the record's force is already faded in
+  const ForcedTest again = simulate_forced(cantilever(), {model_one()}, in, o);
+  const Eigen::VectorXd& a = made.record.channels[1].samples;
+  EXPECT_LT((again.record.channels[1].samples - a).cwiseAbs().maxCoeff(),
+            1e-9 * a.cwiseAbs().maxCoeff());
+}
+
+TEST(RandomTests, TwoForcesSuperposeOnTheLinearStructure) {
+  // Without joints the structure is linear: the response to forces at 4:uy and 7:uy together is
+  // the sum of the responses to each alone — to rounding on the full model; on the modal route
+  // to its truncation error (1e-3 of the peak; measured 4e-5), since the static correction is
+  // made at the loaded DOFs, which differ between the three runs.
+  ForceInput both = random_input();
+  both.at = {mid, tip};
+  both.samples.conservativeResize(Eigen::NoChange, 2);
+  both.samples.col(1) = fem::band_limited_random({5.0, 30.0, 10.0, 77}, {8.0, 256.0});
+  ForceInput first = both, second = both;
+  first.at = {mid};
+  first.samples = both.samples.leftCols(1);
+  second.at = {tip};
+  second.samples = both.samples.rightCols(1);
+  for (TransientRoute route : {TransientRoute::full, TransientRoute::modal}) {
+    ForcedOptions o;
+    o.route = route;
+    o.fade_in_s = 0.5;
+    o.quantities = {Quantity::displacement};
+    const ForcedTest together = simulate_forced(cantilever(), {}, both, o);
+    o.extra_outputs = {tip};
+    const ForcedTest a = simulate_forced(cantilever(), {}, first, o);
+    o.extra_outputs = {mid};
+    const ForcedTest b = simulate_forced(cantilever(), {}, second, o);
+    ASSERT_EQ(together.record.all(Quantity::force).size(), 2u);
+    for (const fem::NodeDof& at : {tip, mid}) {
+      const Eigen::VectorXd& x = together.record.find(Quantity::displacement, at)->samples;
+      const Eigen::VectorXd sum = a.record.find(Quantity::displacement, at)->samples +
+                                  b.record.find(Quantity::displacement, at)->samples;
+      const double tolerance = route == TransientRoute::full ? 1e-10 : 1e-3;
+      EXPECT_LT((x - sum).cwiseAbs().maxCoeff(), tolerance * x.cwiseAbs().maxCoeff())
+          << fem::to_string(at);
+    }
+  }
+}
+
+TEST(RandomTests, ErrorsNameWhatIsWrong) {
+  Record none;
+  none.source = "empty.csv";
+  none.t = Eigen::VectorXd::LinSpaced(10, 0.0, 0.9);
+  none.channels.push_back({Quantity::displacement, tip, Eigen::VectorXd::Zero(10)});
+  try {
+    force_input(none);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("empty.csv: no force channel"), std::string::npos);
+  }
+  ForceInput in = random_input();
+  ForcedOptions o;
+  o.substeps = 0;
+  EXPECT_THROW(simulate_forced(cantilever(), {}, in, o), std::invalid_argument);
+  in.sample_rate_hz = -1.0;
+  EXPECT_THROW(simulate_forced(cantilever(), {}, in, {}), std::invalid_argument);
+}
