@@ -465,7 +465,7 @@ void identify(const IdentifyOptions& o) {
   const identify::FitResult result = identify::fit(sub, file.joints, measured, options);
   if (result.status != identify::FitStatus::ok) throw io::Error("identify: " + result.reason);
   if (!output_rank()) return;
-  io::write_json(o.output, io::identify_result_json(result));
+  io::write_json(o.output, io::identify_result_json(result, {}, &measured));
 
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
              "95 % interval");

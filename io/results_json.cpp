@@ -165,7 +165,8 @@ std::string discovery_json(const discover::Result& r) {
 }
 
 std::string identify_result_json(const identify::FitResult& result,
-                                 const std::vector<std::string>& extra) {
+                                 const std::vector<std::string>& extra,
+                                 const std::vector<identify::Measurement>* measured) {
   Json joints = Json::array();
   for (const auto& joint : result.joints) {
     Json terms = Json::array();
@@ -192,6 +193,8 @@ std::string identify_result_json(const identify::FitResult& result,
     warnings.push_back(w);
 
   Json out;
+  out["status"] = result.status == identify::FitStatus::ok ? "ok" : "not_separable";
+  out["reason"] = result.reason;
   out["joints"] = std::move(joints);
   out["equations"] = result.equations;
   out["unknowns"] = result.unknowns;
@@ -205,6 +208,29 @@ std::string identify_result_json(const identify::FitResult& result,
     sv.push_back(number(v));
   out["singular_values"] = std::move(sv);
   out["identifiability"] = result.identifiability;
+  if (measured) {
+    Json noise = Json::array();
+    for (const auto& m : *measured) {
+      Json channels = Json::object();
+      for (std::size_t r = 0; r < m.response_at.size(); ++r) {
+        const char q = identify::quantity_letter(m.measured_as[r]);
+        const std::string at = fem::to_string(m.response_at[r]);
+        channels[std::string(1, q) + "@" + at] =
+            r < m.channel_noise.size() ? number(m.channel_noise[r]) : Json(nullptr);
+        if (r < m.velocity_noise.size() && std::isfinite(m.velocity_noise[r]) &&
+            m.measured_as[r] != identify::Quantity::velocity)
+          channels["v@" + at] = number(m.velocity_noise[r]);
+      }
+      for (std::size_t f = 0; f < m.force_at.size(); ++f)
+        channels["f@" + fem::to_string(m.force_at[f])] =
+            f < m.force_noise.size() ? number(m.force_noise[f]) : Json(nullptr);
+      noise.push_back({{"test", m.source},
+                       {"frequency_hz", m.frequency_hz},
+                       {"periods_averaged", m.periods_averaged},
+                       {"channels", std::move(channels)}});
+    }
+    out["noise"] = std::move(noise);
+  }
   out["warnings"] = std::move(warnings);
   return text(out);
 }

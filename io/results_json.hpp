@@ -4,6 +4,7 @@
 #include "fem/modal.hpp"
 #include "identify/design.hpp"
 #include "identify/fit.hpp"
+#include "identify/measurement.hpp"
 
 #include <filesystem>
 #include <string>
@@ -17,8 +18,14 @@ namespace jointid::io {
 /// "residual_relative", "interval_method", "chi2_per_dof", "singular_values",
 /// "identifiability": [...], "warnings": [...]}. `extra` warnings are appended to the result's.
 /// NaN and infinite numbers are written as null.
+/// With `measured` (the tests as fit() saw them), also "noise": [{"test", "frequency_hz",
+/// "periods_averaged", "channels": {"x@7:uy": σ, "v@7:uy": σ, "f@7:uy": σ}}], each channel's
+/// noise standard deviation per sample as estimated from the record (its unit; null where
+/// unknown, e.g. stepped-sine tables). And always "status" ("ok" or "not_separable") with
+/// "reason".
 std::string identify_result_json(const identify::FitResult& result,
-                                 const std::vector<std::string>& extra = {});
+                                 const std::vector<std::string>& extra = {},
+                                 const std::vector<identify::Measurement>* measured = nullptr);
 
 /// {"modes": [{"mode": 1, "frequency_hz": ...}, ...]} for the first `count` modes (all when
 /// count < 0 or larger than the number of modes).

@@ -893,6 +893,19 @@ TEST_F(CliTest, DesignPredictsTheUncertaintyIdentifyThenReports) {
   const Outcome id = jointid(args, dir());
   ASSERT_EQ(id.status, 0) << id.err;
   const json r = json::parse(test::read_text(result));
+  EXPECT_EQ(r.at("status"), "ok");
+  // The noise identify estimated from each record: the force is A sin ωt, so its noise is
+  // 1 % of A/√2; estimated from 8 periods × 256 samples to about 1 %.
+  ASSERT_EQ(r.at("noise").size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) {
+    const json& n = r["noise"][i];
+    EXPECT_EQ(n.at("periods_averaged").get<int>(), 8);
+    const double expected = 0.01 * std::stod(amps[i]) / std::sqrt(2.0);
+    EXPECT_NEAR(n.at("channels").at("f@7:uy").get<double>(), expected, 0.05 * expected)
+        << n.at("test");
+    EXPECT_GT(n["channels"].at("x@7:uy").get<double>(), 0.0);
+    EXPECT_GT(n["channels"].at("v@7:uy").get<double>(), 0.0);
+  }
   const json& terms = r.at("joints").at(0).at("terms");
   ASSERT_EQ(terms.size(), 4u);
   for (std::size_t t = 0; t < 4; ++t) {
