@@ -7,8 +7,8 @@
 #include "fem/modal.hpp"
 #include "fem/zero_modes.hpp"
 #include "frf/substructure.hpp"
-#include "identify/design.hpp"
 #include "identify/compare.hpp"
+#include "identify/design.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "identify/random_tests.hpp"
@@ -76,6 +76,9 @@ void check_output_file(const fs::path& file) {
 
 void check_harmonics(const std::vector<int>& harmonics, int lowest) {
   if (harmonics.empty()) throw io::Error("--harmonics: expected at least one harmonic, e.g. 1,2,3");
+  if (harmonics.size() == 1 && harmonics[0] == 0)
+    throw io::Error("--harmonics: 0 alone is the mean (static) balance, which a sine test does not "
+                    "excite: add harmonic 1 (e.g. 0,1,2,3)");
   std::set<int> seen;
   for (int k : harmonics) {
     if (k < lowest || k > 50)
@@ -104,6 +107,26 @@ identify::Quantity parse_quantity(const std::string& text) {
   if (text == "v") return identify::Quantity::velocity;
   if (text == "a") return identify::Quantity::acceleration;
   throw io::Error(fmt::format("--channels: expected x, v or a, got \"{}\"", text));
+}
+
+// --channels: x, v, a, each once.
+std::vector<identify::Quantity> parse_channels(const std::vector<std::string>& channels) {
+  std::vector<identify::Quantity> out;
+  for (const auto& c : channels) {
+    const identify::Quantity q = parse_quantity(c);
+    if (std::find(out.begin(), out.end(), q) != out.end())
+      throw io::Error(fmt::format("--channels: {} is listed twice", c));
+    out.push_back(q);
+  }
+  if (out.empty()) throw io::Error("--channels: expected x, v and/or a");
+  return out;
+}
+
+// --noise: a fraction of each channel's RMS.
+void check_noise(double noise) {
+  if (!(std::isfinite(noise) && noise >= 0.0 && noise < 1.0))
+    throw io::Error(fmt::format(
+        "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", noise));
 }
 
 // "F0:F1" in Hz, two finite numbers 0 <= F0 < F1; io::Error naming the option otherwise.
@@ -212,19 +235,9 @@ void simulate_signal(const SimulateOptions& o) {
     throw io::Error(fmt::format("--modal-cutoff: expected >= 0 Hz, got {}", o.modal_cutoff));
   if (!std::isfinite(o.fade_in))
     throw io::Error(fmt::format("--fade-in: expected seconds >= 0, got {}", o.fade_in));
-  if (!(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise < 1.0))
-    throw io::Error(fmt::format(
-        "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", o.noise));
+  check_noise(o.noise);
   identify::ForcedOptions options;
-  options.quantities.clear();
-  for (const auto& c : o.channels) {
-    const identify::Quantity q = parse_quantity(c);
-    if (std::find(options.quantities.begin(), options.quantities.end(), q) !=
-        options.quantities.end())
-      throw io::Error(fmt::format("--channels: {} is listed twice", c));
-    options.quantities.push_back(q);
-  }
-  if (options.quantities.empty()) throw io::Error("--channels: expected x, v and/or a");
+  options.quantities = parse_channels(o.channels);
   options.route = route;
   options.modal_cutoff_hz = o.modal_cutoff;
   options.substeps = o.substeps;
@@ -358,19 +371,9 @@ void simulate(const SimulateOptions& o) {
                                 o.steps_per_period, o.samples_per_period));
   if (o.harmonics < 1)
     throw io::Error(fmt::format("--harmonics: expected at least 1, got {}", o.harmonics));
-  if (!(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise < 1.0))
-    throw io::Error(fmt::format(
-        "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", o.noise));
+  check_noise(o.noise);
   identify::SimulationOptions options;
-  options.quantities.clear();
-  for (const auto& c : o.channels) {
-    const identify::Quantity q = parse_quantity(c);
-    if (std::find(options.quantities.begin(), options.quantities.end(), q) !=
-        options.quantities.end())
-      throw io::Error(fmt::format("--channels: {} is listed twice", c));
-    options.quantities.push_back(q);
-  }
-  if (options.quantities.empty()) throw io::Error("--channels: expected x, v and/or a");
+  options.quantities = parse_channels(o.channels);
   check_output_dir(o.output_dir);
 
   // 2. The model and the tests.

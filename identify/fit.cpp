@@ -781,6 +781,16 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   int tables = 0;
   for (const auto& m : measurements) {
     warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());
+    // Response channels on DOFs the model does not have, or holds fixed, are not used: said.
+    for (std::size_t r = 0; r < m.response_at.size(); ++r) {
+      const fem::DofMap::State state = dofs.state(m.response_at[r]);
+      if (state == fem::DofMap::State::free) continue;
+      warnings.push_back(
+          fmt::format("{}: channel {}@{}: {}; the channel is not used", m.source,
+                      quantity_letter(m.measured_as[r]), fem::to_string(m.response_at[r]),
+                      state == fem::DofMap::State::absent ? "the model has no such DOF"
+                                                          : "a support holds this DOF fixed"));
+    }
     tests.push_back(spectrum(m, dofs, joints, warnings));
     tables += m.fundamental_only ? 1 : 0;
   }

@@ -120,8 +120,20 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   if (best.empty())
     fail("no response channel (expected x, v or a columns such as x@7:uy next to the force)");
 
+  // A force channel that is zero in every sample measured no force.
+  std::vector<const Channel*> loaded;
+  for (const Channel* c : forces) {
+    if (c->samples.size() > 0 && c->samples.cwiseAbs().maxCoeff() == 0.0)
+      m.warnings.push_back(r.source + ": channel " + c->name() +
+                           ": zero in every sample (no force was measured there)");
+    else
+      loaded.push_back(c);
+  }
+  if (loaded.empty())
+    fail("every force channel is zero in every sample (" + forces.front()->name() +
+         "): no force was measured; a sine test needs its force");
   m.frequency_hz =
-      r.excitation_hz ? *r.excitation_hz : estimate_frequency(r.t, forces.front()->samples);
+      r.excitation_hz ? *r.excitation_hz : estimate_frequency(r.t, loaded.front()->samples);
   if (!(m.frequency_hz > 0.0)) fail("excitation frequency must be > 0 Hz");
   const double omega = two_pi * m.frequency_hz, dt = r.dt();
   const int n = whole_period_samples(r.t, m.frequency_hz);

@@ -1,5 +1,7 @@
 #include "identify/random_tests.hpp"
 
+#include "identify/sine_tests.hpp"
+
 #include "fem/modal.hpp"
 #include "fem/transient.hpp"
 
@@ -16,16 +18,6 @@ namespace {
 
 void add_unique(std::vector<int>& list, int value) {
   if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
-}
-
-std::string describe(const joints::Joint& j) {
-  std::string text =
-      fmt::format("joint '{}': {}:{} {}", j.name, j.node, fem::dof_name(j.dof),
-                  j.to_ground() ? std::string("to ground") : fmt::format("to node {}", j.node_b));
-  for (std::size_t t = 0; t < j.terms.size(); ++t)
-    text +=
-        fmt::format("{} {} = {}", t == 0 ? ";" : ",", joints::term_name(j.terms[t]), j.values[t]);
-  return text;
 }
 
 } // namespace
@@ -185,7 +177,7 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
   else
     test.comments.push_back("from rest");
   for (const auto& j : joints)
-    test.comments.push_back(describe(j));
+    test.comments.push_back(joint_comment(j));
   test.comments.push_back(method);
   return test;
 }

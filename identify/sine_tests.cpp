@@ -27,16 +27,6 @@ void add_unique(std::vector<int>& list, int value) {
   if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
 }
 
-std::string describe(const joints::Joint& j) {
-  std::string text =
-      fmt::format("joint '{}': {}:{} {}", j.name, j.node, fem::dof_name(j.dof),
-                  j.to_ground() ? std::string("to ground") : fmt::format("to node {}", j.node_b));
-  for (std::size_t t = 0; t < j.terms.size(); ++t)
-    text += fmt::format("{} {} = {}", t == 0 ? ";" : ",", joints::term_name(j.terms[t]),
-                        compact(j.values[t]));
-  return text;
-}
-
 // The derivative of a periodic signal sampled uniformly over whole periods, from the harmonics
 // of its period (below the Nyquist frequency).
 Eigen::VectorXd periodic_derivative(const Eigen::VectorXd& x, double omega, int periods) {
@@ -60,6 +50,16 @@ Eigen::VectorXd periodic_derivative(const Eigen::VectorXd& x, double omega, int 
 }
 
 } // namespace
+
+std::string joint_comment(const joints::Joint& j) {
+  std::string text =
+      fmt::format("joint '{}': {}:{} {}", j.name, j.node, fem::dof_name(j.dof),
+                  j.to_ground() ? std::string("to ground") : fmt::format("to node {}", j.node_b));
+  for (std::size_t t = 0; t < j.terms.size(); ++t)
+    text += fmt::format("{} {} = {}", t == 0 ? ";" : ",", joints::term_name(j.terms[t]),
+                        compact(j.values[t]));
+  return text;
+}
 
 std::string sine_test_name(const SineTestPlan& plan) {
   return fmt::format("sine_f{}Hz_F{}N.csv", compact(plan.frequency_hz), compact(plan.amplitude));
@@ -149,7 +149,7 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
                                      compact(plan.amplitude), compact(plan.frequency_hz),
                                      fem::to_string(force_at)));
     for (const auto& j : joints)
-      s.comments.push_back(describe(j));
+      s.comments.push_back(joint_comment(j));
     return s;
   };
 

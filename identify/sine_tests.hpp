@@ -51,6 +51,9 @@ struct SimulatedTest {
   std::vector<std::string> warnings; ///< not periodic, not converged
 };
 
+/// "joint 'tip': 7:uy to ground; k = 4800, c = 20": a record's comment line describing a joint.
+std::string joint_comment(const joints::Joint& joint);
+
 /// "sine_f3.4Hz_F80N.csv": numbers in their shortest exact form.
 std::string sine_test_name(const SineTestPlan& plan);
 

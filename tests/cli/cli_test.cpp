@@ -338,6 +338,43 @@ TEST_F(CliTest, RecordWithoutTheJointChannelFails) {
   EXPECT_EQ(test::read_text(result), "old\n");
 }
 
+// The silent wrong answers of issue 10: each now names its culprit.
+TEST_F(CliTest, ZeroForceForeignChannelAndHarmonicZeroAloneAreNamed) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  // A record whose force channel is zero in every sample: refused, naming it.
+  identify::Record zero = io::read_record(record_files()[0]);
+  zero.channels[0].samples.setZero();
+  zero.excitation_hz = 3.4;
+  const fs::path zero_file = dir() / "zero_force.csv";
+  io::write_record(zero_file, zero);
+  expect_one_line_error(
+      jointid({"identify", model().string(), zero_file.string(), record_files()[1],
+               record_files()[2], "-o", (dir() / "zero.json").string()},
+              dir()),
+      "zero_force.csv: every force channel is zero in every sample");
+  // A channel on a DOF the planar model does not have: used nowhere, and said so.
+  identify::Record extra = io::read_record(record_files()[0]);
+  identify::Channel uz = extra.channels[1];
+  uz.at.dof = fem::Dof::uz;
+  extra.channels.push_back(uz);
+  const fs::path extra_file = dir() / "with_uz.csv";
+  io::write_record(extra_file, extra);
+  const fs::path out = dir() / "with_uz.json";
+  const Outcome run = jointid({"identify", model().string(), extra_file.string(), record_files()[1],
+                               record_files()[2], "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("with_uz.csv: channel x@7:uz: the model has no such DOF"),
+            std::string::npos)
+      << run.err;
+  // Harmonic 0 alone: the mean balance, which a sine test does not excite.
+  expect_one_line_error(
+      jointid({"identify", model().string(), record_files()[0], record_files()[1],
+               record_files()[2], "--harmonics", "0", "-o", (dir() / "h0.json").string()},
+              dir()),
+      "0 alone");
+}
+
 TEST_F(CliTest, SimulateChecksEverythingBeforeWriting) {
   const fs::path out = dir() / "sim_out";
   fs::create_directories(out);
