@@ -129,8 +129,9 @@ void check_noise(double noise) {
         "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", noise));
 }
 
-// "F0:F1" in Hz, two finite numbers 0 <= F0 < F1; io::Error naming the option otherwise.
-std::pair<double, double> parse_band(const std::string& option, const std::string& text) {
+// "F0:F1" in Hz: two finite numbers; io::Error naming the option otherwise.
+std::pair<double, double> parse_pair(const std::string& option, const std::string& text,
+                                     const char* example) {
   double f0 = 0.0, f1 = 0.0;
   const auto colon = text.find(':');
   bool ok = colon != std::string::npos;
@@ -140,14 +141,21 @@ std::pair<double, double> parse_band(const std::string& option, const std::strin
       const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
       f0 = std::stod(a, &n0);
       f1 = std::stod(b, &n1);
-      ok = n0 == a.size() && n1 == b.size();
+      ok = n0 == a.size() && n1 == b.size() && std::isfinite(f0) && std::isfinite(f1);
     } catch (const std::exception&) {
       ok = false;
     }
   }
   if (!ok)
-    throw io::Error(fmt::format("{}: expected F0:F1 in Hz, e.g. 2:40, got \"{}\"", option, text));
-  if (!(std::isfinite(f0) && std::isfinite(f1) && f0 >= 0.0 && f1 > f0))
+    throw io::Error(
+        fmt::format("{}: expected F0:F1 in Hz, e.g. {}, got \"{}\"", option, example, text));
+  return {f0, f1};
+}
+
+// A band "F0:F1" in Hz with 0 <= F0 < F1.
+std::pair<double, double> parse_band(const std::string& option, const std::string& text) {
+  const auto [f0, f1] = parse_pair(option, text, "2:40");
+  if (!(f0 >= 0.0 && f1 > f0))
     throw io::Error(fmt::format("{}: expected 0 <= F0 < F1 (Hz), got {} and {}", option, f0, f1));
   return {f0, f1};
 }
@@ -666,28 +674,10 @@ void response(const ResponseOptions& o) {
           fmt::format("--amplitude: expected finite amplitudes > 0 (N or N m), got {}", a));
   if (std::set<double>(o.amplitudes.begin(), o.amplitudes.end()).size() != o.amplitudes.size())
     throw io::Error("--amplitude: an amplitude is listed twice");
-  double f0 = 0.0, f1 = 0.0;
-  {
-    const auto colon = o.freq_range.find(':');
-    bool ok = colon != std::string::npos;
-    if (ok) {
-      try {
-        std::size_t n0 = 0, n1 = 0;
-        const std::string a = o.freq_range.substr(0, colon), b = o.freq_range.substr(colon + 1);
-        f0 = std::stod(a, &n0);
-        f1 = std::stod(b, &n1);
-        ok = n0 == a.size() && n1 == b.size();
-      } catch (const std::exception&) {
-        ok = false;
-      }
-    }
-    if (!ok)
-      throw io::Error(
-          fmt::format("--freq-range: expected F0:F1 in Hz, e.g. 15:25, got \"{}\"", o.freq_range));
-    if (!(std::isfinite(f0) && std::isfinite(f1) && f0 > 0.0 && f1 > 0.0 && f0 != f1))
-      throw io::Error(fmt::format(
-          "--freq-range: expected two different frequencies > 0 Hz, got {} and {}", f0, f1));
-  }
+  const auto [f0, f1] = parse_pair("--freq-range", o.freq_range, "15:25");
+  if (!(f0 > 0.0 && f1 > 0.0 && f0 != f1))
+    throw io::Error(fmt::format(
+        "--freq-range: expected two different frequencies > 0 Hz, got {} and {}", f0, f1));
   if (o.harmonics < 1 || o.harmonics > 200)
     throw io::Error(fmt::format("--harmonics: expected 1 to 200, got {}", o.harmonics));
   check_output_dir(o.output_dir);

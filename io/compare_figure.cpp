@@ -9,22 +9,6 @@
 
 namespace jointid::io {
 
-namespace {
-std::string psd_unit(const std::string& channel) {
-  switch (identify::parse_channel_name(channel).quantity) {
-  case identify::Quantity::displacement:
-    return "m^2/Hz";
-  case identify::Quantity::velocity:
-    return "(m/s)^2/Hz";
-  case identify::Quantity::acceleration:
-    return "(m/s^2)^2/Hz";
-  case identify::Quantity::force:
-    return "N^2/Hz";
-  }
-  return "";
-}
-} // namespace
-
 Figure compare_figure(const identify::Comparison& c) {
   Figure figure;
   const auto n = static_cast<int>(c.channels.size());

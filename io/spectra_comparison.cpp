@@ -22,21 +22,23 @@ Json number(double value) {
   return std::isfinite(value) ? Json(value) : Json(nullptr);
 }
 
-const char* psd_unit(identify::Quantity q) {
-  switch (q) {
+} // namespace
+
+std::string psd_unit(const std::string& channel) {
+  const identify::Channel c = identify::parse_channel_name(channel);
+  const bool turn = fem::is_rotation(c.at.dof);
+  switch (c.quantity) {
   case identify::Quantity::displacement:
-    return "m^2/Hz (rad^2/Hz for rotations)";
+    return turn ? "rad^2/Hz" : "m^2/Hz";
   case identify::Quantity::velocity:
-    return "(m/s)^2/Hz";
+    return turn ? "(rad/s)^2/Hz" : "(m/s)^2/Hz";
   case identify::Quantity::acceleration:
-    return "(m/s^2)^2/Hz";
+    return turn ? "(rad/s^2)^2/Hz" : "(m/s^2)^2/Hz";
   case identify::Quantity::force:
-    return "N^2/Hz";
+    return turn ? "(N m)^2/Hz" : "N^2/Hz";
   }
   return "";
 }
-
-} // namespace
 
 std::string compare_json(const identify::Comparison& c) {
   Json j;
@@ -55,7 +57,7 @@ std::string compare_json(const identify::Comparison& c) {
   for (const auto& ch : c.channels) {
     Json o;
     o["channel"] = ch.channel;
-    o["unit"] = psd_unit(identify::parse_channel_name(ch.channel).quantity);
+    o["unit"] = psd_unit(ch.channel);
     o["rms_difference_db"] = number(ch.rms_db);
     o["max_difference_db"] = number(ch.max_db);
     o["frequency_hz"] = numbers(ch.frequency_hz);

@@ -15,6 +15,9 @@ namespace jointid::io {
 ///  "predicted": [...], "difference_db": [...]}]}. Non-finite numbers are written as null.
 std::string compare_json(const identify::Comparison& comparison);
 
+/// The unit of the one-sided PSD of a channel ("x@7:uy"): "m^2/Hz", "(rad/s)^2/Hz" for v@7:rz, …
+std::string psd_unit(const std::string& channel);
+
 /// One chart per channel: measured and predicted PSD over the band (log y), titled with the
 /// channel and its RMS difference in dB. Part of jointid_io_output (the chart writer's library).
 Figure compare_figure(const identify::Comparison& comparison);

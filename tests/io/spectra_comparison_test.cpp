@@ -46,3 +46,12 @@ TEST(CompareJson, HoldsEveryChannelWithItsSpectraAndDifferences) {
   EXPECT_TRUE(o["difference_db"][1].is_null());
   EXPECT_NE(j["psd_convention"].get<std::string>().find("one-sided"), std::string::npos);
 }
+
+TEST(CompareJson, PsdUnitsFollowTheQuantityAndTheDof) {
+  EXPECT_EQ(jointid::io::psd_unit("x@7:uy"), "m^2/Hz");
+  EXPECT_EQ(jointid::io::psd_unit("x@1:rz"), "rad^2/Hz");
+  EXPECT_EQ(jointid::io::psd_unit("v@3:rx"), "(rad/s)^2/Hz");
+  EXPECT_EQ(jointid::io::psd_unit("a@3:ux"), "(m/s^2)^2/Hz");
+  EXPECT_EQ(jointid::io::psd_unit("f@2:ry"), "(N m)^2/Hz");
+  EXPECT_EQ(jointid::io::psd_unit("f@2:uz"), "N^2/Hz");
+}
