@@ -265,30 +265,21 @@ void simulate_signal(const SimulateOptions& o) {
     duration = static_cast<double>(record.t.size()) / input.sample_rate_hz;
     name = o.force_from.stem().string() + "_simulated.csv";
   } else {
-    input.sample_rate_hz = o.sample_rate;
-    const fem::Sampling sampling{o.duration, o.sample_rate};
+    const identify::ExcitationSpec spec{kind == "random"  ? identify::Excitation::random
+                                        : kind == "sweep" ? identify::Excitation::sweep
+                                                          : identify::Excitation::multisine,
+                                        f0,
+                                        f1,
+                                        level,
+                                        o.seed,
+                                        o.duration,
+                                        o.sample_rate};
     try {
-      if (kind == "random") {
-        input.samples = fem::band_limited_random({f0, f1, level, o.seed}, sampling);
-        input.description = fmt::format("excitation: band-limited Gaussian random, flat {}-{} Hz, "
-                                        "RMS {} N, seed {}",
-                                        f0, f1, level, o.seed);
-      } else if (kind == "sweep") {
-        input.samples = fem::sine_sweep({f0, f1, level, false}, sampling);
-        input.description = fmt::format(
-            "excitation: linear sine sweep {}-{} Hz, amplitude {} N (peak)", f0, f1, level);
-      } else {
-        input.samples = fem::multisine({f0, f1, level}, sampling);
-        input.description =
-            fmt::format("excitation: multisine, lines k/T in {}-{} Hz, Schroeder phases, RMS {} N",
-                        f0, f1, level);
-      }
+      input = identify::generated_force(spec, {}); // the DOF is resolved with the model
     } catch (const std::invalid_argument& e) {
       throw io::Error(std::string("--band, --duration, --sample-rate: ") + e.what());
     }
-    input.description += fmt::format("; {} s at {} Hz", o.duration, o.sample_rate);
-    name = fmt::format("{}_{}-{}Hz_{}N{}.csv", kind, f0, f1, level,
-                       kind == "random" ? fmt::format("_seed{}", o.seed) : "");
+    name = identify::excitation_record_name(spec);
   }
   // Default: 5 % of the duration, none for a record's force that already starts at zero.
   const bool starts_at_zero =

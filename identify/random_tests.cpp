@@ -2,6 +2,7 @@
 
 #include "identify/sine_tests.hpp"
 
+#include "fem/excitation.hpp"
 #include "fem/modal.hpp"
 #include "fem/transient.hpp"
 
@@ -180,6 +181,53 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
     test.comments.push_back(joint_comment(j));
   test.comments.push_back(method);
   return test;
+}
+
+namespace {
+const char* excitation_name(Excitation kind) {
+  switch (kind) {
+  case Excitation::random:
+    return "random";
+  case Excitation::sweep:
+    return "sweep";
+  case Excitation::multisine:
+    return "multisine";
+  }
+  return "";
+}
+} // namespace
+
+ForceInput generated_force(const ExcitationSpec& s, const fem::NodeDof& at) {
+  ForceInput input;
+  input.at = {at};
+  input.sample_rate_hz = s.sample_rate_hz;
+  const fem::Sampling sampling{s.duration_s, s.sample_rate_hz};
+  switch (s.kind) {
+  case Excitation::random:
+    input.samples = fem::band_limited_random({s.f0_hz, s.f1_hz, s.level, s.seed}, sampling);
+    input.description =
+        fmt::format("excitation: band-limited Gaussian random, flat {}-{} Hz, RMS {} N, seed {}",
+                    s.f0_hz, s.f1_hz, s.level, s.seed);
+    break;
+  case Excitation::sweep:
+    input.samples = fem::sine_sweep({s.f0_hz, s.f1_hz, s.level, false}, sampling);
+    input.description = fmt::format("excitation: linear sine sweep {}-{} Hz, amplitude {} N (peak)",
+                                    s.f0_hz, s.f1_hz, s.level);
+    break;
+  case Excitation::multisine:
+    input.samples = fem::multisine({s.f0_hz, s.f1_hz, s.level}, sampling);
+    input.description =
+        fmt::format("excitation: multisine, lines k/T in {}-{} Hz, Schroeder phases, RMS {} N",
+                    s.f0_hz, s.f1_hz, s.level);
+    break;
+  }
+  input.description += fmt::format("; {} s at {} Hz", s.duration_s, s.sample_rate_hz);
+  return input;
+}
+
+std::string excitation_record_name(const ExcitationSpec& s) {
+  return fmt::format("{}_{}-{}Hz_{}N{}.csv", excitation_name(s.kind), s.f0_hz, s.f1_hz, s.level,
+                     s.kind == Excitation::random ? fmt::format("_seed{}", s.seed) : "");
 }
 
 } // namespace jointid::identify

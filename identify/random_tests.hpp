@@ -8,6 +8,7 @@
 #include "identify/record.hpp"
 #include "joints/joint.hpp"
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -63,6 +64,24 @@ struct ForcedTest {
 ForcedTest simulate_forced(const frf::Substructure& substructure,
                            const std::vector<joints::Joint>& joints, const ForceInput& input,
                            const ForcedOptions& options = {});
+
+enum class Excitation { random, sweep, multisine };
+
+/// A generated force at one DOF: band-limited Gaussian random (level = RMS, seeded), linear sine
+/// sweep (level = peak) or Schroeder multisine (level = RMS) over [f0_hz, f1_hz].
+struct ExcitationSpec {
+  Excitation kind = Excitation::random;
+  double f0_hz = 0.0, f1_hz = 0.0, level = 0.0; ///< Hz, N or N·m
+  std::uint64_t seed = 1;                       ///< random only
+  double duration_s = 0.0, sample_rate_hz = 0.0;
+};
+
+/// The force history of the spec at `at`, with its description for the record's comments.
+/// Throws std::invalid_argument (from fem/excitation.hpp) for a bad band or sampling.
+ForceInput generated_force(const ExcitationSpec& spec, const fem::NodeDof& at);
+
+/// The record's file name: "random_2-40Hz_40N_seed1.csv", "sweep_2-40Hz_10N.csv", …
+std::string excitation_record_name(const ExcitationSpec& spec);
 
 /// The force channels of a record as a ForceInput (every `f@` channel; std::invalid_argument
 /// naming the record when it has none or its sampling is not uniform).
