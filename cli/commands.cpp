@@ -7,6 +7,7 @@
 #include "fem/modal.hpp"
 #include "fem/zero_modes.hpp"
 #include "frf/substructure.hpp"
+#include "frf/sweep.hpp"
 #include "identify/compare.hpp"
 #include "identify/design.hpp"
 #include "identify/fit.hpp"
@@ -16,6 +17,7 @@
 #include "io/chart.hpp"
 #include "io/discovery_report.hpp"
 #include "io/files.hpp"
+#include "io/frf_output.hpp"
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
 #include "io/response_curves.hpp"
@@ -608,10 +610,7 @@ void modes(const ModesOptions& o) {
   const fem::Modes modes =
       compute_modes(file.model, sub ? sub->system() : nullptr, options, engine);
   if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error(modes.status == fem::ModalStatus::not_converging
-                                 ? "modal analysis did not converge"
-                                 : "modal analysis failed: the mass matrix is not positive "
-                                   "definite (a DOF without mass?)");
+    throw std::runtime_error("modal analysis failed: " + modes.reason);
   if (!output_rank()) return;
   if (!sub) sub.emplace(file.substructure());
   const fem::Assembled& system = *sub->system();
@@ -744,6 +743,80 @@ void response(const ResponseOptions& o) {
   }
   for (const auto& n : curves.notes)
     fmt::print("note: {}\n", n);
+}
+
+void frf(const FrfOptions& o) {
+  // 1. The options.
+  const auto [f0, f1] = parse_pair("--freq-range", o.freq_range, "0:100");
+  if (!(f0 >= 0.0 && f1 > f0))
+    throw io::Error(fmt::format(
+        "--freq-range: expected F0 >= 0 Hz below F1, got {} and {} (e.g. 0:100)", f0, f1));
+  if (o.points < 2 || o.points > 1000000)
+    throw io::Error(fmt::format("--points: expected 2 to 1000000, got {}", o.points));
+  frf::FrfKind kind{};
+  try {
+    kind = frf::parse_frf_kind(o.kind);
+  } catch (const std::invalid_argument& e) {
+    throw io::Error(std::string("--kind: ") + e.what());
+  }
+  check_output_dir(o.output_dir);
+
+  // 2. The model and the DOFs.
+  const io::ModelFile file = io::read_model(o.model);
+  frf::Substructure sub = file.substructure();
+  use_engine(sub, parse_engine(o.engine));
+  const fem::NodeDof drive = resolve(file, sub, "--drive", o.drive);
+  std::vector<int> responses;
+  for (const std::string& r : o.responses) {
+    const int e = sub.dofs().equation(resolve(file, sub, "--response", r));
+    if (std::find(responses.begin(), responses.end(), e) != responses.end())
+      throw io::Error(fmt::format("--response: {} is listed twice", r));
+    responses.push_back(e);
+  }
+  if (responses.empty()) responses.push_back(sub.dofs().equation(drive));
+  std::vector<double> freq(static_cast<std::size_t>(o.points));
+  for (int i = 0; i < o.points; ++i) // exact ends; evenly spaced (dataset 58's even spacing)
+    freq[static_cast<std::size_t>(i)] =
+        i + 1 == o.points ? f1 : f0 + (f1 - f0) * i / (o.points - 1.0);
+
+  // 3. The FRFs.
+  frf::FrfSweep sweep;
+  try {
+    sweep = frf::frf_sweep(sub, sub.dofs().equation(drive), std::move(responses), std::move(freq),
+                           kind);
+  } catch (const std::invalid_argument& e) {
+    throw io::Error(o.model.string() + ": " + e.what());
+  }
+  if (!output_rank()) return;
+  if (!file.joints.empty())
+    fmt::print("note: the FRFs are the linear substructure's; the {} joint{} of {} {} not in "
+               "them (see jointid response for the structure with its joints)\n",
+               file.joints.size(), file.joints.size() == 1 ? "" : "s", o.model.string(),
+               file.joints.size() == 1 ? "is" : "are");
+  for (const std::string& n : sweep.notes)
+    fmt::print("note: {}\n", n);
+
+  // 4. Write: the table and the universal file staged and renamed into place together (a
+  //    failure leaves both as they were); the picture after them, atomically too.
+  const fs::path csv = o.output_dir / "frf.csv", uff = o.output_dir / "frf.uff",
+                 png = o.output_dir / "frf.png";
+  const std::string table = io::frf_csv(sweep, sub.dofs());
+  const std::string universal = io::uff58_text(io::frf_uff58(sweep, sub.dofs()));
+  make_output_dir(o.output_dir);
+  io::OutputFiles files;
+  files.add(csv, table);
+  files.add(uff, universal);
+  files.commit();
+  fmt::print("wrote {}\nwrote {}\n", csv.string(), uff.string());
+  if (o.plot) {
+    std::string why;
+    if (io::can_render_charts(&why)) {
+      io::write_chart_png(png, io::frf_figure(sweep, sub.dofs()));
+      fmt::print("wrote {}\n", png.string());
+    } else {
+      warn("no frf.png: " + why + " (run under xvfb-run -a)");
+    }
+  }
 }
 
 namespace {

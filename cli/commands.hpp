@@ -119,6 +119,22 @@ struct ResponseOptions {
 /// contract) and DIR/response.png. Progress on a terminal (stderr), nothing otherwise.
 void response(const ResponseOptions& options);
 
+struct FrfOptions {
+  std::filesystem::path model;
+  std::string drive;                  ///< NODE:DOF of the force
+  std::vector<std::string> responses; ///< NODE:DOF each; empty: the drive DOF
+  std::string freq_range;             ///< F0:F1, Hz (F0 >= 0)
+  int points = 1000;                  ///< evenly spaced frequencies, both ends included
+  std::string kind = "receptance";    ///< receptance, mobility or accelerance
+  bool plot = true;
+  std::string engine = "auto";
+  std::filesystem::path output_dir;
+};
+
+/// The linear substructure's FRFs from one force: DIR/frf.csv, DIR/frf.uff (dataset 58, FRFs)
+/// and DIR/frf.png (magnitude and phase).
+void frf(const FrfOptions& options);
+
 struct DesignOptions {
   std::filesystem::path model;
   std::string force;                    ///< NODE:DOF of the sine force

@@ -255,6 +255,26 @@ int main(int argc, char** argv) {
   response->add_option("-o,--output", resp.output_dir, "Output directory (created if missing)")
       ->required();
 
+  cli::FrfOptions fr;
+  auto* frf = app.add_subcommand(
+      "frf", "FRFs of the linear substructure (modal synthesis) from one force: receptance, "
+             "mobility or accelerance; writes DIR/frf.csv, DIR/frf.uff (UFF58) and DIR/frf.png");
+  frf->add_option("MODEL", fr.model, "Model file (TOML)")->required();
+  frf->add_option("--drive", fr.drive, "DOF of the force, NODE:DOF (e.g. 7:uy)")->required();
+  frf->add_option("--response", fr.responses,
+                  "Response DOFs, NODE:DOF (comma-separated; default: the drive DOF)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  frf->add_option("--freq-range", fr.freq_range, "Band F0:F1 in Hz (F0 >= 0)")->required();
+  frf->add_option("--points", fr.points, "Evenly spaced frequencies, both ends included")
+      ->capture_default_str();
+  frf->add_option("--kind", fr.kind,
+                  "receptance (m/N), mobility ((m/s)/N) or accelerance ((m/s^2)/N)")
+      ->capture_default_str();
+  frf->add_flag("!--no-plot", fr.plot, "Write no frf.png");
+  frf->add_option("-o,--output", fr.output_dir, "Output directory (created if missing)")
+      ->required();
+
   cli::DesignOptions des;
   auto* design = app.add_subcommand(
       "design", "Experiment design: choose the N sine tests (of candidate frequencies x force "
@@ -318,6 +338,9 @@ int main(int argc, char** argv) {
   response->add_option("--engine", resp.engine, large_help)
       ->check(CLI::IsMember({"auto", "slepc"}))
       ->capture_default_str();
+  frf->add_option("--engine", fr.engine, large_help)
+      ->check(CLI::IsMember({"auto", "slepc"}))
+      ->capture_default_str();
   design->add_option("--engine", des.engine, large_help)
       ->check(CLI::IsMember({"auto", "slepc"}))
       ->capture_default_str();
@@ -335,6 +358,7 @@ int main(int argc, char** argv) {
                                : discover->parsed() ? disc.engine
                                : response->parsed() ? resp.engine
                                : design->parsed()   ? des.engine
+                               : frf->parsed()      ? fr.engine
                                                     : mod.engine;
     // MPI for the distributed engine; no X display is looked for under it (a picture is
     // then drawn only when one exists).
@@ -349,6 +373,8 @@ int main(int argc, char** argv) {
     if (design->parsed()) cli::design(des);
     if (modes->parsed() && mod.pictures > 0 && !distributed) rerun_with_display(argv);
     if (modes->parsed()) cli::modes(mod);
+    if (frf->parsed() && fr.plot && !distributed) rerun_with_display(argv);
+    if (frf->parsed()) cli::frf(fr);
     if (compare->parsed() && cmp.plot) rerun_with_display(argv);
     if (compare->parsed()) cli::compare(cmp);
     return 0;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -32,30 +33,88 @@ double to_omega(double lambda) {
   return std::sqrt(std::max(lambda, 0.0));
 }
 
+// The lowest `count` of the eigenvalues `lambda` (ascending) below o.max_frequency_hz, or
+// o.num_modes of them (0 = all).
+int wanted_count(const Eigen::VectorXd& lambda, const ModalOptions& o) {
+  const int n = static_cast<int>(lambda.size());
+  if (o.max_frequency_hz <= 0.0) return o.num_modes > 0 ? std::min(o.num_modes, n) : n;
+  int count = 0;
+  while (count < n && to_omega(lambda(count)) < two_pi * o.max_frequency_hz)
+    ++count;
+  return count;
+}
+
+// DOFs with mass: M's rank (a positive semi-definite M has a zero row where its diagonal is zero).
+int massive_dofs(const Assembled& s) {
+  return static_cast<int>((s.M.diagonal().array() != 0.0).count());
+}
+
+// A DOF with a zero diagonal in both K and M (neither stiffness nor mass), if any: -1 if none.
+int bare_equation(const Assembled& s) {
+  for (int i = 0; i < s.K.rows(); ++i)
+    if (s.K.coeff(i, i) == 0.0 && s.M.coeff(i, i) == 0.0) return i;
+  return -1;
+}
+
+std::invalid_argument not_positive_definite(const Assembled& s, double shift_hz, int equation) {
+  const std::string where =
+      equation >= 0 ? "; it breaks down at " + to_string(s.dofs.node_dof(equation)) : "";
+  return std::invalid_argument(
+      "modal analysis: K + (2 pi " + std::to_string(shift_hz) +
+      " Hz)^2 M is not positive definite" + where +
+      ". Look there for a DOF with neither stiffness nor mass (e.g. a rotation no element or "
+      "spring holds), or a negative mass or stiffness");
+}
+
 Modes dense_modes(const Assembled& s, const ModalOptions& o) {
   const Eigen::MatrixXd K(s.K), M(s.M);
   Modes out;
-  // Eigen's generalised solver factorises M without checking the factorisation (3.4), so a
-  // massless DOF would come back as "success" with an infinite frequency: check M first.
-  if (Eigen::LLT<Eigen::MatrixXd>(M).info() != Eigen::Success) {
-    out.status = ModalStatus::numerical_issue; // M not positive definite
+  if (Eigen::LLT<Eigen::MatrixXd>(M).info() == Eigen::Success) {
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(K, M);
+    if (solver.info() != Eigen::Success) {
+      out.status = ModalStatus::numerical_issue;
+      out.reason = "the dense generalised eigensolver (K, M) did not succeed";
+      return out;
+    }
+    const Eigen::VectorXd& lambda = solver.eigenvalues();
+    const int count = wanted_count(lambda, o);
+    out.omega = lambda.head(count).unaryExpr(&to_omega);
+    out.phi = solver.eigenvectors().leftCols(count);
     return out;
   }
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(K, M);
+  // M is singular (massless DOFs, e.g. rotations of a lumped-mass model), so Eigen's solver,
+  // which factorises M, cannot be used (3.4 does not even check that factorisation). Solve the
+  // shifted, inverted problem M φ = μ (K − σM) φ instead, as the sparse engine does: K − σM is
+  // positive definite for σ < 0 whenever every DOF has stiffness or mass, ω² = σ + 1/μ, and a
+  // massless DOF gives μ = 0, an infinite frequency, which is not a mode of the structure (its
+  // static condensation gives the same finite modes). Kept for singular M only: for the finite
+  // modes the direct solution is more accurate when the frequencies span many decades.
+  const double sigma = -std::pow(two_pi * o.shift_hz, 2);
+  const Eigen::MatrixXd A = K - sigma * M;
+  if (Eigen::LLT<Eigen::MatrixXd>(A).info() != Eigen::Success)
+    throw not_positive_definite(s, o.shift_hz, bare_equation(s));
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(M, A);
   if (solver.info() != Eigen::Success) {
     out.status = ModalStatus::numerical_issue;
+    out.reason = "the dense generalised eigensolver (M, K - sigma M) did not succeed";
     return out;
   }
-  const Eigen::VectorXd& lambda = solver.eigenvalues();
-  const int n = static_cast<int>(lambda.size());
-  int count = o.num_modes > 0 ? std::min(o.num_modes, n) : n;
-  if (o.max_frequency_hz > 0.0) {
-    count = 0;
-    while (count < n && to_omega(lambda(count)) < two_pi * o.max_frequency_hz)
-      ++count;
-  }
+  // μ ascending: the finite modes are the positive μ from the largest down. μ at rounding level
+  // (relative to the largest) belongs to a massless DOF.
+  const Eigen::VectorXd& mu = solver.eigenvalues();
+  const int n = static_cast<int>(mu.size());
+  const double floor = 1e3 * std::numeric_limits<double>::epsilon() * mu.cwiseAbs().maxCoeff();
+  int finite = 0;
+  while (finite < n && mu(n - 1 - finite) > floor)
+    ++finite;
+  Eigen::VectorXd lambda(finite);
+  for (int r = 0; r < finite; ++r)
+    lambda(r) = sigma + 1.0 / mu(n - 1 - r);
+  const int count = wanted_count(lambda, o);
   out.omega = lambda.head(count).unaryExpr(&to_omega);
-  out.phi = solver.eigenvectors().leftCols(count);
+  out.phi.resize(K.rows(), count);
+  for (int r = 0; r < count; ++r) // φᵀ(K − σM)φ = 1 from the solver, so φᵀMφ = μ
+    out.phi.col(r) = solver.eigenvectors().col(n - 1 - r) / std::sqrt(mu(n - 1 - r));
   return out;
 }
 
@@ -81,12 +140,7 @@ public:
     try {
       llt_.factorize(A);
     } catch (const NotPositiveDefinite& e) {
-      const NodeDof at = system_.dofs.node_dof(static_cast<int>(e.equation()));
-      throw std::invalid_argument(
-          "sparse modal analysis: K + (2 pi " + std::to_string(options_.shift_hz) +
-          " Hz)^2 M is not positive definite; the factorisation broke down at " + to_string(at) +
-          ". Look there for a DOF with neither stiffness nor mass (e.g. a rotation no element "
-          "or spring holds), or a negative mass or stiffness");
+      throw not_positive_definite(system_, options_.shift_hz, static_cast<int>(e.equation()));
     }
     stats_.factorize_s = seconds_since(start);
     stats_.cholesky_peak_bytes = llt_.peak_memory_bytes();
@@ -115,7 +169,14 @@ Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert&
   const int n = s.dofs.num_equations();
   const double sigma = -std::pow(two_pi * o.shift_hz, 2);
   Spectra::SparseSymMatProd<double> bop(s.M);
-  const int ncv = std::min(n, std::max(2 * nev + 1, nev + 20));
+  // With massless DOFs the Krylov space of (K − σM)⁻¹M has at most as many dimensions as M
+  // has massive DOFs (its rank); a larger basis breaks down into M's null space.
+  const int massive = massive_dofs(s);
+  if (nev >= massive)
+    throw std::invalid_argument("the sparse engine finds fewer modes than DOFs with mass (" +
+                                std::to_string(massive) +
+                                "); ask for fewer modes or use the dense engine");
+  const int ncv = std::min(massive, std::max(2 * nev + 1, nev + 20));
   stats.ncv = ncv;
   stats.solves = 0;
   stats.solve_s = 0.0;
@@ -123,7 +184,19 @@ Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert&
                                Spectra::GEigsMode::ShiftInvert>
       solver(op, bop, nev, ncv, sigma);
   const auto start = std::chrono::steady_clock::now();
-  solver.init();
+  // A singular M (massless DOFs) makes the M-inner product of the Lanczos basis semi-definite:
+  // components in M's null space are invisible to it and grow unchecked. Keep them out: start
+  // from (K − σM)⁻¹ M r, which has none (exact arithmetic), and purify the eigenvectors at the
+  // end (below). A positive semi-definite M is singular exactly when a diagonal entry is zero.
+  const bool singular_mass = massive < n;
+  if (singular_mass) {
+    const Eigen::VectorXd r = s.M * Eigen::VectorXd::LinSpaced(n, 1.0, 2.0);
+    Eigen::VectorXd start_vector(n);
+    op.perform_op(r.data(), start_vector.data());
+    solver.init(start_vector.data());
+  } else {
+    solver.init();
+  }
   solver.compute(Spectra::SortRule::LargestMagn, o.max_iterations, o.tolerance,
                  Spectra::SortRule::SmallestAlge);
   stats.lanczos_s = seconds_since(start);
@@ -132,27 +205,39 @@ Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert&
   out.sparse = stats;
   if (solver.info() != Spectra::CompInfo::Successful) {
     out.status = ModalStatus::not_converging;
+    std::ostringstream reason;
+    reason << "shift-invert Lanczos (Spectra) did not converge to " << nev << " modes in "
+           << o.max_iterations << " restarts (tolerance " << o.tolerance << ")";
+    out.reason = reason.str();
     return out;
   }
   out.omega = solver.eigenvalues().unaryExpr(&to_omega);
   out.phi = solver.eigenvectors();
+  if (singular_mass) { // φ ← (K − σM)⁻¹ M φ removes M's null space, then φᵀMφ = 1 again
+    for (int r = 0; r < out.num_modes(); ++r) {
+      const Eigen::VectorXd mphi = s.M * out.phi.col(r);
+      Eigen::VectorXd pure(n);
+      op.perform_op(mphi.data(), pure.data());
+      out.phi.col(r) = pure / std::sqrt(pure.dot(s.M * pure));
+    }
+  }
   return out;
 }
 
 Modes sparse_modes(const Assembled& s, const ModalOptions& o) {
-  const int n = s.dofs.num_equations();
   SparseModalStats stats;
   ShiftInvert op(s, o, stats);
   if (o.max_frequency_hz <= 0.0) return sparse_modes_count(s, o, op, stats, o.num_modes);
   // Every mode below f_max: grow the count until the highest mode found lies above f_max.
   // The factorisation is reused; only the Lanczos iteration is repeated.
   int nev = std::max(o.num_modes, 8);
+  const int last = massive_dofs(s) - 1; // the most modes the engine can find
   while (true) {
-    nev = std::min(nev, n - 1);
+    nev = std::min(nev, last);
     Modes m = sparse_modes_count(s, o, op, stats, nev);
     if (m.status != ModalStatus::success) return m;
     const double omega_max = two_pi * o.max_frequency_hz;
-    if (m.omega(m.num_modes() - 1) >= omega_max || nev == n - 1) {
+    if (m.omega(m.num_modes() - 1) >= omega_max || nev == last) {
       int count = 0;
       while (count < m.num_modes() && m.omega(count) < omega_max)
         ++count;

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace jointid::fem {
@@ -54,6 +55,7 @@ struct DistributedModalStats {
 
 struct Modes {
   ModalStatus status = ModalStatus::success;
+  std::string reason;    ///< why, when status is not success
   Eigen::VectorXd omega; ///< circular frequencies ω_r, rad/s, ascending (rigid modes ≈ 0)
   /// n_eq × n_modes, mass-normalised; or |rows| × n_modes when `rows` is not empty.
   Eigen::MatrixXd phi;
@@ -66,7 +68,11 @@ struct Modes {
   double frequency_hz(int r) const;
 };
 
-/// Throws std::invalid_argument for bad options (e.g. more modes than equations).
+/// Throws std::invalid_argument for bad options (e.g. more modes than equations) and for a model
+/// with a DOF that has neither stiffness nor mass (K − σM not positive definite), naming it.
+/// Massless DOFs that have stiffness are no error: they have no finite mode, so both engines
+/// return the finite modes only (a count is capped at their number). A solver that fails or
+/// does not converge gives a status with its reason.
 Modes modal_analysis(const Assembled& system, const ModalOptions& options = {});
 
 } // namespace jointid::fem

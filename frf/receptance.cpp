@@ -14,7 +14,7 @@ ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& m
                                const ModalSynthesisOptions& options)
     : dofs_(std::move(dofs)) {
   if (modes.status != fem::ModalStatus::success)
-    throw std::invalid_argument("modal synthesis: the modal analysis failed");
+    throw std::invalid_argument("modal synthesis: the modal analysis failed: " + modes.reason);
   const int n = system.dofs.num_equations(), m = modes.num_modes(),
             d = static_cast<int>(dofs_.size());
   for (int e : dofs_)

@@ -25,11 +25,8 @@ std::string number(double value) {
 }
 
 fem::Modes checked(fem::Modes modes) {
-  if (modes.status == fem::ModalStatus::not_converging)
-    throw std::runtime_error("modal analysis: the eigensolver did not converge");
   if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error(
-        "modal analysis: numerical issue (is the mass matrix positive definite?)");
+    throw std::runtime_error("modal analysis failed: " + modes.reason);
   return modes;
 }
 

@@ -48,7 +48,7 @@ public:
   /// residual. `notes` (if not null) receives what the user should know, e.g. "receptance from
   /// 12 of 3000 modes without residual flexibility (the model has rigid-body modes): the modes
   /// left out are ignored". Throws std::runtime_error when the modal analysis fails, saying why
-  /// (not converging; mass matrix not positive definite), std::invalid_argument for an
+  /// (its status and reason), std::invalid_argument for an
   /// equation outside the model or f_max_hz <= 0 where it is needed.
   ModalSynthesis synthesis(std::vector<int> dofs, double f_max_hz,
                            std::vector<std::string>* notes = nullptr) const;

@@ -119,8 +119,7 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
     }
     fem::Modes modes = fem::modal_analysis(system, mo);
     if (modes.status != fem::ModalStatus::success)
-      throw std::runtime_error("modal analysis failed (not converging, or a mass matrix that is "
-                               "not positive definite)");
+      throw std::runtime_error("modal analysis failed: " + modes.reason);
     int kept = 0;
     while (kept < modes.num_modes() && modes.frequency_hz(kept) < cutoff)
       ++kept;

@@ -1379,6 +1379,25 @@ std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& fu
   return tests;
 }
 
+Uff58Axis uff58_axis(identify::Quantity quantity, bool rotation) {
+  switch (quantity) {
+  case identify::Quantity::force:
+    return rotation ? Uff58Axis{uff_data_type::excitation_force, 1, 1, 0, "Moment", "N m"}
+                    : Uff58Axis{uff_data_type::excitation_force, 0, 1, 0, "Force", "N"};
+  case identify::Quantity::displacement:
+    return rotation ? Uff58Axis{uff_data_type::displacement, 0, 0, 0, "Rotation", "rad"}
+                    : Uff58Axis{uff_data_type::displacement, 1, 0, 0, "Displacement", "m"};
+  case identify::Quantity::velocity:
+    return rotation ? Uff58Axis{uff_data_type::velocity, 0, 0, 0, "Angular velocity", "rad/s"}
+                    : Uff58Axis{uff_data_type::velocity, 1, 0, 0, "Velocity", "m/s"};
+  case identify::Quantity::acceleration:
+    return rotation
+               ? Uff58Axis{uff_data_type::acceleration, 0, 0, 0, "Angular acceleration", "rad/s^2"}
+               : Uff58Axis{uff_data_type::acceleration, 1, 0, 0, "Acceleration", "m/s^2"};
+  }
+  throw std::logic_error("uff58_axis: unknown quantity");
+}
+
 std::vector<Uff58Function> uff58_from_record(const identify::Record& record) {
   const std::string name = record.source.empty() ? std::string("record") : record.source;
   const Eigen::Index n = record.t.size();
@@ -1420,27 +1439,7 @@ std::vector<Uff58Function> uff58_from_record(const identify::Record& record) {
     f.abscissa_min = record.t(0);
     f.abscissa_increment = dt;
     f.abscissa = {uff_data_type::time, 0, 0, 0, "Time", "s"};
-    switch (channel.quantity) {
-    case identify::Quantity::force:
-      f.ordinate = rotation ? Uff58Axis{uff_data_type::excitation_force, 1, 1, 0, "Moment", "N m"}
-                            : Uff58Axis{uff_data_type::excitation_force, 0, 1, 0, "Force", "N"};
-      break;
-    case identify::Quantity::displacement:
-      f.ordinate = rotation ? Uff58Axis{uff_data_type::displacement, 0, 0, 0, "Rotation", "rad"}
-                            : Uff58Axis{uff_data_type::displacement, 1, 0, 0, "Displacement", "m"};
-      break;
-    case identify::Quantity::velocity:
-      f.ordinate = rotation
-                       ? Uff58Axis{uff_data_type::velocity, 0, 0, 0, "Angular velocity", "rad/s"}
-                       : Uff58Axis{uff_data_type::velocity, 1, 0, 0, "Velocity", "m/s"};
-      break;
-    case identify::Quantity::acceleration:
-      f.ordinate =
-          rotation
-              ? Uff58Axis{uff_data_type::acceleration, 0, 0, 0, "Angular acceleration", "rad/s^2"}
-              : Uff58Axis{uff_data_type::acceleration, 1, 0, 0, "Acceleration", "m/s^2"};
-      break;
-    }
+    f.ordinate = uff58_axis(channel.quantity, rotation);
     f.data = channel.samples;
     functions.push_back(std::move(f));
   }

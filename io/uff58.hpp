@@ -191,6 +191,11 @@ void write_uff58(const std::filesystem::path& path, const std::vector<Uff58Funct
 std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& functions,
                                             const std::filesystem::path& path);
 
+/// Records 8–11 of a channel of `quantity` at a translation or rotation: data types 13/8/11/12,
+/// the exponents of the standard's Addendum A (length, force, temperature) and SI units labels
+/// ("N", "N m", "m", "rad", "m/s", "rad/s", "m/s^2", "rad/s^2").
+Uff58Axis uff58_axis(identify::Quantity quantity, bool rotation);
+
 /// A record as functions to write: one real double-precision time response per channel (type 1,
 /// response node and +direction of its DOF, no reference), even spacing with minimum t(0) and
 /// increment Record::dt(), data types 13/8/11/12 with their Addendum A exponents and SI units

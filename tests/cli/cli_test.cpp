@@ -2,6 +2,7 @@
 #include "io/cantilever_toml.hpp"
 #include "io/record_csv.hpp"
 #include "io/test_files.hpp"
+#include "io/uff58.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -106,7 +107,8 @@ TEST_F(CliTest, EveryCommandHasHelp) {
                                                {"modes", "--help"},
                                                {"response", "--help"},
                                                {"design", "--help"},
-                                               {"compare", "--help"}}) {
+                                               {"compare", "--help"},
+                                               {"frf", "--help"}}) {
     const Outcome run = jointid(args, dir());
     EXPECT_EQ(run.status, 0) << args[0];
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << run.out;
@@ -1127,6 +1129,89 @@ TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
               dir()),
       "bad_node.csv: channel x@9:uy: node 9 does not exist");
   EXPECT_FALSE(fs::exists(cmp));
+}
+
+// `jointid frf`: the static end of the tip receptance is the beam's flexibility L³/3EI at the tip
+// and 5L³/48EI at mid-span (Euler–Bernoulli, exact for cubic elements); the universal file holds
+// the numbers of the table; mobility is iω times the receptance; bad options write nothing.
+TEST_F(CliTest, FrfStartsAtTheStaticFlexibilityAndWritesTableAndUniversalFile) {
+  const fs::path out = dir() / "frf", mob = dir() / "frf_mobility";
+  const std::vector<std::string> common{
+      "frf",       model().string(), "--drive", "7:uy",     "--response",
+      "7:uy,4:uy", "--freq-range",   "0:20",    "--points", "401"};
+  std::vector<std::string> args = common;
+  args.insert(args.end(), {"-o", out.string()});
+  const Outcome run = jointid(args, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("is not in them"), std::string::npos) << run.out; // the joint
+  // The table: rows of freq_hz, then re, im per response.
+  auto table = [](const fs::path& csv) {
+    std::istringstream in(test::read_text(csv));
+    std::vector<std::vector<double>> rows;
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#' || line.rfind("freq_hz", 0) == 0) continue;
+      std::vector<double> row;
+      std::istringstream cells(line);
+      std::string cell;
+      while (std::getline(cells, cell, ','))
+        row.push_back(std::stod(cell));
+      rows.push_back(row);
+    }
+    return rows;
+  };
+  const auto rows = table(out / "frf.csv");
+  ASSERT_EQ(rows.size(), 401u);
+  const double EI = test::E * test::Iz, L3 = std::pow(test::length, 3);
+  EXPECT_NEAR(rows[0][1], L3 / (3.0 * EI), 1e-9 * L3 / (3.0 * EI));
+  EXPECT_NEAR(rows[0][3], 5.0 * L3 / (48.0 * EI), 1e-9 * L3 / (3.0 * EI));
+  EXPECT_EQ(rows[0][2], 0.0);
+  // The peak of |H| at the first natural frequency (Euler–Bernoulli, within a 0.05 Hz line).
+  const double f1 = 1.8751040687 * 1.8751040687 /
+                    (2.0 * std::numbers::pi * test::length * test::length) *
+                    std::sqrt(EI / (test::rho * test::area));
+  std::size_t peak = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (std::hypot(rows[i][1], rows[i][2]) > std::hypot(rows[peak][1], rows[peak][2])) peak = i;
+  EXPECT_NEAR(rows[peak][0], f1, 0.05);
+  // The universal file: the same numbers.
+  const auto functions = io::read_uff58(out / "frf.uff");
+  ASSERT_EQ(functions.size(), 2u);
+  EXPECT_EQ(functions[1].response_node, 4);
+  EXPECT_EQ(functions[1].reference_node, 7);
+  for (std::size_t i = 0; i < rows.size(); i += 50) {
+    EXPECT_EQ(functions[0].complex_data(static_cast<Eigen::Index>(i)).real(), rows[i][1]);
+    EXPECT_EQ(functions[1].complex_data(static_cast<Eigen::Index>(i)).imag(), rows[i][4]);
+  }
+#if JOINTID_WITH_VTK
+  EXPECT_TRUE(fs::exists(out / "frf.png")) << run.out << run.err;
+#endif
+  // Mobility: iω times the receptance.
+  args = common;
+  args.insert(args.end(), {"--kind", "mobility", "--no-plot", "-o", mob.string()});
+  ASSERT_EQ(jointid(args, dir()).status, 0);
+  const auto mobility = table(mob / "frf.csv");
+  ASSERT_EQ(mobility.size(), rows.size());
+  for (std::size_t i = 0; i < rows.size(); i += 40) {
+    const double w = 2.0 * std::numbers::pi * rows[i][0];
+    const double scale = std::max(1e-300, w * std::hypot(rows[i][1], rows[i][2]));
+    EXPECT_NEAR(mobility[i][1], -w * rows[i][2], 1e-12 * scale);
+    EXPECT_NEAR(mobility[i][2], w * rows[i][1], 1e-12 * scale);
+  }
+  EXPECT_FALSE(fs::exists(mob / "frf.png"));
+  // Bad options: one line naming the option, nothing written.
+  const fs::path bad = dir() / "frf_bad";
+  auto fails = [&](const std::vector<std::string>& extra, const std::string& part) {
+    std::vector<std::string> a{"frf", model().string(), "--no-plot", "-o", bad.string()};
+    a.insert(a.end(), extra.begin(), extra.end());
+    expect_one_line_error(jointid(a, dir()), part);
+  };
+  fails({"--drive", "7:uy", "--freq-range", "5:1"}, "--freq-range");
+  fails({"--drive", "7:uy", "--freq-range", "0:10", "--points", "1"}, "--points: expected 2");
+  fails({"--drive", "7:uy", "--freq-range", "0:10", "--kind", "inertance"}, "--kind");
+  fails({"--drive", "9:uy", "--freq-range", "0:10"}, "--drive 9:uy");
+  fails({"--drive", "7:uy", "--freq-range", "0:10", "--response", "4:uy,4:uy"}, "listed twice");
+  EXPECT_FALSE(fs::exists(bad));
 }
 
 } // namespace

@@ -260,7 +260,7 @@ TEST(Modal, FrequencyBandReturnsExactlyTheModesBelowIt) {
   }
 }
 
-TEST(Modal, BadOptionsThrowAndMasslessDofIsANumericalIssue) {
+TEST(Modal, BadOptionsThrow) {
   const fem::Assembled s = fem::assemble(test::cantilever(3, {}));
   fem::ModalOptions o;
   o.num_modes = 7; // 6 equations
@@ -270,31 +270,105 @@ TEST(Modal, BadOptionsThrowAndMasslessDofIsANumericalIssue) {
   o.num_modes = 0;
   o.engine = ModalEngine::sparse;
   EXPECT_THROW(fem::modal_analysis(s, o), std::invalid_argument);
-  // A spring without a mass: M is singular, which is a numerical outcome, not success.
+}
+
+// A lumped mass matrix without rotary inertia: the rotations are massless. Both engines must
+// give the modes of the statically condensed model (rotations eliminated from K, exact for a
+// massless DOF): ω² from K* = Ktt − Ktr Krr⁻¹ Krt with Mtt, and φr = −Krr⁻¹ Krt φt.
+TEST(Modal, MasslessRotationsGiveTheCondensedModelsModes) {
+  fem::Assembled s = fem::assemble(test::cantilever(60, {}));
+  const int n = s.dofs.num_equations();
+  std::vector<int> t, r; // translations (mass), rotations (none)
+  Eigen::VectorXd lumped = Eigen::VectorXd::Zero(n);
+  const Eigen::MatrixXd M(s.M);
+  for (int e = 0; e < n; ++e) {
+    if (s.dofs.node_dof(e).dof == fem::Dof::rz) {
+      r.push_back(e);
+    } else {
+      t.push_back(e);
+      for (int j = 0; j < n; ++j) // the row sum of the translational part: a lumped mass
+        if (s.dofs.node_dof(j).dof != fem::Dof::rz) lumped(e) += M(e, j);
+    }
+  }
+  ASSERT_EQ(r.size(), t.size());
+  s.M = fem::SparseMatrix(lumped.asDiagonal());
+  const Eigen::MatrixXd K(s.K);
+  const auto nt = static_cast<Eigen::Index>(t.size());
+  Eigen::MatrixXd Ktt(nt, nt), Ktr(nt, nt), Krr(nt, nt), Mtt = Eigen::MatrixXd::Zero(nt, nt);
+  for (Eigen::Index i = 0; i < nt; ++i) {
+    Mtt(i, i) = lumped(t[i]);
+    for (Eigen::Index j = 0; j < nt; ++j) {
+      Ktt(i, j) = K(t[i], t[j]);
+      Ktr(i, j) = K(t[i], r[j]);
+      Krr(i, j) = K(r[i], r[j]);
+    }
+  }
+  const Eigen::LLT<Eigen::MatrixXd> Krr_llt(Krr);
+  const Eigen::MatrixXd condensed = Ktt - Ktr * Krr_llt.solve(Ktr.transpose());
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> reference(condensed, Mtt);
+  const int count = 6;
+  for (const ModalEngine engine : {ModalEngine::dense, ModalEngine::sparse}) {
+    fem::ModalOptions o;
+    o.num_modes = count;
+    o.engine = engine;
+    const fem::Modes m = fem::modal_analysis(s, o);
+    ASSERT_EQ(m.status, fem::ModalStatus::success) << m.reason;
+    ASSERT_EQ(m.num_modes(), count);
+    // ΦᵀMΦ = I (rounding level: the solvers' accuracy, eps times the spread of the spectrum).
+    const Eigen::MatrixXd gram = m.phi.transpose() * (s.M * m.phi);
+    EXPECT_LT((gram - Eigen::MatrixXd::Identity(count, count)).cwiseAbs().maxCoeff(), 1e-9);
+    for (int k = 0; k < count; ++k) {
+      // Backward-stable solvers (and the condensation) err by ~eps·λ_max absolute; the sparse
+      // engine's Lanczos tolerance is 1e-10 relative.
+      const double lambda = reference.eigenvalues()(k);
+      const double lambda_max = reference.eigenvalues()(nt - 1);
+      EXPECT_NEAR(m.omega(k) * m.omega(k), lambda, 1e-10 * lambda + 100.0 * eps * lambda_max)
+          << "engine " << static_cast<int>(engine) << ", mode " << k + 1;
+      Eigen::VectorXd phi_t(nt), phi_r(nt);
+      for (Eigen::Index i = 0; i < nt; ++i) {
+        phi_t(i) = m.phi(t[i], k);
+        phi_r(i) = m.phi(r[i], k);
+      }
+      const Eigen::VectorXd expected = reference.eigenvectors().col(k);
+      const double sign = phi_t.dot(expected) < 0.0 ? -1.0 : 1.0;
+      EXPECT_LT((sign * phi_t - expected).norm(), 1e-7 * expected.norm());
+      const Eigen::VectorXd condensed_r = -Krr_llt.solve(Ktr.transpose() * phi_t);
+      EXPECT_LT((phi_r - condensed_r).norm(), 1e-7 * condensed_r.norm());
+    }
+  }
+  // All modes of the dense engine: only the finite ones, as many as the massive DOFs.
+  fem::ModalOptions all;
+  all.num_modes = 0;
+  all.engine = ModalEngine::dense;
+  EXPECT_EQ(fem::modal_analysis(s, all).num_modes(), nt);
+}
+
+TEST(Modal, BothEnginesNameTheDofThatIsNeitherStiffNorHeavy) {
+  // A spring of zero stiffness to a massless node: K − σM has a zero row at 99:uy.
+  fem::Model m = test::cantilever(10, {});
+  m.nodes.push_back({99, Eigen::Vector3d(5.0, 5.0, 0.0)});
+  m.springs.push_back({99, 0, fem::Dof::uy, 0.0});
+  for (const ModalEngine engine : {ModalEngine::dense, ModalEngine::sparse}) {
+    fem::ModalOptions o;
+    o.num_modes = 3;
+    o.engine = engine;
+    try {
+      fem::modal_analysis(fem::assemble(m), o);
+      FAIL() << "no error";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("99:uy"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
+    }
+  }
+  // A spring without a mass and nothing else: no finite mode at all, an empty result.
   fem::Model massless = test::oscillator(1.0, 100.0);
   massless.masses.clear();
   fem::ModalOptions dense;
   dense.num_modes = 0;
   dense.engine = ModalEngine::dense;
-  EXPECT_EQ(fem::modal_analysis(fem::assemble(massless), dense).status,
-            fem::ModalStatus::numerical_issue);
-}
-
-TEST(Modal, SparseEngineNamesTheDofThatIsNeitherStiffNorHeavy) {
-  // A spring of zero stiffness to a massless node: K − σM has a zero row at 99:uy.
-  fem::Model m = test::cantilever(10, {});
-  m.nodes.push_back({99, Eigen::Vector3d(5.0, 5.0, 0.0)});
-  m.springs.push_back({99, 0, fem::Dof::uy, 0.0});
-  fem::ModalOptions o;
-  o.num_modes = 3;
-  o.engine = ModalEngine::sparse;
-  try {
-    fem::modal_analysis(fem::assemble(m), o);
-    FAIL() << "no error";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("99:uy"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
-  }
+  const fem::Modes none = fem::modal_analysis(fem::assemble(massless), dense);
+  EXPECT_EQ(none.status, fem::ModalStatus::success);
+  EXPECT_EQ(none.num_modes(), 0);
 }
 
 TEST(Modal, BandNeedingASecondPassFindsEveryMode) {

@@ -81,6 +81,40 @@ TEST(Substructure, SmallFEModelUsesEveryMode) {
   }
 }
 
+TEST(Substructure, MasslessRotationsGetTheirStaticFlexibility) {
+  // A cantilever whose mass matrix is lumped on the translations only: the rotations have no
+  // mass, so no finite mode. The synthesis from the finite modes plus the residual flexibility
+  // K⁻¹ − Σ φφᵀ/ω² must equal the direct solve at a translation and at a massless rotation
+  // (exactly so with mass-proportional damping: the missing "infinite" modes are undamped).
+  fem::Assembled system = fem::assemble(test::cantilever(12, {}));
+  const int n = system.dofs.num_equations();
+  Eigen::VectorXd lumped = Eigen::VectorXd::Zero(n);
+  const Eigen::MatrixXd M(system.M);
+  for (int e = 0; e < n; ++e)
+    if (system.dofs.node_dof(e).dof != Dof::rz)
+      for (int j = 0; j < n; ++j)
+        if (system.dofs.node_dof(j).dof != Dof::rz) lumped(e) += M(e, j);
+  system.M = fem::SparseMatrix(lumped.asDiagonal());
+  fem::Damping damping;
+  damping.kind = fem::Damping::Kind::rayleigh;
+  damping.alpha = 0.5;
+  const frf::Substructure sub(system, damping);
+  const std::vector<int> dofs{system.dofs.equation({13, Dof::uy}),
+                              system.dofs.equation({13, Dof::rz}),
+                              system.dofs.equation({7, Dof::rz})};
+  const frf::ModalSynthesis H = sub.synthesis(dofs, 0.0);
+  EXPECT_EQ(H.num_modes(), n / 2);
+  EXPECT_TRUE(H.has_residual());
+  const fem::SparseMatrix C = sub.damping_matrix();
+  for (double f : {0.0, 2.0, 18.0, 150.0}) {
+    const double w = two_pi * f;
+    EXPECT_LE(relative_difference(H.receptance(w, dofs, dofs),
+                                  frf::direct_receptance(system, C, w, dofs, dofs)),
+              1e-9)
+        << f << " Hz";
+  }
+}
+
 TEST(Substructure, LargeFEModelUsesTheModesBelowFmaxWithResidual) {
   // 1600 equations: the sparse engine's modes below 30 Hz (the cantilever's first three,
   // 3.0, 18.8 and 52.7 Hz for 2 m: two of them) plus residual flexibility.
