@@ -241,8 +241,8 @@ void simulate_signal(const SimulateOptions& o) {
     throw io::Error(fmt::format("--substeps: expected at least 1, got {}", o.substeps));
   if (!(std::isfinite(o.modal_cutoff) && o.modal_cutoff >= 0.0))
     throw io::Error(fmt::format("--modal-cutoff: expected >= 0 Hz, got {}", o.modal_cutoff));
-  if (!std::isfinite(o.fade_in))
-    throw io::Error(fmt::format("--fade-in: expected seconds >= 0, got {}", o.fade_in));
+  if (o.fade_in && !(std::isfinite(*o.fade_in) && *o.fade_in >= 0.0))
+    throw io::Error(fmt::format("--fade-in: expected seconds >= 0, got {}", *o.fade_in));
   check_noise(o.noise);
   identify::ForcedOptions options;
   options.quantities = parse_channels(o.channels);
@@ -284,7 +284,7 @@ void simulate_signal(const SimulateOptions& o) {
   // Default: 5 % of the duration, none for a record's force that already starts at zero.
   const bool starts_at_zero =
       input.samples.row(0).cwiseAbs().maxCoeff() <= 1e-9 * input.samples.cwiseAbs().maxCoeff();
-  const double fade = o.fade_in >= 0.0                ? o.fade_in
+  const double fade = o.fade_in                       ? *o.fade_in
                       : from_record && starts_at_zero ? 0.0
                                                       : 0.05 * duration;
   if (!(fade >= 0.0 && fade < duration))
@@ -607,11 +607,21 @@ void modes(const ModesOptions& o) {
   options.num_modes = count;
   const fem::Modes modes =
       compute_modes(file.model, sub ? sub->system() : nullptr, options, engine);
-  if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error(modes.status == fem::ModalStatus::not_converging
-                                 ? "modal analysis did not converge"
-                                 : "modal analysis failed: the mass matrix is not positive "
-                                   "definite (a DOF without mass?)");
+  if (modes.status == fem::ModalStatus::not_converging)
+    throw std::runtime_error("modal analysis did not converge");
+  if (modes.status != fem::ModalStatus::success) {
+    // Name the first DOF without mass, the usual cause.
+    std::string cause = " (a DOF without mass?)";
+    if (sub && sub->system())
+      for (int i = 0; i < sub->dofs().num_equations(); ++i)
+        if (!(sub->system()->M.coeff(i, i) > 0.0)) {
+          cause = fmt::format(": {} has no mass (give it one with [[masses]], or hold it fixed)",
+                              fem::to_string(sub->dofs().node_dof(i)));
+          break;
+        }
+    throw std::runtime_error("modal analysis failed: the mass matrix is not positive definite" +
+                             cause);
+  }
   if (!output_rank()) return;
   if (!sub) sub.emplace(file.substructure());
   const fem::Assembled& system = *sub->system();
@@ -925,9 +935,9 @@ void compare(const CompareOptions& o) {
     throw io::Error(
         fmt::format("--segment: expected at least 8 samples (or 0: automatic), got {}", o.segment));
   options.segment = o.segment;
-  if (!std::isfinite(o.skip))
-    throw io::Error(fmt::format("--skip: expected seconds >= 0, got {}", o.skip));
-  options.skip_s = o.skip;
+  if (o.skip && !(std::isfinite(*o.skip) && *o.skip >= 0.0))
+    throw io::Error(fmt::format("--skip: expected seconds >= 0, got {}", *o.skip));
+  options.skip_s = o.skip.value_or(-1.0); // < 0: the library's default, 10 % of the record
   options.simulation.route = parse_route(o.route);
   if (o.substeps < 1)
     throw io::Error(fmt::format("--substeps: expected at least 1, got {}", o.substeps));

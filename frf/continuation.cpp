@@ -173,7 +173,7 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
   // bound), and at least 16 steps per period of the highest harmonic.
   const int probe = 16 * (K + 1);
   double gy_max = 0.0, gv_max = 0.0;
-  for (int i = 0; i < probe; ++i) {
+  for (int i = 0; i < probe && nj > 0; ++i) { // no joints (a linear substructure): no bound
     sample(T * i / probe);
     gy_max = std::max(gy_max, gy.cwiseAbs().maxCoeff());
     gv_max = std::max(gv_max, gv.cwiseAbs().maxCoeff());

@@ -1129,5 +1129,238 @@ TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
   EXPECT_FALSE(fs::exists(cmp));
 }
 
+// Options out of range, of every command: refused before any input is read, one line naming the
+// option, what it expects and what it got; nothing written.
+TEST_F(CliTest, OptionsOutOfRangeAreNamedBeforeAnythingIsRead) {
+  const fs::path out = dir() / "never_written";
+  const std::string model_path = model().string(), rec = record_files()[0];
+  auto sine = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"simulate", model_path,    "--force", "7:uy", "--freq",
+                                  "3",        "--amplitude", "10",      "-o",   out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  expect_one_line_error(sine({"--periods", "0"}), "jointid: --periods: expected at least 1, got 0");
+  expect_one_line_error(sine({"--steps-per-period", "4"}),
+                        "jointid: --steps-per-period: expected at least 8, got 4");
+  expect_one_line_error(sine({"--steps-per-period", "64", "--samples-per-period", "48"}),
+                        "jointid: --samples-per-period: expected at least 8 and a divisor of "
+                        "--steps-per-period (64), got 48");
+  expect_one_line_error(sine({"--method", "hb", "--harmonics", "0"}),
+                        "jointid: --harmonics: expected at least 1, got 0");
+  expect_one_line_error(sine({"--channels", "x,v,x"}), "jointid: --channels: x is listed twice");
+  expect_one_line_error(sine({"--channels", "x,d"}),
+                        "jointid: --channels: expected x, v or a, got \"d\"");
+  auto random = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"simulate",      model_path, "--force",    "7:uy",
+                                  "--excitation",  "random",   "--band",     "2:40",
+                                  "--rms",         "1",        "--duration", "2",
+                                  "--sample-rate", "256",      "-o",         out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  expect_one_line_error(random({"--substeps", "0"}),
+                        "jointid: --substeps: expected at least 1, got 0");
+  expect_one_line_error(random({"--modal-cutoff=-1"}),
+                        "jointid: --modal-cutoff: expected >= 0 Hz, got -1");
+  // A negative fade-in was taken for "not given" (5 % of the duration) without a word.
+  expect_one_line_error(random({"--fade-in=-0.5"}),
+                        "jointid: --fade-in: expected seconds >= 0, got -0.5");
+  expect_one_line_error(random({"--fade-in", "3"}),
+                        "jointid: --fade-in: expected 0 to below the duration (2 s), got 3");
+
+  const fs::path result = out / "result.json";
+  expect_one_line_error(
+      jointid({"identify", model_path, rec, "--harmonics", "1,51", "-o", result.string()}, dir()),
+      "jointid: --harmonics: expected harmonics from 0 to 50, got 51");
+  expect_one_line_error(
+      jointid({"identify", model_path, rec, "--harmonics", "1,3,1", "-o", result.string()}, dir()),
+      "jointid: --harmonics: harmonic 1 is listed twice");
+  expect_one_line_error(
+      jointid({"discover", model_path, rec, "--max-steps", "0", "-o", out.string()}, dir()),
+      "jointid: --max-steps: expected at least 1, got 0");
+  expect_one_line_error(
+      jointid({"modes", model_path, "--count", "0", "--pictures", "0", "-o", out.string()}, dir()),
+      "jointid: --count: expected at least 1, got 0");
+  for (const std::string k : {"0", "201"})
+    expect_one_line_error(
+        jointid({"response", model_path, "--force", "7:uy", "--amplitude", "10", "--freq-range",
+                 "2:4", "--harmonics", k, "--no-plot", "-o", out.string()},
+                dir()),
+        "jointid: --harmonics: expected 1 to 200, got " + k);
+
+  auto design = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"design", model_path, "--force", "7:uy",
+                                  "-n",     "1",        "-o",      out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  const std::vector<std::string> grid{"--freq", "2,3", "--amplitude", "10"};
+  auto with_grid = [&](std::vector<std::string> extra) {
+    extra.insert(extra.begin(), grid.begin(), grid.end());
+    return extra;
+  };
+  expect_one_line_error(design(with_grid({"--harmonics", "1,60"})),
+                        "jointid: --harmonics: expected harmonics from 0 to 50, got 60");
+  expect_one_line_error(design(with_grid({"--harmonics", "3,3"})),
+                        "jointid: --harmonics: harmonic 3 is listed twice");
+  expect_one_line_error(design(with_grid({"--max-misfit", "0"})),
+                        "jointid: --max-misfit: expected a number > 0 (noise standard "
+                        "deviations), got 0");
+  expect_one_line_error(design(with_grid({"--balance-harmonics", "0"})),
+                        "jointid: --balance-harmonics: expected 1 to 200, got 0");
+  expect_one_line_error(design({"--freq", "1:0.0001:3", "--amplitude", "10"}),
+                        "jointid: --freq 1:0.0001:3: more than 10000 values");
+  expect_one_line_error(design({"--freq", "2,3", "--amplitude", "1:0.001:100"}),
+                        "jointid: --amplitude 1:0.001:100: more than 10000 values");
+
+  auto compare = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"compare", model_path, rec, "--no-plot", "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  // A negative --skip was taken for "not given" (10 % of the record) without a word.
+  expect_one_line_error(compare({"--skip=-1"}), "jointid: --skip: expected seconds >= 0, got -1");
+  expect_one_line_error(compare({"--substeps", "0"}),
+                        "jointid: --substeps: expected at least 1, got 0");
+  expect_one_line_error(compare({"--modal-cutoff=-2"}),
+                        "jointid: --modal-cutoff: expected >= 0 Hz, got -2");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(CliTest, OutputOfTheWrongKindIsRefused) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  // simulate writes into a directory: an existing file there is not one.
+  const fs::path file = dir() / "a_file.txt";
+  test::write_text(file, "keep\n");
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3",
+                                 "--amplitude", "10", "-o", file.string()},
+                                dir()),
+                        "jointid: -o " + file.string() + ": exists and is not a directory");
+  EXPECT_EQ(test::read_text(file), "keep\n");
+  // identify writes a file: an existing directory is not one.
+  const fs::path directory = dir() / "a_directory";
+  fs::create_directories(directory);
+  std::vector<std::string> args{"identify", model().string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"-o", directory.string()});
+  expect_one_line_error(jointid(args, dir()), "jointid: -o " + directory.string() +
+                                                  ": expected a file name, got a directory");
+  EXPECT_TRUE(fs::is_empty(directory));
+}
+
+TEST_F(CliTest, AModelWithoutJointsIsNamed) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const std::string text = test::cantilever_toml();
+  const fs::path linear = dir() / "no_joints.toml";
+  test::write_text(linear, text.substr(0, text.find("[[joints]]")));
+  const fs::path out = dir() / "no_joints_out";
+  const std::string rec = record_files()[0];
+  expect_one_line_error(
+      jointid({"identify", linear.string(), rec, "-o", (dir() / "no_joints.json").string()}, dir()),
+      "jointid: " + linear.string() + ": no [[joints]] to identify");
+  expect_one_line_error(jointid({"discover", linear.string(), rec, "-o", out.string()}, dir()),
+                        "jointid: " + linear.string() +
+                            ": no [[joints]]: discovery starts from the joints' terms");
+  expect_one_line_error(jointid({"design", linear.string(), "--force", "7:uy", "--freq", "2,3",
+                                 "--amplitude", "10", "-n", "1", "-o", out.string()},
+                                dir()),
+                        "jointid: " + linear.string() +
+                            ": no [[joints]]: nothing to design tests for");
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir() / "no_joints.json"));
+  // response goes on with the linear substructure, and says so (it crashed in the stability
+  // check of each point before).
+  const Outcome run = jointid({"response", linear.string(), "--force", "7:uy", "--amplitude", "10",
+                               "--freq-range", "2:4", "--no-plot", "-o", out.string()},
+                              dir());
+  EXPECT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("jointid: warning: " + linear.string() +
+                         ": no [[joints]]: the response is the linear substructure's\n"),
+            std::string::npos)
+      << run.err;
+  EXPECT_TRUE(fs::exists(out / "response.json"));
+}
+
+TEST_F(CliTest, ModesOfAMechanismWarnAndAMasslessDofIsNamed) {
+  // The cantilever pinned instead of clamped (rz free at node 1): it swings about the pin.
+  const fs::path pinned = dir() / "pinned.toml";
+  test::write_text(pinned, test::replaced(test::cantilever_toml(), "fix = [\"ux\", \"uy\", \"rz\"]",
+                                          "fix = [\"ux\", \"uy\"]"));
+  const fs::path out = dir() / "modes_pinned";
+  const Outcome run =
+      jointid({"modes", pinned.string(), "--pictures", "0", "-o", out.string()}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  // "Largest motion" ranks the DOFs by their share of the mode's kinetic energy: node 6 carries
+  // twice the tip's mass at 5/6 of its motion.
+  const std::string warning =
+      "mechanism: 1 zero-frequency mode although the model is supported; it cannot carry load "
+      "in that shape (largest motion at 6:uy): add supports, stiffer connections or springs";
+  EXPECT_NE(run.err.find("jointid: warning: " + warning + "\n"), std::string::npos) << run.err;
+  const json j = json::parse(test::read_text(out / "modes.json"));
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_EQ(j["warnings"][0], warning);
+
+  // A node held by a spring alone has no mass: M is singular (dense engine).
+  std::string text =
+      test::replaced(test::cantilever_toml(), "[7, 2, 0.0]]", "[7, 2, 0.0], [8, 2.5, 0.0]]");
+  text += "\n[[springs]]\nnode = 8\ndof = \"uy\"\nstiffness = 1000.0\n";
+  const fs::path massless = dir() / "massless.toml";
+  test::write_text(massless, text);
+  const fs::path never = dir() / "modes_massless";
+  expect_one_line_error(jointid({"modes", massless.string(), "--engine", "dense", "--pictures", "0",
+                                 "-o", never.string()},
+                                dir()),
+                        "jointid: modal analysis failed: the mass matrix is not positive definite: "
+                        "8:uy has no mass");
+  EXPECT_FALSE(fs::exists(never));
+}
+
+TEST_F(CliTest, SimulateWarnsAboutARecordThatIsNotPeriodic) {
+  // Without damping (no modal damping, a joint of stiffness only) the start from rest never
+  // dies out: after the most periods time integration runs (4000) the record is not periodic.
+  std::string text = test::replaced(test::cantilever_toml(), "modal = 0.01", "modal = 0.0");
+  text = test::replaced(text, "terms = [\"k\", \"c\", \"k3\"]", "terms = [\"k\"]");
+  text = test::replaced(text, "values = { k = 4800.0, c = 20.0, k3 = 1.6e8 }",
+                        "values = { k = 4800.0 }");
+  const fs::path undamped = dir() / "undamped.toml";
+  test::write_text(undamped, text);
+  const fs::path out = dir() / "undamped_records";
+  const Outcome run =
+      jointid({"simulate", undamped.string(), "--force", "7:uy", "--freq", "3", "--amplitude", "10",
+               "--steps-per-period", "32", "--periods", "2", "-o", out.string()},
+              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const std::string warning =
+      "sine_f3Hz_F10N.csv: not a periodic steady state after 4000 periods (last period-to-period "
+      "change ";
+  EXPECT_NE(run.err.find("jointid: warning: " + warning), std::string::npos) << run.err;
+  // The record is written, and says so itself.
+  const std::string record = test::read_text(out / "sine_f3Hz_F10N.csv");
+  EXPECT_NE(record.find("# WARNING: " + warning), std::string::npos) << record.substr(0, 600);
+  EXPECT_NE(record.find("NOT periodic"), std::string::npos) << record.substr(0, 600);
+}
+
+TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  // A second joint at the tip with a stiffness of its own: the two k act alike in every test.
+  const fs::path twin = dir() / "twin.toml";
+  test::write_text(twin, test::cantilever_toml() +
+                             "\n[[joints]]\nname = \"twin\"\nnode = 7\ndof = \"uy\"\n"
+                             "terms = [\"k\"]\nvalues = { k = 100.0 }\n");
+  const fs::path result = dir() / "twin.json";
+  std::vector<std::string> args{"identify", twin.string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"-o", result.string()});
+  const Outcome run = jointid(args, dir());
+  expect_one_line_error(run, "jointid: identify: the unknowns cannot be separated by these tests "
+                             "(condition number ");
+  EXPECT_NE(run.err.find("); term k of 'tip' is a combination of the others: "), std::string::npos)
+      << run.err;
+  EXPECT_FALSE(fs::exists(result));
+}
+
 } // namespace
 } // namespace jointid
