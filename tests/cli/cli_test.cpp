@@ -1342,6 +1342,25 @@ TEST_F(CliTest, SimulateWarnsAboutARecordThatIsNotPeriodic) {
   EXPECT_NE(record.find("NOT periodic"), std::string::npos) << record.substr(0, 600);
 }
 
+TEST_F(CliTest, JointsNewtonFailureStopsTheSimulation) {
+  // A softening cubic (k3 < 0) driven hard: the tip runs away from rest, the joint force
+  // overflows and its Newton iteration fails. Nothing is written.
+  const fs::path soft = dir() / "softening.toml";
+  test::write_text(soft, test::replaced(test::cantilever_toml(), "k3 = 1.6e8", "k3 = -1.6e8"));
+  const fs::path out = dir() / "softening_records";
+  expect_one_line_error(
+      jointid({"simulate", soft.string(), "--force", "7:uy", "--freq", "3", "--amplitude", "80",
+               "--steps-per-period", "64", "--periods", "2", "-o", out.string()},
+              dir()),
+      "jointid: time integration at 3 Hz, 80 N: the joints' Newton iteration failed in period 1");
+  expect_one_line_error(jointid({"simulate", soft.string(), "--force", "7:uy", "--excitation",
+                                 "random", "--band", "2:10", "--rms", "300", "--duration", "4",
+                                 "--sample-rate", "128", "-o", out.string()},
+                                dir()),
+                        "jointid: time simulation: the joints' Newton iteration failed after t = ");
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
   ASSERT_EQ(simulate_.status, 0) << simulate_.err;
   // A second joint at the tip with a stiffness of its own: the two k act alike in every test.

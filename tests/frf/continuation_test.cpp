@@ -290,6 +290,22 @@ TEST(Continuation, IncompleteBranchesSayWhereAndWhy) {
   ASSERT_EQ(none.notes.size(), 1u);
   EXPECT_EQ(none.notes[0].rfind("no steady state found at the start, 3 Hz (residual ", 0), 0u)
       << none.notes[0];
+  // A stall: at 10 N the branch climbs towards its upper fold, where steps of at least 0.02
+  // (scaled arclength) with 4 Newton iterations no longer converge.
+  frf::ContinuationOptions coarse;
+  coarse.hb.max_iterations = 4;
+  coarse.initial_step = coarse.min_step = 0.02;
+  coarse.max_step = 0.05;
+  const frf::ResponseBranch stalled = trace(c, js, 10.0, 2.0, 4.5, coarse);
+  EXPECT_FALSE(stalled.complete);
+  ASSERT_FALSE(stalled.points.empty());
+  ASSERT_EQ(stalled.notes.size(), 1u);
+  std::ostringstream where;
+  where.precision(6);
+  where << stalled.points.back().hb.frequency_hz;
+  EXPECT_EQ(stalled.notes[0],
+            "continuation stalled at " + where.str() + " Hz: no step down to 0.02 converged");
+  EXPECT_GT(stalled.points.back().hb.frequency_hz, 3.0);
 }
 
 TEST(Continuation, BadArgumentsThrow) {
