@@ -1361,6 +1361,61 @@ TEST_F(CliTest, JointsNewtonFailureStopsTheSimulation) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST_F(CliTest, HarmonicBalanceWithoutASolutionIsNamedBySimulateDesignAndResponse) {
+  // The softening cubic at 5000 N, 3 Hz: no periodic response the harmonic balance can reach.
+  const fs::path soft = dir() / "softening_hb.toml";
+  test::write_text(soft, test::replaced(test::cantilever_toml(), "k3 = 1.6e8", "k3 = -1.6e8"));
+  const fs::path out = dir() / "softening_hb";
+  const Outcome sim =
+      jointid({"simulate", soft.string(), "--force", "7:uy", "--freq", "3", "--amplitude", "5000",
+               "--method", "hb", "--steps-per-period", "64", "--periods", "2", "-o", out.string()},
+              dir());
+  expect_one_line_error(sim, "jointid: harmonic balance at 3 Hz, 5000 N: no periodic solution "
+                             "found (no convergence: relative residual ");
+  EXPECT_NE(sim.err.find("); simulate this test by time integration\n"), std::string::npos)
+      << sim.err;
+  EXPECT_FALSE(fs::exists(out));
+  // design leaves that candidate out, says so, and gives the reason in design.json.
+  const Outcome run = jointid({"design", soft.string(), "--force", "7:uy", "--freq", "2,3",
+                               "--amplitude", "10,5000", "-n", "3", "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("jointid: warning: 1 of 4 candidates left out: no periodic solution at "
+                         "the model's values"),
+            std::string::npos)
+      << run.err;
+  const json j = json::parse(test::read_text(out / "design.json"));
+  int left_out = 0;
+  for (const json& c : j["candidates"])
+    if (!c["usable"].get<bool>()) {
+      ++left_out;
+      EXPECT_EQ(c["freq_hz"], 3.0);
+      EXPECT_EQ(c["amplitude"], 5000.0);
+      EXPECT_EQ(c["reason"].get<std::string>().rfind(
+                    "sine_f3Hz_F5000N.csv: no periodic solution found (no convergence: relative "
+                    "residual ",
+                    0),
+                0u)
+          << c["reason"];
+    }
+  EXPECT_EQ(left_out, 1);
+  // response: the branch has no start; the curve is written incomplete, with a warning.
+  const fs::path curves = dir() / "softening_response";
+  const Outcome resp = jointid({"response", soft.string(), "--force", "7:uy", "--amplitude", "5000",
+                                "--freq-range", "3:4", "--no-plot", "-o", curves.string()},
+                               dir());
+  ASSERT_EQ(resp.status, 0) << resp.err;
+  EXPECT_NE(resp.err.find("jointid: warning: 5000 N: no steady state found at the start, 3 Hz "
+                          "(residual "),
+            std::string::npos)
+      << resp.err;
+  EXPECT_NE(resp.out.find("5000 N: 0 points, 0 folds, 0 unstable (incomplete)"), std::string::npos)
+      << resp.out;
+  const json r = json::parse(test::read_text(curves / "response.json"));
+  ASSERT_EQ(r["curves"].size(), 1u);
+  EXPECT_FALSE(r["curves"][0]["complete"].get<bool>());
+}
+
 TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
   ASSERT_EQ(simulate_.status, 0) << simulate_.err;
   // A second joint at the tip with a stiffness of its own: the two k act alike in every test.
