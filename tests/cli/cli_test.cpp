@@ -1292,11 +1292,13 @@ TEST_F(CliTest, ModesOfAMechanismWarnAndAMasslessDofIsNamed) {
   const Outcome run =
       jointid({"modes", pinned.string(), "--pictures", "0", "-o", out.string()}, dir());
   ASSERT_EQ(run.status, 0) << run.err;
-  // "Largest motion" ranks the DOFs by their share of the mode's kinetic energy: node 6 carries
-  // twice the tip's mass at 5/6 of its motion.
+  // The DOFs are ranked by their share of the mode's kinetic energy: node 6 carries twice the
+  // tip's mass at 5/6 of its motion. (The message said "largest motion at 6:uy", where the tip
+  // moves farther.)
   const std::string warning =
       "mechanism: 1 zero-frequency mode although the model is supported; it cannot carry load "
-      "in that shape (largest motion at 6:uy): add supports, stiffer connections or springs";
+      "in that shape (most of its kinetic energy at 6:uy): add supports, stiffer connections or "
+      "springs";
   EXPECT_NE(run.err.find("jointid: warning: " + warning + "\n"), std::string::npos) << run.err;
   const json j = json::parse(test::read_text(out / "modes.json"));
   ASSERT_EQ(j["warnings"].size(), 1u);
