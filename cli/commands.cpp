@@ -243,8 +243,8 @@ void simulate_signal(const SimulateOptions& o) {
     throw io::Error(fmt::format("--substeps: expected at least 1, got {}", o.substeps));
   if (!(std::isfinite(o.modal_cutoff) && o.modal_cutoff >= 0.0))
     throw io::Error(fmt::format("--modal-cutoff: expected >= 0 Hz, got {}", o.modal_cutoff));
-  if (!std::isfinite(o.fade_in))
-    throw io::Error(fmt::format("--fade-in: expected seconds >= 0, got {}", o.fade_in));
+  if (o.fade_in && !(std::isfinite(*o.fade_in) && *o.fade_in >= 0.0))
+    throw io::Error(fmt::format("--fade-in: expected seconds >= 0, got {}", *o.fade_in));
   check_noise(o.noise);
   identify::ForcedOptions options;
   options.quantities = parse_channels(o.channels);
@@ -286,7 +286,7 @@ void simulate_signal(const SimulateOptions& o) {
   // Default: 5 % of the duration, none for a record's force that already starts at zero.
   const bool starts_at_zero =
       input.samples.row(0).cwiseAbs().maxCoeff() <= 1e-9 * input.samples.cwiseAbs().maxCoeff();
-  const double fade = o.fade_in >= 0.0                ? o.fade_in
+  const double fade = o.fade_in                       ? *o.fade_in
                       : from_record && starts_at_zero ? 0.0
                                                       : 0.05 * duration;
   if (!(fade >= 0.0 && fade < duration))
@@ -998,9 +998,9 @@ void compare(const CompareOptions& o) {
     throw io::Error(
         fmt::format("--segment: expected at least 8 samples (or 0: automatic), got {}", o.segment));
   options.segment = o.segment;
-  if (!std::isfinite(o.skip))
-    throw io::Error(fmt::format("--skip: expected seconds >= 0, got {}", o.skip));
-  options.skip_s = o.skip;
+  if (o.skip && !(std::isfinite(*o.skip) && *o.skip >= 0.0))
+    throw io::Error(fmt::format("--skip: expected seconds >= 0, got {}", *o.skip));
+  options.skip_s = o.skip.value_or(-1.0); // < 0: the library's default, 10 % of the record
   options.simulation.route = parse_route(o.route);
   if (o.substeps < 1)
     throw io::Error(fmt::format("--substeps: expected at least 1, got {}", o.substeps));

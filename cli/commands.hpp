@@ -3,6 +3,7 @@
 /// only then writes its outputs. Errors are exceptions (io::Error for bad input); warnings go
 /// to stderr.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,7 +36,7 @@ struct SimulateOptions {
   std::string route = "modal";      ///< modal (retained modes + static correction) or full
   double modal_cutoff = 0.0;        ///< Hz; 0: the Nyquist frequency
   int substeps = 4;                 ///< Newmark steps per sample
-  double fade_in = -1.0;            ///< s; < 0: 5 % of the duration
+  std::optional<double> fade_in;    ///< s; not given: 5 % of the duration
   std::filesystem::path force_from; ///< --excitation record: the record whose f@ channels drive
 };
 
@@ -49,7 +50,7 @@ struct CompareOptions {
   std::filesystem::path record;
   std::string band;            ///< F0:F1, Hz; empty: the whole spectrum
   int segment = 0;             ///< Welch segment, samples; 0: automatic
-  double skip = -1.0;          ///< s left out at the start; < 0: 10 % of the record
+  std::optional<double> skip;  ///< s left out at the start; not given: 10 % of the record
   std::string route = "modal"; ///< modal or full
   double modal_cutoff = 0.0;   ///< Hz; 0: the Nyquist frequency
   int substeps = 4;

@@ -144,8 +144,8 @@ int main(int argc, char** argv) {
   simulate->add_option("--force-from", sim.force_from,
                        "--excitation record: a record (CSV) whose f@NODE:DOF channels drive the "
                        "model");
-  simulate->add_option(
-      "--fade-in", sim.fade_in,
+  simulate->add_option_function<double>(
+      "--fade-in", [&sim](const double& s) { sim.fade_in = s; },
       "Force faded in over this time from rest, s (default: 5 % of --duration; none "
       "for a record's force that starts at zero)");
 
@@ -162,9 +162,10 @@ int main(int argc, char** argv) {
       ->add_option("--segment", cmp.segment,
                    "Welch segment, samples (0: largest power of two giving >= 16 averages)")
       ->capture_default_str();
-  compare->add_option("--skip", cmp.skip,
-                      "Seconds left out at the start of both records (default: 10 % of the "
-                      "record; the simulation starts from rest)");
+  compare->add_option_function<double>(
+      "--skip", [&cmp](const double& s) { cmp.skip = s; },
+      "Seconds left out at the start of both records (default: 10 % of the "
+      "record; the simulation starts from rest)");
   compare
       ->add_option("--route", cmp.route,
                    "modal: retained modes + static correction (fast); full: the whole FE model")

@@ -25,7 +25,8 @@ Newmark::Newmark(const Assembled& system, const SparseMatrix& C, const LocalForc
   if (C.nonZeros() > 0) keff += a1_ * C;
   keff_.compute(keff);
   if (keff_.info() != Eigen::Success)
-    throw std::runtime_error("Newmark: the effective stiffness K + a1 C + a0 M is singular");
+    throw std::runtime_error("Newmark: the effective stiffness K + a1 C + a0 M is singular (a DOF "
+                             "with neither stiffness nor mass?)");
   const int nc = forces ? static_cast<int>(forces->coordinates().cols()) : 0;
   if (forces) {
     const Eigen::MatrixXd B(forces->coordinates());

@@ -29,8 +29,14 @@ void check_history(const ForceHistory& h, int n_eq) {
     if (e < 0 || e >= n_eq)
       throw std::invalid_argument("force history: equation " + std::to_string(e) +
                                   " is not one of the model's " + std::to_string(n_eq));
-  if (!h.samples.allFinite())
-    throw std::invalid_argument("force history: a sample is not a finite number");
+  for (Eigen::Index c = 0; c < h.samples.cols(); ++c)
+    for (Eigen::Index i = 0; i < h.samples.rows(); ++i)
+      if (!std::isfinite(h.samples(i, c)))
+        throw std::invalid_argument("force history: sample " + std::to_string(i + 1) +
+                                    " of column " + std::to_string(c + 1) + " (equation " +
+                                    std::to_string(h.equations[static_cast<std::size_t>(c)]) +
+                                    ") is " + std::to_string(h.samples(i, c)) +
+                                    ", not a finite number");
 }
 
 void check_outputs(std::span<const int> outputs, int n_eq) {

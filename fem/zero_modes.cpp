@@ -7,7 +7,9 @@ std::string ZeroModes::describe() const {
   const std::string n = std::to_string(count);
   if (!mechanism)
     return "free structure: " + n + " rigid-body mode" + (count > 1 ? "s" : "") + " at 0 Hz";
-  const std::string where = " (largest motion at " + to_string(largest_motion) + ")";
+  // Ranked by kinetic energy (radians and metres do not compare): not always the DOF that
+  // moves farthest, so say what it is.
+  const std::string where = " (most of its kinetic energy at " + to_string(largest_motion) + ")";
   if (supported)
     return "mechanism: " + n + " zero-frequency mode" + (count > 1 ? "s" : "") +
            " although the model is supported; it cannot carry load in " +

@@ -24,6 +24,14 @@ bool has_exact_friction(const std::vector<joints::Joint>& joints, const Harmonic
   return false;
 }
 
+// A residual or a step as %g would print it: 7.05e-06, not 0.000007 (or 0.000000).
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
 std::string hz(double f) {
   std::ostringstream s;
   s.precision(6);
@@ -173,7 +181,7 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
   // bound), and at least 16 steps per period of the highest harmonic.
   const int probe = 16 * (K + 1);
   double gy_max = 0.0, gv_max = 0.0;
-  for (int i = 0; i < probe; ++i) {
+  for (int i = 0; i < probe && nj > 0; ++i) { // no joints (a linear substructure): no bound
     sample(T * i / probe);
     gy_max = std::max(gy_max, gy.cwiseAbs().maxCoeff());
     gv_max = std::max(gv_max, gv.cwiseAbs().maxCoeff());
@@ -265,7 +273,7 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
     }
     if (!ok) {
       branch.notes.push_back("no steady state found at the start, " + hz(start_hz) + " (residual " +
-                             std::to_string(s.residual) + ")");
+                             number(s.residual) + ")");
       return branch;
     }
   }
@@ -366,7 +374,7 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
     }
     if (ds < o.min_step) {
       branch.notes.push_back("continuation stalled at " + hz(s.omega / two_pi) +
-                             ": no step down to " + std::to_string(o.min_step) + " converged");
+                             ": no step down to " + number(o.min_step) + " converged");
       return branch;
     }
     const Eigen::VectorXd u = scale(s.z, s.omega);

@@ -14,7 +14,8 @@ ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& m
                                const ModalSynthesisOptions& options)
     : dofs_(std::move(dofs)) {
   if (modes.status != fem::ModalStatus::success)
-    throw std::invalid_argument("modal synthesis: the modal analysis failed: " + modes.reason);
+    throw std::invalid_argument("modal synthesis: the modal analysis failed (" + modes.reason +
+                                "): no modes to synthesise from");
   const int n = system.dofs.num_equations(), m = modes.num_modes(),
             d = static_cast<int>(dofs_.size());
   for (int e : dofs_)
@@ -155,8 +156,10 @@ CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix&
   D.makeCompressed();
   Eigen::UmfPackLU<CSparse> lu(D);
   if (lu.info() != Eigen::Success)
-    throw std::runtime_error("direct receptance: K - w^2 M + i w C is singular at w = " +
-                             std::to_string(omega) + " rad/s");
+    throw std::runtime_error(
+        "direct receptance: K - w^2 M + i w C is singular at w = " + std::to_string(omega) +
+        " rad/s (" + std::to_string(omega / (2.0 * std::numbers::pi)) +
+        " Hz): an undamped natural frequency, or a DOF with neither stiffness nor mass");
   Eigen::MatrixXcd unit = Eigen::MatrixXcd::Zero(n, static_cast<int>(cols.size()));
   for (std::size_t j = 0; j < cols.size(); ++j)
     unit(cols[j], j) = 1.0;

@@ -18,6 +18,13 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 using Complex = std::complex<double>;
 
+// A number as %g would print it (6 significant digits): 2.5, 0.4, 1e-05.
+std::string number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 std::string percent(double fraction) {
   std::ostringstream s;
   s.precision(3);
@@ -138,7 +145,9 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   const double omega = two_pi * m.frequency_hz, dt = r.dt();
   const int n = whole_period_samples(r.t, m.frequency_hz);
   if (n == 0)
-    fail("shorter than one period of the excitation (" + std::to_string(m.frequency_hz) + " Hz)");
+    fail("shorter than one period of the excitation (" + number(m.frequency_hz) +
+         " Hz): " + number(static_cast<double>(r.t.size()) * dt) + " s recorded, a period lasts " +
+         number(1.0 / m.frequency_hz) + " s");
   const double nyquist = 0.5 / dt;
   if (K * m.frequency_hz >= nyquist)
     fail("harmonic " + std::to_string(K) + " (" + std::to_string(K * m.frequency_hz) +
@@ -146,7 +155,8 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
          " Hz): sample faster, or ask fewer harmonics");
   if (n < 2 * K + 1)
     fail("its whole periods hold " + std::to_string(n) +
-         " samples, too few to fit harmonics 0 to " + std::to_string(K));
+         " samples, too few to fit harmonics 0 to " + std::to_string(K) + " (at least " +
+         std::to_string(2 * K + 1) + " needed: record more periods, or ask fewer harmonics)");
 
   // The span analysed: the synchronous average of the periods when a period holds a whole
   // number of samples, else the whole periods as they are.

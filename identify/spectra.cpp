@@ -29,7 +29,12 @@ WelchSpectra welch(const Eigen::MatrixXd& signals, double fs, const WelchOptions
   if (signals.rows() < N)
     throw std::invalid_argument(fmt::format(
         "Welch: the record has {} samples, fewer than one segment of {}", signals.rows(), N));
-  if (!signals.allFinite()) throw std::invalid_argument("Welch: a sample is not a finite number");
+  for (Eigen::Index c = 0; c < signals.cols(); ++c)
+    for (Eigen::Index i = 0; i < signals.rows(); ++i)
+      if (!std::isfinite(signals(i, c)))
+        throw std::invalid_argument(
+            fmt::format("Welch: sample {} of channel {} is {}, not a finite number", i + 1, c + 1,
+                        signals(i, c)));
   const int step = std::max(1, static_cast<int>(std::lround(N * (1.0 - o.overlap))));
   const auto channels = signals.cols();
   Eigen::VectorXd window(N);

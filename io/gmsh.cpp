@@ -84,7 +84,8 @@ public:
   }
   void expect(const std::string& tag) {
     std::string l;
-    if (!next_line(l) || l != tag) fail("expected " + tag);
+    if (!next_line(l)) fail("unexpected end of file, expected " + tag);
+    if (l != tag) fail("expected " + tag + ", got '" + l + "'");
   }
   void skip_section(const std::string& name) {
     std::string l;

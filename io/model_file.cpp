@@ -103,7 +103,11 @@ public:
   bool has(std::string_view key) const { return table_.contains(key); }
   const toml::node* get(std::string_view key) const { return table_.get(key); }
 
-  [[noreturn]] void fail(const std::string& what) const { file_.fail(line(), prefix() + what); }
+  // The document itself (no label) has no line of its own: what is missing from it is not at
+  // line 1.
+  [[noreturn]] void fail(const std::string& what) const {
+    file_.fail(where_.empty() ? 0 : line(), prefix() + what);
+  }
   [[noreturn]] void fail_at(const toml::node& n, const std::string& label,
                             const std::string& what) const {
     file_.fail(line_of(n) > 0 ? line_of(n) : line(), prefix() + label + ": " + what);

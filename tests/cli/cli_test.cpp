@@ -1214,5 +1214,338 @@ TEST_F(CliTest, FrfStartsAtTheStaticFlexibilityAndWritesTableAndUniversalFile) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// Options out of range, of every command: refused before any input is read, one line naming the
+// option, what it expects and what it got; nothing written.
+TEST_F(CliTest, OptionsOutOfRangeAreNamedBeforeAnythingIsRead) {
+  const fs::path out = dir() / "never_written";
+  const std::string model_path = model().string(), rec = record_files()[0];
+  auto sine = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"simulate", model_path,    "--force", "7:uy", "--freq",
+                                  "3",        "--amplitude", "10",      "-o",   out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  expect_one_line_error(sine({"--periods", "0"}), "jointid: --periods: expected at least 1, got 0");
+  expect_one_line_error(sine({"--steps-per-period", "4"}),
+                        "jointid: --steps-per-period: expected at least 8, got 4");
+  expect_one_line_error(sine({"--steps-per-period", "64", "--samples-per-period", "48"}),
+                        "jointid: --samples-per-period: expected at least 8 and a divisor of "
+                        "--steps-per-period (64), got 48");
+  expect_one_line_error(sine({"--method", "hb", "--harmonics", "0"}),
+                        "jointid: --harmonics: expected at least 1, got 0");
+  expect_one_line_error(sine({"--channels", "x,v,x"}), "jointid: --channels: x is listed twice");
+  expect_one_line_error(sine({"--channels", "x,d"}),
+                        "jointid: --channels: expected x, v or a, got \"d\"");
+  auto random = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"simulate",      model_path, "--force",    "7:uy",
+                                  "--excitation",  "random",   "--band",     "2:40",
+                                  "--rms",         "1",        "--duration", "2",
+                                  "--sample-rate", "256",      "-o",         out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  expect_one_line_error(random({"--substeps", "0"}),
+                        "jointid: --substeps: expected at least 1, got 0");
+  expect_one_line_error(random({"--modal-cutoff=-1"}),
+                        "jointid: --modal-cutoff: expected >= 0 Hz, got -1");
+  // A negative fade-in was taken for "not given" (5 % of the duration) without a word.
+  expect_one_line_error(random({"--fade-in=-0.5"}),
+                        "jointid: --fade-in: expected seconds >= 0, got -0.5");
+  expect_one_line_error(random({"--fade-in", "3"}),
+                        "jointid: --fade-in: expected 0 to below the duration (2 s), got 3");
+
+  const fs::path result = out / "result.json";
+  expect_one_line_error(
+      jointid({"identify", model_path, rec, "--harmonics", "1,51", "-o", result.string()}, dir()),
+      "jointid: --harmonics: expected harmonics from 0 to 50, got 51");
+  expect_one_line_error(
+      jointid({"identify", model_path, rec, "--harmonics", "1,3,1", "-o", result.string()}, dir()),
+      "jointid: --harmonics: harmonic 1 is listed twice");
+  expect_one_line_error(
+      jointid({"discover", model_path, rec, "--max-steps", "0", "-o", out.string()}, dir()),
+      "jointid: --max-steps: expected at least 1, got 0");
+  expect_one_line_error(
+      jointid({"modes", model_path, "--count", "0", "--pictures", "0", "-o", out.string()}, dir()),
+      "jointid: --count: expected at least 1, got 0");
+  for (const std::string k : {"0", "201"})
+    expect_one_line_error(
+        jointid({"response", model_path, "--force", "7:uy", "--amplitude", "10", "--freq-range",
+                 "2:4", "--harmonics", k, "--no-plot", "-o", out.string()},
+                dir()),
+        "jointid: --harmonics: expected 1 to 200, got " + k);
+
+  auto design = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"design", model_path, "--force", "7:uy",
+                                  "-n",     "1",        "-o",      out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  const std::vector<std::string> grid{"--freq", "2,3", "--amplitude", "10"};
+  auto with_grid = [&](std::vector<std::string> extra) {
+    extra.insert(extra.begin(), grid.begin(), grid.end());
+    return extra;
+  };
+  expect_one_line_error(design(with_grid({"--harmonics", "1,60"})),
+                        "jointid: --harmonics: expected harmonics from 0 to 50, got 60");
+  expect_one_line_error(design(with_grid({"--harmonics", "3,3"})),
+                        "jointid: --harmonics: harmonic 3 is listed twice");
+  expect_one_line_error(design(with_grid({"--max-misfit", "0"})),
+                        "jointid: --max-misfit: expected a number > 0 (noise standard "
+                        "deviations), got 0");
+  expect_one_line_error(design(with_grid({"--balance-harmonics", "0"})),
+                        "jointid: --balance-harmonics: expected 1 to 200, got 0");
+  expect_one_line_error(design({"--freq", "1:0.0001:3", "--amplitude", "10"}),
+                        "jointid: --freq 1:0.0001:3: more than 10000 values");
+  expect_one_line_error(design({"--freq", "2,3", "--amplitude", "1:0.001:100"}),
+                        "jointid: --amplitude 1:0.001:100: more than 10000 values");
+
+  auto compare = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"compare", model_path, rec, "--no-plot", "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  // A negative --skip was taken for "not given" (10 % of the record) without a word.
+  expect_one_line_error(compare({"--skip=-1"}), "jointid: --skip: expected seconds >= 0, got -1");
+  expect_one_line_error(compare({"--substeps", "0"}),
+                        "jointid: --substeps: expected at least 1, got 0");
+  expect_one_line_error(compare({"--modal-cutoff=-2"}),
+                        "jointid: --modal-cutoff: expected >= 0 Hz, got -2");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(CliTest, OutputOfTheWrongKindIsRefused) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  // simulate writes into a directory: an existing file there is not one.
+  const fs::path file = dir() / "a_file.txt";
+  test::write_text(file, "keep\n");
+  expect_one_line_error(jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3",
+                                 "--amplitude", "10", "-o", file.string()},
+                                dir()),
+                        "jointid: -o " + file.string() + ": exists and is not a directory");
+  EXPECT_EQ(test::read_text(file), "keep\n");
+  // identify writes a file: an existing directory is not one.
+  const fs::path directory = dir() / "a_directory";
+  fs::create_directories(directory);
+  std::vector<std::string> args{"identify", model().string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"-o", directory.string()});
+  expect_one_line_error(jointid(args, dir()), "jointid: -o " + directory.string() +
+                                                  ": expected a file name, got a directory");
+  EXPECT_TRUE(fs::is_empty(directory));
+}
+
+TEST_F(CliTest, AModelWithoutJointsIsNamed) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const std::string text = test::cantilever_toml();
+  const fs::path linear = dir() / "no_joints.toml";
+  test::write_text(linear, text.substr(0, text.find("[[joints]]")));
+  const fs::path out = dir() / "no_joints_out";
+  const std::string rec = record_files()[0];
+  expect_one_line_error(
+      jointid({"identify", linear.string(), rec, "-o", (dir() / "no_joints.json").string()}, dir()),
+      "jointid: " + linear.string() + ": no [[joints]] to identify");
+  expect_one_line_error(jointid({"discover", linear.string(), rec, "-o", out.string()}, dir()),
+                        "jointid: " + linear.string() +
+                            ": no [[joints]]: discovery starts from the joints' terms");
+  expect_one_line_error(jointid({"design", linear.string(), "--force", "7:uy", "--freq", "2,3",
+                                 "--amplitude", "10", "-n", "1", "-o", out.string()},
+                                dir()),
+                        "jointid: " + linear.string() +
+                            ": no [[joints]]: nothing to design tests for");
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir() / "no_joints.json"));
+  // response goes on with the linear substructure, and says so (it crashed in the stability
+  // check of each point before).
+  const Outcome run = jointid({"response", linear.string(), "--force", "7:uy", "--amplitude", "10",
+                               "--freq-range", "2:4", "--no-plot", "-o", out.string()},
+                              dir());
+  EXPECT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("jointid: warning: " + linear.string() +
+                         ": no [[joints]]: the response is the linear substructure's\n"),
+            std::string::npos)
+      << run.err;
+  EXPECT_TRUE(fs::exists(out / "response.json"));
+}
+
+TEST_F(CliTest, ModesOfAMechanismWarnAndAMasslessDofIsNamed) {
+  // The cantilever pinned instead of clamped (rz free at node 1): it swings about the pin.
+  const fs::path pinned = dir() / "pinned.toml";
+  test::write_text(pinned, test::replaced(test::cantilever_toml(), "fix = [\"ux\", \"uy\", \"rz\"]",
+                                          "fix = [\"ux\", \"uy\"]"));
+  const fs::path out = dir() / "modes_pinned";
+  const Outcome run =
+      jointid({"modes", pinned.string(), "--pictures", "0", "-o", out.string()}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  // The DOFs are ranked by their share of the mode's kinetic energy: node 6 carries twice the
+  // tip's mass at 5/6 of its motion. (The message said "largest motion at 6:uy", where the tip
+  // moves farther.)
+  const std::string warning =
+      "mechanism: 1 zero-frequency mode although the model is supported; it cannot carry load "
+      "in that shape (most of its kinetic energy at 6:uy): add supports, stiffer connections or "
+      "springs";
+  EXPECT_NE(run.err.find("jointid: warning: " + warning + "\n"), std::string::npos) << run.err;
+  const json j = json::parse(test::read_text(out / "modes.json"));
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_EQ(j["warnings"][0], warning);
+
+  // A node held by a spring alone has no mass but stiffness: it has no finite mode, and the
+  // beam's modes are those without it (both engines). With a spring of zero stiffness the node
+  // has neither: refused, naming it.
+  std::string text =
+      test::replaced(test::cantilever_toml(), "[7, 2, 0.0]]", "[7, 2, 0.0], [8, 2.5, 0.0]]");
+  const fs::path plain = dir() / "modes_plain";
+  ASSERT_EQ(jointid({"modes", model().string(), "--engine", "dense", "--pictures", "0", "--count",
+                     "3", "-o", plain.string()},
+                    dir())
+                .status,
+            0);
+  const json reference = json::parse(test::read_text(plain / "modes.json"));
+  const fs::path massless = dir() / "massless.toml";
+  test::write_text(massless, text + "\n[[springs]]\nnode = 8\ndof = \"uy\"\nstiffness = 1000.0\n");
+  for (const std::string engine : {"dense", "sparse"}) {
+    const fs::path with = dir() / ("modes_massless_" + engine);
+    const Outcome ok = jointid({"modes", massless.string(), "--engine", engine, "--pictures", "0",
+                                "--count", "3", "-o", with.string()},
+                               dir());
+    ASSERT_EQ(ok.status, 0) << engine << ": " << ok.err;
+    const json modes = json::parse(test::read_text(with / "modes.json"));
+    ASSERT_EQ(modes["modes"].size(), 3u) << engine;
+    for (int r = 0; r < 3; ++r) {
+      const double f = reference["modes"][r]["frequency_hz"].get<double>();
+      EXPECT_NEAR(modes["modes"][r]["frequency_hz"].get<double>(), f, 1e-9 * f) << engine;
+    }
+  }
+  const fs::path bare = dir() / "bare.toml";
+  test::write_text(bare, text + "\n[[springs]]\nnode = 8\ndof = \"uy\"\nstiffness = 0.0\n");
+  const fs::path never = dir() / "modes_bare";
+  for (const std::string engine : {"dense", "sparse"}) {
+    const Outcome run = jointid({"modes", bare.string(), "--engine", engine, "--pictures", "0",
+                                 "--count", "3", "-o", never.string()},
+                                dir());
+    expect_one_line_error(run, "is not positive definite; it breaks down at 8:uy");
+  }
+  EXPECT_FALSE(fs::exists(never));
+}
+
+TEST_F(CliTest, SimulateWarnsAboutARecordThatIsNotPeriodic) {
+  // Without damping (no modal damping, a joint of stiffness only) the start from rest never
+  // dies out: after the most periods time integration runs (4000) the record is not periodic.
+  std::string text = test::replaced(test::cantilever_toml(), "modal = 0.01", "modal = 0.0");
+  text = test::replaced(text, "terms = [\"k\", \"c\", \"k3\"]", "terms = [\"k\"]");
+  text = test::replaced(text, "values = { k = 4800.0, c = 20.0, k3 = 1.6e8 }",
+                        "values = { k = 4800.0 }");
+  const fs::path undamped = dir() / "undamped.toml";
+  test::write_text(undamped, text);
+  const fs::path out = dir() / "undamped_records";
+  const Outcome run =
+      jointid({"simulate", undamped.string(), "--force", "7:uy", "--freq", "3", "--amplitude", "10",
+               "--steps-per-period", "32", "--periods", "2", "-o", out.string()},
+              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const std::string warning =
+      "sine_f3Hz_F10N.csv: not a periodic steady state after 4000 periods (last period-to-period "
+      "change ";
+  EXPECT_NE(run.err.find("jointid: warning: " + warning), std::string::npos) << run.err;
+  // The record is written, and says so itself.
+  const std::string record = test::read_text(out / "sine_f3Hz_F10N.csv");
+  EXPECT_NE(record.find("# WARNING: " + warning), std::string::npos) << record.substr(0, 600);
+  EXPECT_NE(record.find("NOT periodic"), std::string::npos) << record.substr(0, 600);
+}
+
+TEST_F(CliTest, JointsNewtonFailureStopsTheSimulation) {
+  // A softening cubic (k3 < 0) driven hard: the tip runs away from rest, the joint force
+  // overflows and its Newton iteration fails. Nothing is written.
+  const fs::path soft = dir() / "softening.toml";
+  test::write_text(soft, test::replaced(test::cantilever_toml(), "k3 = 1.6e8", "k3 = -1.6e8"));
+  const fs::path out = dir() / "softening_records";
+  expect_one_line_error(
+      jointid({"simulate", soft.string(), "--force", "7:uy", "--freq", "3", "--amplitude", "80",
+               "--steps-per-period", "64", "--periods", "2", "-o", out.string()},
+              dir()),
+      "jointid: time integration at 3 Hz, 80 N: the joints' Newton iteration failed in period 1");
+  expect_one_line_error(jointid({"simulate", soft.string(), "--force", "7:uy", "--excitation",
+                                 "random", "--band", "2:10", "--rms", "300", "--duration", "4",
+                                 "--sample-rate", "128", "-o", out.string()},
+                                dir()),
+                        "jointid: time simulation: the joints' Newton iteration failed after t = ");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(CliTest, HarmonicBalanceWithoutASolutionIsNamedBySimulateDesignAndResponse) {
+  // The softening cubic at 5000 N, 3 Hz: no periodic response the harmonic balance can reach.
+  const fs::path soft = dir() / "softening_hb.toml";
+  test::write_text(soft, test::replaced(test::cantilever_toml(), "k3 = 1.6e8", "k3 = -1.6e8"));
+  const fs::path out = dir() / "softening_hb";
+  const Outcome sim =
+      jointid({"simulate", soft.string(), "--force", "7:uy", "--freq", "3", "--amplitude", "5000",
+               "--method", "hb", "--steps-per-period", "64", "--periods", "2", "-o", out.string()},
+              dir());
+  expect_one_line_error(sim, "jointid: harmonic balance at 3 Hz, 5000 N: no periodic solution "
+                             "found (no convergence: relative residual ");
+  EXPECT_NE(sim.err.find("); simulate this test by time integration\n"), std::string::npos)
+      << sim.err;
+  EXPECT_FALSE(fs::exists(out));
+  // design leaves that candidate out, says so, and gives the reason in design.json.
+  const Outcome run = jointid({"design", soft.string(), "--force", "7:uy", "--freq", "2,3",
+                               "--amplitude", "10,5000", "-n", "3", "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("jointid: warning: 1 of 4 candidates left out: no periodic solution at "
+                         "the model's values"),
+            std::string::npos)
+      << run.err;
+  const json j = json::parse(test::read_text(out / "design.json"));
+  int left_out = 0;
+  for (const json& c : j["candidates"])
+    if (!c["usable"].get<bool>()) {
+      ++left_out;
+      EXPECT_EQ(c["freq_hz"], 3.0);
+      EXPECT_EQ(c["amplitude"], 5000.0);
+      EXPECT_EQ(c["reason"].get<std::string>().rfind(
+                    "sine_f3Hz_F5000N.csv: no periodic solution found (no convergence: relative "
+                    "residual ",
+                    0),
+                0u)
+          << c["reason"];
+    }
+  EXPECT_EQ(left_out, 1);
+  // response: the branch has no start; the curve is written incomplete, with a warning.
+  const fs::path curves = dir() / "softening_response";
+  const Outcome resp = jointid({"response", soft.string(), "--force", "7:uy", "--amplitude", "5000",
+                                "--freq-range", "3:4", "--no-plot", "-o", curves.string()},
+                               dir());
+  ASSERT_EQ(resp.status, 0) << resp.err;
+  EXPECT_NE(resp.err.find("jointid: warning: 5000 N: no steady state found at the start, 3 Hz "
+                          "(residual "),
+            std::string::npos)
+      << resp.err;
+  EXPECT_NE(resp.out.find("5000 N: 0 points, 0 folds, 0 unstable (incomplete)"), std::string::npos)
+      << resp.out;
+  const json r = json::parse(test::read_text(curves / "response.json"));
+  ASSERT_EQ(r["curves"].size(), 1u);
+  EXPECT_FALSE(r["curves"][0]["complete"].get<bool>());
+}
+
+TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  // A second joint at the tip with a stiffness of its own: the two k act alike in every test.
+  const fs::path twin = dir() / "twin.toml";
+  test::write_text(twin, test::cantilever_toml() +
+                             "\n[[joints]]\nname = \"twin\"\nnode = 7\ndof = \"uy\"\n"
+                             "terms = [\"k\"]\nvalues = { k = 100.0 }\n");
+  const fs::path result = dir() / "twin.json";
+  std::vector<std::string> args{"identify", twin.string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"-o", result.string()});
+  const Outcome run = jointid(args, dir());
+  expect_one_line_error(run, "jointid: identify: the unknowns cannot be separated by these tests "
+                             "(condition number ");
+  EXPECT_NE(run.err.find("); term k of 'tip' is a combination of the others: "), std::string::npos)
+      << run.err;
+  EXPECT_FALSE(fs::exists(result));
+}
+
 } // namespace
 } // namespace jointid

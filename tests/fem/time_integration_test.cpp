@@ -310,4 +310,14 @@ TEST(Newmark, BadTimeStepThrows) {
   const fem::Assembled s = fem::assemble(test::oscillator(1.0, 1.0));
   const fem::SparseMatrix C(1, 1);
   EXPECT_THROW(fem::Newmark(s, C, nullptr, 0.0), std::invalid_argument);
+  // A DOF with neither mass nor stiffness: K + a1 C + a0 M is zero there.
+  const fem::Assembled nothing = fem::assemble(test::oscillator(0.0, 0.0));
+  ASSERT_EQ(nothing.dofs.num_equations(), 1);
+  try {
+    fem::Newmark(nothing, C, nullptr, 0.01);
+    FAIL() << "a singular effective stiffness accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "Newmark: the effective stiffness K + a1 C + a0 M is singular (a DOF "
+                           "with neither stiffness nor mass?)");
+  }
 }

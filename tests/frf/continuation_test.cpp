@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <sstream>
 #include <vector>
 
 using namespace jointid;
@@ -93,6 +94,26 @@ TEST(Continuation, LinearJointFollowsTheExactFrf) {
     EXPECT_LE(std::abs(p.hb.X(1, 0) - X), 1e-9 * std::abs(X)) << p.hb.frequency_hz;
     ASSERT_TRUE(p.stable.has_value());
     EXPECT_TRUE(*p.stable);
+  }
+}
+
+TEST(Continuation, WithoutJointsTheBranchIsTheLinearFrf) {
+  // No joints (jointid response on a model without [[joints]]): the branch is the bare
+  // structure's receptance times the force, and stable. The stability check bounded its time
+  // step by the largest joint stiffness of an empty set of joints and crashed.
+  const PaperCantilever c;
+  const double F0 = 10.0;
+  const frf::ResponseBranch b = trace(c, {}, F0, 2.0, 4.0);
+  ASSERT_TRUE(b.complete);
+  EXPECT_TRUE(b.folds.empty());
+  EXPECT_GT(b.points.size(), 10u);
+  const std::vector<int> tip{c.eq(7)};
+  for (const frf::ResponsePoint& p : b.points) {
+    const Complex X =
+        c.H.receptance(two_pi * p.hb.frequency_hz, tip, tip)(0, 0) * Complex(0.0, -F0);
+    EXPECT_LE(std::abs(p.hb.X(1, 0) - X), 1e-9 * std::abs(X)) << p.hb.frequency_hz;
+    ASSERT_TRUE(p.stable.has_value()) << p.hb.frequency_hz;
+    EXPECT_TRUE(*p.stable) << p.hb.frequency_hz;
   }
 }
 
@@ -243,6 +264,48 @@ TEST(Continuation, ExactFrictionPointsAreFixedFrequencySteadyStates) {
     ASSERT_TRUE(r.converged) << i;
     EXPECT_LE((r.X - p.hb.X).norm(), 1e-8 * r.X.norm()) << i << " at " << p.hb.frequency_hz;
   }
+}
+
+TEST(Continuation, IncompleteBranchesSayWhereAndWhy) {
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{make("tip", 7, {Term::k3}, {1.6e8})};
+  // The point limit: a branch of 5 points stops short of the band's end.
+  frf::ContinuationOptions few;
+  few.max_points = 5;
+  const frf::ResponseBranch b = trace(c, js, 0.5, 2.5, 4.5, few);
+  EXPECT_FALSE(b.complete);
+  ASSERT_EQ(b.points.size(), 5u);
+  ASSERT_EQ(b.notes.size(), 1u);
+  std::ostringstream at;
+  at.precision(6);
+  at << b.points.back().hb.frequency_hz;
+  EXPECT_EQ(b.notes[0], "stopped after 5 points at " + at.str() + " Hz (max_points)");
+  // No start: two Newton iterations (and two load steps) cannot solve 80 N at 3 Hz.
+  frf::ContinuationOptions weak;
+  weak.hb.max_iterations = 2;
+  weak.hb.continuation_steps = 2;
+  const frf::ResponseBranch none = trace(c, js, 80.0, 3.0, 4.0, weak);
+  EXPECT_FALSE(none.complete);
+  EXPECT_TRUE(none.points.empty());
+  ASSERT_EQ(none.notes.size(), 1u);
+  EXPECT_EQ(none.notes[0].rfind("no steady state found at the start, 3 Hz (residual ", 0), 0u)
+      << none.notes[0];
+  // A stall: at 10 N the branch climbs towards its upper fold, where steps of at least 0.02
+  // (scaled arclength) with 4 Newton iterations no longer converge.
+  frf::ContinuationOptions coarse;
+  coarse.hb.max_iterations = 4;
+  coarse.initial_step = coarse.min_step = 0.02;
+  coarse.max_step = 0.05;
+  const frf::ResponseBranch stalled = trace(c, js, 10.0, 2.0, 4.5, coarse);
+  EXPECT_FALSE(stalled.complete);
+  ASSERT_FALSE(stalled.points.empty());
+  ASSERT_EQ(stalled.notes.size(), 1u);
+  std::ostringstream where;
+  where.precision(6);
+  where << stalled.points.back().hb.frequency_hz;
+  EXPECT_EQ(stalled.notes[0],
+            "continuation stalled at " + where.str() + " Hz: no step down to 0.02 converged");
+  EXPECT_GT(stalled.points.back().hb.frequency_hz, 3.0);
 }
 
 TEST(Continuation, BadArgumentsThrow) {

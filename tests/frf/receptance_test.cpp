@@ -216,6 +216,44 @@ TEST(Receptance, BadInputThrows) {
   fem::Modes failed = modes;
   failed.status = fem::ModalStatus::not_converging;
   EXPECT_THROW(frf::ModalSynthesis(c.system, failed, d, c.dofs), std::invalid_argument);
+  // Undamped, at its natural frequency (1 rad/s), a 1 kg, 1 N/m oscillator has no receptance.
+  const fem::Assembled one = fem::assemble(test::oscillator(1.0, 1.0));
+  const std::vector<int> dof{0};
+  try {
+    frf::direct_receptance(one, fem::SparseMatrix(1, 1), 1.0, dof, dof);
+    FAIL() << "a singular dynamic stiffness accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "direct receptance: K - w^2 M + i w C is singular at w = 1.000000 "
+                           "rad/s (0.159155 Hz): an undamped natural frequency, or a DOF with "
+                           "neither stiffness nor mass");
+  }
+}
+
+TEST(Receptance, ModesThatDidNotConvergeAreRefused) {
+  // The sparse engine allowed one Lanczos restart and a tolerance of 0: 10 modes of a
+  // 400-equation cantilever do not converge, which the status says; a synthesis refuses them.
+  const fem::Damping d = modal(0.01);
+  const Cantilever c(200, d);
+  fem::ModalOptions o;
+  o.num_modes = 10;
+  o.engine = fem::ModalEngine::sparse;
+  o.max_iterations = 1;
+  o.tolerance = 0.0;
+  const fem::Modes modes = fem::modal_analysis(c.system, o);
+  ASSERT_EQ(modes.status, fem::ModalStatus::not_converging);
+  try {
+    frf::ModalSynthesis(c.system, modes, d, c.dofs);
+    FAIL() << "modes that did not converge accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(
+        std::string(e.what()).rfind("modal synthesis: the modal analysis failed (shift-invert "
+                                    "Lanczos (Spectra) did not converge to 10 modes in 1 "
+                                    "restarts",
+                                    0),
+        0u)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("): no modes to synthesise from"), std::string::npos);
+  }
 }
 
 // A substructure given by its modes (frf::ModalModel): the paper cantilever's FE modes at two

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <numbers>
 
 using namespace jointid;
@@ -43,6 +44,31 @@ protected:
     };
   }
   int eq(int node) const { return system.dofs.equation({node, fem::Dof::uy}); }
+
+  // Spectra built by hand, one per frequency, for a joint with two terms at the tip: the
+  // fundamental only, a force of 80 N, X2 = 1e-3 - 2e-3 i, the first term's basis harmonic that
+  // of a viscous damper (i ω X2) and the second's `second(f, first)`.
+  std::vector<identify::TestSpectrum> two_term_spectra(
+      const std::vector<double>& frequencies,
+      const std::function<Eigen::VectorXcd(double, const Eigen::VectorXcd&)>& second) const {
+    std::vector<identify::TestSpectrum> tests;
+    for (double f : frequencies) {
+      identify::TestSpectrum t;
+      t.source = "synthetic";
+      t.frequency_hz = f;
+      t.force_equations = {eq(7)};
+      t.F = Eigen::MatrixXcd::Zero(2, 1);
+      t.F(1, 0) = {0.0, -80.0};
+      t.X2 = Eigen::MatrixXcd::Zero(2, 1);
+      t.X2(1, 0) = {1e-3, -2e-3};
+      Eigen::MatrixXcd G(2, 2);
+      G.col(0) = std::complex<double>(0.0, two_pi * f) * t.X2.col(0);
+      G.col(1) = second(f, G.col(0));
+      t.G = {G};
+      tests.push_back(t);
+    }
+    return tests;
+  }
 
   // A steady-state record by time integration (the library's virtual sine test): force, x and v
   // at the joint DOFs and the force DOF.
@@ -176,22 +202,10 @@ TEST_F(FitTest, InseparableTermsAreAClearError) {
   // Two terms whose basis harmonics are exactly proportional in every test (here built by
   // hand: G_c3 = 2 G_c) cannot be told apart, however many tests there are.
   const std::vector<joints::Joint> js{make_joint("tip", 7, 0, {Term::c, Term::c3}, {20, 1.0})};
-  std::vector<identify::TestSpectrum> tests;
-  for (double f : {2.0, 3.0, 4.0}) {
-    identify::TestSpectrum t;
-    t.source = "synthetic";
-    t.frequency_hz = f;
-    t.force_equations = {eq(7)};
-    t.F = Eigen::MatrixXcd::Zero(2, 1);
-    t.F(1, 0) = {0.0, -80.0};
-    t.X2 = Eigen::MatrixXcd::Zero(2, 1);
-    t.X2(1, 0) = {1e-3, -2e-3};
-    Eigen::MatrixXcd G(2, 2);
-    G.col(0) = std::complex<double>(0.0, two_pi * f) * t.X2.col(0);
-    G.col(1) = 2.0 * G.col(0);
-    t.G = {G};
-    tests.push_back(t);
-  }
+  const auto tests =
+      two_term_spectra({2.0, 3.0, 4.0}, [](double, const Eigen::VectorXcd& g) -> Eigen::VectorXcd {
+        return 2.0 * g;
+      });
   // A numerical outcome, not bad input: a status with its reason, and no value is returned as
   // if it were determined.
   const identify::FitResult r = identify::fit(H, system.dofs, js, tests);
@@ -205,6 +219,62 @@ TEST_F(FitTest, InseparableTermsAreAClearError) {
   ASSERT_FALSE(r.identifiability.empty());
   EXPECT_EQ(r.identifiability[0], r.reason);
   EXPECT_THROW(r.identified(js), std::invalid_argument);
+}
+
+TEST_F(FitTest, ATermWithoutEffectOrEveryTermFixedIsRefused) {
+  auto message = [&](const std::vector<joints::Joint>& js,
+                     const std::vector<identify::TestSpectrum>& tests) {
+    try {
+      identify::fit(H, system.dofs, js, tests);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  // c3's basis harmonics are zero in every test: nothing to fit it to.
+  const auto zero = two_term_spectra({2.0, 3.0, 4.0}, [](double, const Eigen::VectorXcd& g) {
+    return Eigen::VectorXcd(Eigen::VectorXcd::Zero(g.size()));
+  });
+  std::vector<joints::Joint> js{make_joint("tip", 7, 0, {Term::c, Term::c3}, {20, 1.0})};
+  EXPECT_EQ(message(js, zero),
+            "identify: term c3 of 'tip' has no effect in these tests (its basis function is zero)");
+  js[0].fixed = {true, true};
+  EXPECT_EQ(message(js, zero), "identify: every joint term is fixed; nothing to identify");
+}
+
+TEST_F(FitTest, IllConditionedAndUnderdeterminedFitsWarn) {
+  const std::vector<joints::Joint> js{make_joint("tip", 7, 0, {Term::c, Term::c3}, {20, 1.0})};
+  auto has = [](const identify::FitResult& r, const std::string& what) {
+    for (const auto& w : r.warnings)
+      if (w.find(what) != std::string::npos) return true;
+    return false;
+  };
+  // c3's basis nearly proportional to c's (1e-9 apart, differently at each frequency): the
+  // condition number lies between the warning (1e8) and inseparable (1e13), and the
+  // inconsistent data leave both terms with a std far above their values.
+  const auto near = two_term_spectra({2.0, 3.0, 4.0}, [](double f, const Eigen::VectorXcd& g) {
+    return Eigen::VectorXcd((2.0 + 1e-9 * (f - 3.0)) * g);
+  });
+  const identify::FitResult r = identify::fit(H, system.dofs, js, near);
+  ASSERT_EQ(r.status, identify::FitStatus::ok) << r.reason;
+  EXPECT_GT(r.condition_number, 1e8);
+  EXPECT_LT(r.condition_number, 1e13);
+  EXPECT_TRUE(has(r, "Q is ill-conditioned (condition number "))
+      << ::testing::PrintToString(r.warnings);
+  EXPECT_TRUE(has(r, "): parameters may be poorly determined"))
+      << ::testing::PrintToString(r.warnings);
+  for (const std::string term : {"c", "c3"})
+    EXPECT_TRUE(has(r, "joint 'tip', term '" + term + "': poorly determined (std "))
+        << term << ": " << ::testing::PrintToString(r.warnings);
+  // One test, its fundamental only: 2 equations (real and imaginary parts) for 2 unknowns.
+  const auto one = two_term_spectra({3.0}, [](double, const Eigen::VectorXcd& g) {
+    return Eigen::VectorXcd(std::complex<double>(0.5, 0.5) * g);
+  });
+  const identify::FitResult exact = identify::fit(H, system.dofs, js, one);
+  ASSERT_EQ(exact.status, identify::FitStatus::ok) << exact.reason;
+  EXPECT_EQ(exact.equations, 2);
+  EXPECT_TRUE(has(exact, "as many equations as unknowns: no uncertainty estimate"))
+      << ::testing::PrintToString(exact.warnings);
 }
 
 TEST_F(FitTest, WarnsAboutUnsteadyAndClippedRecordsAndDerivedVelocity) {
@@ -369,9 +439,11 @@ TEST_P(EveryTermTest, SimulatedByTimeIntegrationAndRecovered) {
   if (T == Term::fc) {
     bool warned = false;
     for (const auto& w : r.warnings)
-      warned = warned || (w.find("sine_f2Hz_F20N.csv") != std::string::npos &&
-                          w.find("sticks") != std::string::npos);
-    EXPECT_TRUE(warned);
+      warned = warned ||
+               (w.rfind("sine_f2Hz_F20N.csv: joint 'tip' sticks for ", 0) == 0 &&
+                w.find(" % of the record; the Coulomb basis sign(ydot) does not describe the force "
+                       "while stuck") != std::string::npos);
+    EXPECT_TRUE(warned) << ::testing::PrintToString(r.warnings);
   }
 }
 

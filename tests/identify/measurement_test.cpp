@@ -396,6 +396,28 @@ TEST(Measure, ErrorsNameTheSource) {
   EXPECT_NE(e.find("no response channel"), std::string::npos) << e;
 }
 
+TEST(Measure, RecordsTooShortForThePeriodOrTheHarmonicsAreNamed) {
+  // 200 samples of a period of 256: 0.3125 s of a 0.4 s period.
+  Record part = make_record(256, 1, {Quantity::displacement});
+  part.t.conservativeResize(200);
+  for (auto& c : part.channels)
+    c.samples.conservativeResize(200);
+  EXPECT_EQ(error_of(part), "synthetic.csv: shorter than one period of the excitation (2.5 Hz): "
+                            "0.3125 s recorded, a period lasts 0.4 s");
+  // 6.2 samples a period, 2 periods: one whole period of 6 samples, below Nyquist for
+  // harmonic 3 (7.75 Hz > 7.5 Hz) but fewer than the 7 unknowns of harmonics 0 to 3.
+  EXPECT_EQ(error_of(make_record(6.2, 2, {Quantity::displacement}), {.harmonics = 3}),
+            "synthetic.csv: its whole periods hold 6 samples, too few to fit harmonics 0 to 3 (at "
+            "least 7 needed: record more periods, or ask fewer harmonics)");
+  // One period is measured, with a warning: its steadiness cannot be checked.
+  const Measurement one =
+      measure(make_record(256, 1, {Quantity::displacement, Quantity::velocity}));
+  ASSERT_EQ(one.warnings.size(), 1u) << ::testing::PrintToString(one.warnings);
+  EXPECT_EQ(one.warnings[0],
+            "synthetic.csv: only 1 period; steady state cannot be checked (record at least 2)");
+  expect_recovered(one, true);
+}
+
 TEST(Measure, SteadyStateWarningIgnoresNoiseButNotGrowth) {
   // 2 % white noise (σ = 0.02 × the channel's RMS) on a steady record: the two halves'
   // fundamentals differ by a complex Gaussian with E|δ|² = 8σ²/n_half ≈ (1.2e-3 |X1|)²,

@@ -325,6 +325,41 @@ TEST(SimulateSineTests, BadPlansAndOptionsAreRefused) {
   EXPECT_NE(run({{3.0, 80.0}}), "");
 }
 
+TEST(SimulateSineTests, HarmonicBalanceWithoutASolutionSaysWhichTestAndWhy) {
+  // Two Newton iterations cannot solve the strongly non-linear k3 case at 80 N, 3 Hz (it takes
+  // about 8; see HarmonicBalance.NonConvergenceSaysWhy).
+  const std::vector<joints::Joint> js{make_joint({Term::k3}, {1.6e8})};
+  SimulationOptions o;
+  o.method = SimulationMethod::harmonic_balance;
+  o.steps_per_period = 64;
+  o.balance.max_iterations = 2;
+  o.balance.continuation_steps = 2;
+  try {
+    simulate_sine_tests(cantilever(), js, tip, {{3.0, 80.0}}, o);
+    FAIL() << "an unconverged harmonic balance accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("harmonic balance at 3 Hz, 80 N: no periodic solution found (no "
+                      "convergence: relative residual ",
+                      0),
+              0u)
+        << m;
+    EXPECT_NE(m.find("); simulate this test by time integration"), std::string::npos) << m;
+  }
+  // design asks to skip such a test, with the reason, and keep the others.
+  o.skip_unconverged = true;
+  const auto tests = simulate_sine_tests(cantilever(), js, tip, {{3.0, 80.0}, {3.0, 1e-6}}, o);
+  ASSERT_EQ(tests.size(), 2u);
+  ASSERT_EQ(tests[0].warnings.size(), 1u);
+  EXPECT_EQ(tests[0].warnings[0].rfind("sine_f3Hz_F80N.csv: no periodic solution found (no "
+                                       "convergence: relative residual ",
+                                       0),
+            0u)
+      << tests[0].warnings[0];
+  EXPECT_TRUE(tests[1].warnings.empty()) << ::testing::PrintToString(tests[1].warnings);
+  EXPECT_EQ(tests[1].record.t.size(), o.periods * o.steps_per_period);
+}
+
 TEST(SimulateSineTests, TestNamesUseTheShortestExactNumbers) {
   EXPECT_EQ(sine_test_name({3.4, 80.0}), "sine_f3.4Hz_F80N.csv");
   EXPECT_EQ(sine_test_name({0.1 + 0.2, 12.5}), "sine_f0.30000000000000004Hz_F12.5N.csv");

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -140,4 +141,13 @@ TEST(Welch, BadInputsAreRefused) {
   EXPECT_THROW(power_spectrum(x, 10.0, {200, 0.5}), std::invalid_argument);
   EXPECT_THROW(power_spectrum(x, 10.0, {16, 1.0}), std::invalid_argument);
   EXPECT_THROW(h1_estimate(x, Eigen::VectorXd::Ones(99), 10.0, {16, 0.5}), std::invalid_argument);
+  // A NaN is named by its sample and channel (the response of an H1 estimate is channel 2).
+  Eigen::VectorXd y = x;
+  y(41) = std::numeric_limits<double>::quiet_NaN();
+  try {
+    h1_estimate(x, y, 10.0, {16, 0.5});
+    FAIL() << "a NaN accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "Welch: sample 42 of channel 2 is nan, not a finite number");
+  }
 }

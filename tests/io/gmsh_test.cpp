@@ -116,7 +116,7 @@ void expect_error(const std::string& text, const std::string& fragment, const st
     FAIL() << "accepted a mesh that should fail with: " << fragment;
   } catch (const io::Error& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find(path.string() + ":" + line), std::string::npos) << what;
+    EXPECT_NE(what.find(path.string() + ":" + line + ": "), std::string::npos) << what;
     EXPECT_NE(what.find(fragment), std::string::npos) << what;
   }
 }
@@ -138,9 +138,67 @@ TEST(Gmsh, ReadsFormat41WithEntityPhysicalGroups) {
 }
 
 TEST(Gmsh, UnknownGroupIsAnError) {
-  const io::GmshMesh m = io::read_gmsh(write_temp("l22.msh", msh22));
-  EXPECT_THROW(m.elements_in("roof"), io::Error);
-  EXPECT_THROW(m.nodes_in("roof"), io::Error);
+  const auto path = write_temp("l22.msh", msh22);
+  const io::GmshMesh m = io::read_gmsh(path);
+  auto message = [](auto&& f) {
+    try {
+      f();
+    } catch (const io::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(message([&] { m.elements_in("roof"); }),
+            path.string() + ": no physical group of lines named 'roof'");
+  EXPECT_EQ(message([&] { m.nodes_in("roof"); }),
+            path.string() + ": no physical group of points or lines named 'roof'");
+  // "tip" is a group of points: not a group of lines.
+  EXPECT_EQ(message([&] { m.elements_in("tip"); }),
+            path.string() + ": no physical group of lines named 'tip'");
+}
+
+TEST(Gmsh, TruncatedFilesAndUnclosedSectionsNameTheLine) {
+  const std::string text = msh22;
+  // Cut inside $Nodes (after node 2, line 14), and right after the last node (line 16).
+  expect_error(text.substr(0, text.find("3 0 3 0")), "unexpected end of file, expected a node",
+               "14");
+  expect_error(text.substr(0, text.find("$EndNodes")), "unexpected end of file, expected $EndNodes",
+               "16");
+  // One node more than announced: the fifth stands where $EndNodes should.
+  expect_error(replace(msh22, "4 2 3 0\n", "4 2 3 0\n5 2 4 0\n"),
+               "expected $EndNodes, got '5 2 4 0'", "17");
+  // A section jointid skips, never closed: the end of the file is where it was looked for.
+  expect_error(text + "$Comments\nmeshed by hand\n", "section $Comments has no $EndComments", "27");
+  expect_error(text.substr(0, text.find("$EndMeshFormat")),
+               "unexpected end of file, expected $EndMeshFormat", "2");
+}
+
+TEST(Gmsh, MalformedLinesNameWhatWasExpected) {
+  // Format 2.2: a node, an element's tags and nodes, a physical name.
+  expect_error(replace(msh22, "2 0 1.5 0", "2 0 1.5"), "expected a node: id x y z", "14");
+  expect_error(replace(msh22, "5 1 2 21 2 3 4", "5 1 2 21"), "element 5: expected 2 tags", "24");
+  expect_error(replace(msh22, "5 1 2 21 2 3 4", "5 1 2 21 2 3"), "element 5: expected 2 node ids",
+               "24");
+  expect_error(replace(msh22, "1 21 \"beam\"", "1 21"),
+               "expected a physical name: dim tag \"name\"", "9");
+  // Format 4.1: node coordinates, an entity, an element.
+  expect_error(replace(msh41, "0 1.5 0", "0 x 0"), "expected node coordinates x y z", "29");
+  expect_error(replace(msh41, "2 0 3 0 2 3 0 1 21 2 3 -2", "2 0 3 0 2 3 0"),
+               "expected an entity: tag, coordinates, number of physical tags", "16");
+  expect_error(replace(msh41, "5 3 4", "5 3"), "element 5: expected 2 node ids", "43");
+}
+
+TEST(Gmsh, MeshWithoutLinesIsAnError) {
+  // Only the two points of the L-frame: nothing to build beams from.
+  std::string points = replace(msh22, "5\n1 15", "2\n1 15");
+  points = replace(points, "3 1 2 20 1 1 2\n4 1 2 20 1 2 3\n5 1 2 21 2 3 4\n", "");
+  const auto path = write_temp("points.msh", points);
+  try {
+    io::read_gmsh(path);
+    FAIL() << "accepted a mesh without lines";
+  } catch (const io::Error& e) {
+    EXPECT_EQ(std::string(e.what()), path.string() + ": the mesh has no 2-node line elements");
+  }
 }
 
 TEST(Gmsh, ErrorsNameFileLineAndProblem) {

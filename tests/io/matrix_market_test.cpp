@@ -156,6 +156,9 @@ TEST(MatrixMarket, DofTableErrors) {
   EXPECT_NE(
       error_of([&] { io::read_dof_table(dir / "d2.txt"); }).find("d2.txt:2: expected NODE:DOF"),
       std::string::npos);
+  test::write_text(dir / "d4.txt", "1:uy\n0:uy\n");
+  EXPECT_EQ(error_of([&] { io::read_dof_table(dir / "d4.txt"); }),
+            (dir / "d4.txt").string() + ":2: node ids must be > 0, got '0:uy'");
   test::write_text(dir / "d3.txt", "# nothing\n");
   EXPECT_NE(error_of([&] { io::read_dof_table(dir / "d3.txt"); }).find("no DOFs"),
             std::string::npos);
@@ -247,5 +250,41 @@ TEST(MatrixMarket, ModelFileErrorsNameTheCulprit) {
                            "1 2 5\n");
   e = error_with(test::replaced(Exported::text(), "k.mtx", "u.mtx"));
   EXPECT_NE(e.find("K is not symmetric: entries (2, 1) and (1, 2) differ by"), std::string::npos)
+      << e;
+}
+
+TEST(MatrixMarket, NonFiniteSumsAndNegativeMassesAreNamed) {
+  const Exported x;
+  const int n = fem::assemble(x.fe.model).dofs.num_equations();
+  // A diagonal matrix with `first` at (1, 1): entries given twice are added.
+  auto diagonal = [n](const std::string& first) {
+    std::string s = first;
+    int entries = 0;
+    for (char c : first)
+      entries += c == '\n';
+    for (int i = 2; i <= n; ++i, ++entries)
+      s += fmt::format("{} {} 1\n", i, i);
+    return fmt::format("%%MatrixMarket matrix coordinate real general\n{} {} {}\n", n, n, entries) +
+           s;
+  };
+  auto error_with = [&](const std::string& from, const std::string& to) {
+    test::write_text(x.model, test::replaced(Exported::text(), from, to));
+    return error_of([&] { io::read_model(x.model); });
+  };
+  // Each value is finite, their sum is not.
+  test::write_text(x.dir / "huge.mtx", diagonal("1 1 1e308\n1 1 1e308\n"));
+  std::string e = error_with("k.mtx", "huge.mtx");
+  EXPECT_NE(e.find(fmt::format("matrices.toml:4: [matrices] (huge.mtx, m.mtx, {} DOFs): K: entry "
+                               "(1, 1) is not finite",
+                               n)),
+            std::string::npos)
+      << e;
+  // The first row of the table is 2:uy (node 1 is clamped).
+  test::write_text(x.dir / "negative.mtx", diagonal("1 1 -0.5\n"));
+  e = error_with("m.mtx", "negative.mtx");
+  EXPECT_NE(e.find(fmt::format("matrices.toml:4: [matrices] (k.mtx, negative.mtx, {} DOFs): M: "
+                               "diagonal entry 1 (2:uy) is negative: -0.5",
+                               n)),
+            std::string::npos)
       << e;
 }

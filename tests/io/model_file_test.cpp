@@ -235,6 +235,53 @@ TEST_F(ModelFileTest, BothDampingKindsAreAnError) {
   expect_error(text, test::line_of(text, "[damping]"), {"[damping]", "not both"});
 }
 
+TEST_F(ModelFileTest, NeitherDampingKindIsAnError) {
+  const std::string text = test::replaced(cantilever_toml(), "modal = 0.01\n", "");
+  expect_error(text, test::line_of(text, "[damping]"),
+               {"[damping]: expected modal = ratio or rayleigh = [alpha, beta]"});
+}
+
+TEST_F(ModelFileTest, MissingTopLevelTablesAreNamed) {
+  // The cantilever without the text from `begin` up to `end`.
+  auto error_without = [&](std::string_view begin, std::string_view end) {
+    std::string text = cantilever_toml();
+    const auto a = text.find(begin), b = text.find(end);
+    if (a == std::string::npos || b == std::string::npos || b < a) return std::string("bad test");
+    text.erase(a, b - a);
+    try {
+      read_model(write(text));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string file = (dir / "cantilever.toml").string();
+  EXPECT_EQ(error_without("[model]", "[[materials]]"),
+            file + ": missing table [model] (expected [model] with dimension = 2 or 3)");
+  EXPECT_EQ(error_without("[[materials]]", "[[sections]]"),
+            file + ": missing [[materials]] (expected at least one, with name, E, rho, nu)");
+  EXPECT_EQ(error_without("[[sections]]", "[mesh]"),
+            file + ": missing [[sections]] (expected at least one, with name, A, Iz)");
+  EXPECT_EQ(error_without("[mesh]", "[[element_sets]]"),
+            file + ": missing table [mesh] (expected nodes = [[id, x, y], ...] and elements = "
+                   "[[id, a, b], ...])");
+}
+
+TEST_F(ModelFileTest, ElementIdMaterialAndSectionNamesUsedTwice) {
+  std::string text = test::replaced(cantilever_toml(), "[2, 2, 3]", "[1, 2, 3]");
+  const int elements = test::line_of(text, "elements = [[1");
+  expect_error(text, elements,
+               {"key 'elements', entry 2",
+                "element id 1 is already used at line " + std::to_string(elements)});
+  text = cantilever_toml() +
+         "\n[[materials]] # again\nname = \"steel\"\nE = 70e9\nrho = 2700.0\nnu = 0.33\n";
+  expect_error(text, test::line_of(text, "# again"),
+               {"[[materials]] 'steel'", "name 'steel' is used by another material"});
+  text = cantilever_toml() + "\n[[sections]] # again\nname = \"bar\"\nA = 1e-3\nIz = 1e-8\n";
+  expect_error(text, test::line_of(text, "# again"),
+               {"[[sections]] 'bar'", "name 'bar' is used by another section"});
+}
+
 TEST_F(ModelFileTest, ElementsOutsideEverySetAreNamed) {
   const std::string text =
       test::replaced(cantilever_toml(), "elements = \"all\"", "elements = [1, 2, 3, 4]");
@@ -604,6 +651,28 @@ TEST_F(GmshModelTest, AGroupWithoutElementSetIsNamed) {
   ASSERT_NE(begin, std::string::npos);
   text.erase(begin, text.find("[[supports]]") - begin);
   expect_error(text, test::line_of(text, "file = "), {"in no [[element_sets]]", "'beam'"});
+}
+
+TEST_F(GmshModelTest, MeshNodesOffThePlaneOrWithIdZeroAreRefused) {
+  const std::string mesh = read_file(source / "portal.msh");
+  auto error_with_mesh = [&](const std::string& msh) {
+    const auto path = write(portal_toml());
+    test::write_text(dir / "portal.msh", msh);
+    try {
+      read_model(path);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string msh = (dir / "portal.msh").string(), toml = (dir / "portal.toml").string();
+  EXPECT_EQ(error_with_mesh(test::replaced(mesh, "\n5 0 0.249999999998938 0\n",
+                                           "\n5 0 0.249999999998938 0.125\n")),
+            msh + ": node 5 has z = 0.125, but " + toml +
+                " declares a planar model (dimension = 2)");
+  // An extra node 0, on no element (Gmsh itself accepts it): 0 means ground in jointid.
+  EXPECT_EQ(error_with_mesh(test::replaced(mesh, "$Nodes\n41\n", "$Nodes\n42\n0 9 9 0\n")),
+            msh + ": node ids must be > 0 (0 means ground), got 0");
 }
 
 TEST_F(GmshModelTest, UnknownGroupsAndAmbiguousNodesAreErrors) {

@@ -207,7 +207,30 @@ TEST_F(RecordCsvTest, ReadRecordsReadsEveryFile) {
   ASSERT_EQ(records.size(), 2u);
   EXPECT_EQ(records[0].source, a.string());
   EXPECT_EQ(*records[1].excitation_hz, 4.0);
-  EXPECT_THROW(read_records({a, dir / "missing.csv"}), Error);
+  try {
+    read_records({a, dir / "missing.csv"});
+    FAIL() << "a missing file accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(
+        std::string(e.what()).find((dir / "missing.csv").string() + ": cannot open for reading: "),
+        std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(RecordCsvTest, HeaderWithoutChannels) {
+  expect_error("# excitation_hz = 2.0\nt\n0\n0.125\n0.25\n0.375\n", 2,
+               {"header: no channels after 't' (expected e.g. t,f@7:uy,x@7:uy)"});
+}
+
+TEST_F(RecordCsvTest, ExcitationGivenTwice) {
+  const std::string twice = test::replaced(good_csv, "# excitation_hz = 2.0\n",
+                                           "# excitation_hz = 2.0\n# excitation_hz = 2.5\n");
+  expect_error(twice, 3, {"excitation_hz given twice (2 and 2.5 Hz)"});
+  // The same value twice says nothing new: accepted.
+  const std::string same = test::replaced(good_csv, "# excitation_hz = 2.0\n",
+                                          "# excitation_hz = 2.0\n# excitation_hz = 2\n");
+  EXPECT_EQ(*read_record(write(same)).excitation_hz, 2.0);
 }
 
 TEST_F(RecordCsvTest, WriterRefusesWhatTheReaderWouldRefuse) {
@@ -319,6 +342,13 @@ TEST_F(RecordCsvTest, SteppedSineTableErrors) {
                      "row has 4 fields, expected 5");
   expect_table_error(test::replaced(table_csv, "3.5,", "-3.5,"), 4, "> 0 Hz");
   expect_table_error(test::replaced(table_csv, "-4e-3", "inf"), 4, "infinite");
+  expect_table_error(test::replaced(table_csv, ",x@7:uy.im", ""), 2,
+                     "header: expected freq_hz then two columns per channel (<channel>.re, "
+                     "<channel>.im), got 3 columns after freq_hz");
+  expect_table_error(test::replaced(table_csv, "x@7:uy.re,x@7:uy.im", "f@7:uy.re,f@7:uy.im"), 2,
+                     "header: column 4: channel f@7:uy appears twice (columns 2 and 4)");
+  expect_table_error("# no tests yet\nfreq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im\n", 2,
+                     "no data rows (expected one row per test)");
 }
 
 TEST_F(RecordCsvTest, SteppedSineTableRoundTripIsBitExact) {
@@ -551,7 +581,12 @@ TEST_F(RecordCsvTest, SteppedSineTableFromRecordsHoldsTheFundamentals) {
   short_record.t.conservativeResize(100); // half a period
   for (auto& c : short_record.channels)
     c.samples.conservativeResize(100);
-  EXPECT_THROW(stepped_sine_table({short_record}), Error);
+  try {
+    stepped_sine_table({short_record});
+    FAIL() << "a record shorter than a period accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), short_record.source + ": shorter than one period of 2.5 Hz");
+  }
   EXPECT_TRUE(stepped_sine_table({}).freq_hz.empty());
 }
 

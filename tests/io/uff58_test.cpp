@@ -673,5 +673,19 @@ TEST_F(Uff58Test, MalformedFilesNameFileLineRecordAndField) {
   EXPECT_NE(error_of([&] { read_tests({empty}); }).find("no dataset 58"), std::string::npos);
 }
 
+TEST_F(Uff58Test, TimeRecordsMustBeFiniteAndHoldFourSamples) {
+  // read_uff58 reads NaN and infinities (FRFs hold them); a time record must not.
+  expect_test_error(test::replaced(hand_written, "-3.25000E+00", "         NAN"),
+                    {"record 12 (data values) value 3 is nan: a time record must be finite"});
+  expect_test_error(test::replaced(hand_written, "  7.75000E+00", "         INF"),
+                    {"record 12 (data values) value 7 is inf: a time record must be finite"});
+  std::string three = test::replaced(hand_written, "         2         8", "         2         3");
+  three = test::replaced(
+      three, "  4.00000E-01  0.00000E+00 -1.50000E+00\n  7.75000E+00  8.12500E+00\n", "\n");
+  expect_test_error(three,
+                    {"record 7 field 2 (number of points) is 3: a time record needs at least "
+                     "4 samples"});
+}
+
 } // namespace
 } // namespace jointid::io
