@@ -14,6 +14,7 @@
 #include "frf/harmonic_balance.hpp"
 #include "identify/fit.hpp"
 #include "identify/sine_tests.hpp"
+#include "io/terminal_progress.hpp"
 #include "support/cantilever.hpp"
 
 #include <Eigen/Dense>
@@ -60,7 +61,9 @@ Stats monte_carlo(const frf::Substructure& sub, const Study& s,
   const std::size_t np = params.size();
   Stats st{std::vector<double>(np), std::vector<double>(np), std::vector<double>(np),
            std::vector<double>(np)};
+  const io::TerminalProgress progress("Monte Carlo");
   for (int r = 0; r < reps; ++r) {
+    progress.show(static_cast<double>(r) / reps);
     std::vector<identify::SineTest> tests;
     for (std::size_t i = 0; i < clean.size(); ++i) {
       identify::Record rec = clean[i].record;
@@ -78,6 +81,7 @@ Stats monte_carlo(const frf::Substructure& sub, const Study& s,
       st.mean_std[q] += te.std / std::abs(truth) / reps;
     }
   }
+  progress.clear();
   for (double& v : st.rms)
     v = std::sqrt(v);
   return st;

@@ -23,6 +23,7 @@
 #include "io/response_curves.hpp"
 #include "io/results_json.hpp"
 #include "io/spectra_comparison.hpp"
+#include "io/terminal_progress.hpp"
 #include "io/vtk_output.hpp"
 #include "joints/joint.hpp"
 
@@ -162,20 +163,10 @@ std::pair<double, double> parse_band(const std::string& option, const std::strin
   return {f0, f1};
 }
 
-// Progress of a time simulation on stderr when it is a terminal (nothing otherwise); clear()
-// wipes the line.
-struct TerminalProgress {
-  std::string label;
-  bool on = isatty(STDERR_FILENO) == 1 && output_rank();
-  std::function<void(double)> callback() const {
-    if (!on) return {};
-    return [label = label](double fraction) {
-      std::cerr << fmt::format("\r{}: {:3.0f} %", label, 100.0 * fraction) << std::flush;
-    };
-  }
-  void clear() const {
-    if (on) std::cerr << "\r" << std::string(label.size() + 8, ' ') << "\r" << std::flush;
-  }
+// Progress on a terminal, from MPI rank 0 only.
+struct TerminalProgress : io::TerminalProgress {
+  explicit TerminalProgress(std::string label)
+      : io::TerminalProgress(std::move(label), output_rank()) {}
 };
 
 identify::TransientRoute parse_route(const std::string& text) {
@@ -405,11 +396,18 @@ void simulate(const SimulateOptions& o) {
 
   // 3. Simulate every test, keeping the records in memory: nothing is written unless all succeed.
   std::vector<identify::SimulatedTest> tests;
+  const TerminalProgress progress{fmt::format("jointid simulate: {} sine tests", plans.size())};
+  options.progress = progress.callback();
   try {
     tests = identify::simulate_sine_tests(sub, file.joints, force_at, plans, options);
   } catch (const std::invalid_argument& e) {
+    progress.clear();
     throw io::Error(o.model.string() + ": " + e.what());
+  } catch (...) {
+    progress.clear();
+    throw;
   }
+  progress.clear();
   for (std::size_t i = 0; i < tests.size(); ++i) {
     auto& t = tests[i];
     t.comments.insert(t.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
@@ -936,8 +934,17 @@ void design(const DesignOptions& o) {
   options.max_misfit = o.max_misfit;
   std::vector<identify::CandidateTest> candidates;
   identify::Design chosen;
+  const TerminalProgress progress{
+      fmt::format("jointid design: predicting {} candidates", plans.size())};
+  options.progress = progress.callback();
   try {
-    candidates = identify::predict_candidates(sub, file.joints, force_at, plans, options);
+    try {
+      candidates = identify::predict_candidates(sub, file.joints, force_at, plans, options);
+    } catch (...) {
+      progress.clear();
+      throw;
+    }
+    progress.clear();
     int usable = 0;
     for (const auto& c : candidates)
       usable += c.usable;

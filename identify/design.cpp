@@ -107,11 +107,13 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
   sim.quantities = o.quantities;
   sim.balance = o.balance;
   sim.skip_unconverged = true;
+  if (o.progress) sim.progress = [&](double done) { o.progress(0.5 * done); };
   std::vector<SimulatedTest> tests = simulate_sine_tests(sub, joints, force_at, candidates, sim);
   // Solved again from the linear response: where the two differ, the test has coexisting
   // periodic responses (near a fold of a non-linear resonance) and a real test could land on
   // either; such a candidate is left out.
   sim.warm_start = false;
+  if (o.progress) sim.progress = [&](double done) { o.progress(0.5 + 0.5 * done); };
   const std::vector<SimulatedTest> cold =
       simulate_sine_tests(sub, joints, force_at, candidates, sim);
   for (std::size_t i = 0; i < tests.size(); ++i) {

@@ -19,6 +19,7 @@
 #include "joints/joint.hpp"
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct DesignOptions {
   /// describe the joints' forces (dry friction that sticks: sign(ẏ) says nothing of the stuck
   /// force), so such a test biases the estimates beyond what its noise says. Infinite: keep all.
   double max_misfit = 0.2;
+  /// Called with the fraction of the predictions done (0 … 1], from one thread at a time (each
+  /// candidate is solved twice: swept up, then from the linear response); empty: not called.
+  std::function<void(double)> progress;
 };
 
 /// One candidate test as predicted at the prior values.

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -153,6 +154,14 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     return s;
   };
 
+  // Progress: tests done so far, reported under a lock (parallel jobs finish in any order).
+  std::mutex progress_lock;
+  std::size_t finished = 0;
+  auto one_done = [&] {
+    if (!o.progress) return;
+    const std::lock_guard<std::mutex> lock(progress_lock);
+    o.progress(static_cast<double>(++finished) / static_cast<double>(plans.size()));
+  };
   std::vector<SimulatedTest> out;
   if (time_domain) {
     const fem::SparseMatrix C = sub.damping_matrix();
@@ -192,6 +201,7 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
           test.comments.push_back("WARNING: " + what);
           test.warnings.push_back(what);
         }
+        one_done();
         return test;
       });
     out = fem::parallel_map(jobs);
@@ -230,6 +240,7 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
         failed.warnings.push_back(
             fmt::format("{}: no periodic solution found ({})", failed.record.source, hb.reason));
         done[i] = std::move(failed);
+        one_done();
         continue;
       }
       if (!hb.converged)
@@ -263,6 +274,7 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
                                           "the harmonics",
                                           hb.iterations, hb.residual, o.periods));
       done[i] = std::move(test);
+      one_done();
     }
     for (auto& t : done)
       out.push_back(std::move(*t));

@@ -11,6 +11,7 @@
 #include "joints/joint.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct SimulationOptions {
   /// the same force (a sweep up, which follows a hardening joint's upper branch); false: every
   /// test from the linear response.
   bool warm_start = true;
+  /// Called with the fraction of the tests done (0 … 1] after each test, from one thread at a
+  /// time (time integration runs tests in parallel); empty: nothing is called.
+  std::function<void(double)> progress;
 };
 
 struct SimulatedTest {

@@ -11,6 +11,7 @@
 #include "identify/measurement.hpp"
 #include "identify/sine_tests.hpp"
 #include "io/model_file.hpp"
+#include "io/terminal_progress.hpp"
 
 #include <fmt/format.h>
 
@@ -139,7 +140,9 @@ int main(int argc, char** argv) {
         fo.harmonics = harmonics;
         Eigen::VectorXd square = Eigen::VectorXd::Zero(scale.size());
         int failed = 0;
+        const io::TerminalProgress progress("paper_design_study: " + design.name);
         for (int r = 0; r < reps; ++r) {
+          progress.show(static_cast<double>(r) / reps);
           std::vector<identify::SineTest> tests;
           for (std::size_t i = 0; i < clean.size(); ++i) {
             identify::Record rec = clean[i].record;
@@ -157,6 +160,7 @@ int main(int argc, char** argv) {
             ++failed;
           }
         }
+        progress.clear();
         std::string row = "| " + design.name + " |";
         for (Eigen::Index u = 0; u < scale.size(); ++u) {
           const double rms = std::sqrt(square(u) / std::max(1, reps - failed));

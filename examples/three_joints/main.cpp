@@ -14,6 +14,7 @@
 #include "identify/sine_tests.hpp"
 #include "io/chart.hpp"
 #include "io/model_file.hpp"
+#include "io/terminal_progress.hpp"
 
 #include <fmt/format.h>
 
@@ -105,7 +106,9 @@ int main(int argc, char** argv) {
       names.push_back(fmt::format("{} {}", truth[j].name, joints::term_name(truth[j].terms[t])));
   covered.assign(names.size(), 0.0);
   bias = square = stds = covered;
+  const io::TerminalProgress progress("three_joints: Monte Carlo");
   for (int r = 0; r < reps; ++r) {
+    progress.show(static_cast<double>(r) / reps);
     const identify::FitResult fit = identify_once(r);
     std::size_t q = 0;
     for (std::size_t j = 0; j < truth.size(); ++j)
@@ -118,6 +121,7 @@ int main(int argc, char** argv) {
         stds[q] += e.std / std::abs(v) / reps;
       }
   }
+  progress.clear();
   fmt::print("\nMonte Carlo, {} repetitions:\n\n| parameter | coverage of the 95 % intervals | "
              "bias | scatter | mean reported std |\n|---|---:|---:|---:|---:|\n",
              reps);

@@ -100,7 +100,13 @@ TEST(Design, ChoiceIsTheBestSubsetOfAnExhaustiveSearch) {
   for (double f : {1.0, 2.5, 3.2, 4.0, 5.5, 17.0})
     for (double a : {10.0, 80.0})
       plans.push_back({f, a});
-  const auto candidates = identify::predict_candidates(sub, joints, tip, plans);
+  identify::DesignOptions options;
+  std::vector<double> progress; // two passes over the 12 candidates: 24 calls up to 1
+  options.progress = [&](double fraction) { progress.push_back(fraction); };
+  const auto candidates = identify::predict_candidates(sub, joints, tip, plans, options);
+  ASSERT_EQ(progress.size(), 24u);
+  for (std::size_t i = 0; i < progress.size(); ++i)
+    EXPECT_DOUBLE_EQ(progress[i], (i + 1.0) / 24.0);
   const auto unknowns = identify::design_unknowns(joints);
   ASSERT_EQ(unknowns.size(), 4u);
   const identify::Design design = identify::choose_tests(candidates, unknowns, 4);

@@ -360,6 +360,27 @@ TEST(SimulateSineTests, HarmonicBalanceWithoutASolutionSaysWhichTestAndWhy) {
   EXPECT_EQ(tests[1].record.t.size(), o.periods * o.steps_per_period);
 }
 
+TEST(SimulateSineTests, ProgressCountsEveryTestOnceUpToOne) {
+  // Five tests, both methods (time integration runs them in parallel): one call per test, the
+  // fractions k/5 in increasing order, the last exactly 1.
+  const std::vector<joints::Joint> js{make_joint({Term::k, Term::k3}, {4800.0, 1.6e8})};
+  const std::vector<SineTestPlan> plans{
+      {2.0, 10.0}, {2.5, 10.0}, {3.0, 10.0}, {3.5, 20.0}, {4.0, 20.0}};
+  for (const SimulationMethod method :
+       {SimulationMethod::time_integration, SimulationMethod::harmonic_balance}) {
+    SimulationOptions o;
+    o.method = method;
+    o.periods = 2;
+    o.steps_per_period = 128;
+    std::vector<double> seen;
+    o.progress = [&](double fraction) { seen.push_back(fraction); };
+    simulate_sine_tests(cantilever(), js, tip, plans, o);
+    ASSERT_EQ(seen.size(), plans.size());
+    for (std::size_t i = 0; i < seen.size(); ++i)
+      EXPECT_DOUBLE_EQ(seen[i], (i + 1.0) / plans.size());
+  }
+}
+
 TEST(SimulateSineTests, TestNamesUseTheShortestExactNumbers) {
   EXPECT_EQ(sine_test_name({3.4, 80.0}), "sine_f3.4Hz_F80N.csv");
   EXPECT_EQ(sine_test_name({0.1 + 0.2, 12.5}), "sine_f0.30000000000000004Hz_F12.5N.csv");
