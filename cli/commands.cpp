@@ -18,6 +18,7 @@
 #include "io/discovery_report.hpp"
 #include "io/files.hpp"
 #include "io/frf_output.hpp"
+#include "io/harmonic_fit_figure.hpp"
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
 #include "io/response_curves.hpp"
@@ -453,11 +454,13 @@ void identify(const IdentifyOptions& o) {
   if (o.records.empty()) throw io::Error("expected at least one record or table (CSV file)");
   check_harmonics(o.harmonics, 0);
   check_output_file(o.output);
+  if (!o.fit_png.empty()) check_output_file(o.fit_png);
 
   const io::ModelFile file = io::read_model(o.model);
   if (file.joints.empty()) throw io::Error(o.model.string() + ": no [[joints]] to identify");
   const std::vector<identify::SineTest> tests = io::read_tests(o.records);
   io::check_not_an_input(o.output);
+  if (!o.fit_png.empty()) io::check_not_an_input(o.fit_png);
   identify::FitOptions options;
   options.harmonics = o.harmonics;
   const std::vector<identify::Measurement> measured =
@@ -468,6 +471,25 @@ void identify(const IdentifyOptions& o) {
   if (result.status != identify::FitStatus::ok) throw io::Error("identify: " + result.reason);
   if (!output_rank()) return;
   io::write_json(o.output, io::identify_result_json(result, {}, &measured));
+  if (!o.fit_png.empty()) {
+    std::vector<fem::NodeDof> shown;
+    for (const joints::Joint& j : file.joints)
+      for (const int node : {j.node, j.node_b})
+        if (node != 0 &&
+            std::find(shown.begin(), shown.end(), fem::NodeDof{node, j.dof}) == shown.end())
+          shown.push_back({node, j.dof});
+    std::string why;
+    if (!io::can_render_charts(&why)) {
+      warn("no " + o.fit_png.string() + ": " + why + " (run under xvfb-run -a)");
+    } else {
+      try {
+        io::write_chart_png(o.fit_png, io::harmonic_fit_figure(measured, shown));
+        fmt::print("wrote {}\n", o.fit_png.string());
+      } catch (const std::invalid_argument& e) {
+        warn("no " + o.fit_png.string() + ": " + e.what());
+      }
+    }
+  }
 
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
              "95 % interval");

@@ -66,11 +66,12 @@ struct IdentifyOptions {
   std::vector<std::filesystem::path> records; ///< time records or stepped-sine tables
   std::filesystem::path output;
   std::vector<int> harmonics{1};
-  std::string engine = "auto"; ///< modes of a large model: auto or slepc (MPI)
+  std::string engine = "auto";   ///< modes of a large model: auto or slepc (MPI)
+  std::filesystem::path fit_png; ///< not empty: the records with their harmonic fits
 };
 
 /// Identifies the joints' non-fixed terms from the tests; writes the JSON result and prints
-/// a table.
+/// a table; with fit_png, a picture of each test's joint displacements and their harmonic fits.
 void identify(const IdentifyOptions& options);
 
 struct DiscoverOptions {

@@ -20,7 +20,8 @@ add_library(jointid_io_vtk ${CMAKE_CURRENT_LIST_DIR}/vtk_output.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/discovery_report.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/response_figure.cpp
                            ${CMAKE_CURRENT_LIST_DIR}/compare_figure.cpp
-                           ${CMAKE_CURRENT_LIST_DIR}/frf_figure.cpp)
+                           ${CMAKE_CURRENT_LIST_DIR}/frf_figure.cpp
+                           ${CMAKE_CURRENT_LIST_DIR}/harmonic_fit_figure.cpp)
 target_link_libraries(jointid_io_vtk PUBLIC jointid_io PRIVATE ${VTK_LIBRARIES} fmt::fmt)
 # Registers the OpenGL render window, the FreeType text renderer and the OpenGL context device
 # (which draws the charts) with VTK's factories.

@@ -197,6 +197,16 @@ TEST_F(CliTest, IdentifyRecoversTheJoint) {
     EXPECT_NEAR(terms[i]["value"].get<double>(), truth[i].second, 0.005 * truth[i].second)
         << truth[i].first;
   }
+#if JOINTID_WITH_VTK
+  // The records with their harmonic fits: a picture beside the result (the same values).
+  const fs::path png = dir() / "fits.png", again = dir() / "result_again.json";
+  args.back() = again.string();
+  args.insert(args.end(), {"--fit-png", png.string()});
+  const Outcome with_png = jointid(args, dir());
+  ASSERT_EQ(with_png.status, 0) << with_png.err;
+  EXPECT_GT(fs::file_size(png), 10000u) << with_png.out << with_png.err;
+  EXPECT_EQ(json::parse(test::read_text(again))["joints"], j["joints"]);
+#endif
 }
 
 TEST_F(CliTest, ModesMatchTheCantileverTheory) {

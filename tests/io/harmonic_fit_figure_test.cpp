@@ -1,0 +1,58 @@
+// The records-and-harmonic-fits figure of `jointid identify --fit-png`: its data, checked without
+// drawing. A harmonic-balance record holds harmonics 0 … 9 exactly, so a fit of 9 harmonics
+// leaves only rounding; a fit of the fundamental alone leaves the cubic joint's harmonics.
+#include "io/harmonic_fit_figure.hpp"
+
+#include "frf/substructure.hpp"
+#include "identify/sine_tests.hpp"
+#include "support/cantilever.hpp"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace jointid;
+
+namespace {
+
+double residual_percent(const std::string& title) {
+  const auto at = title.find("residual ");
+  return std::stod(title.substr(at + 9));
+}
+
+TEST(HarmonicFitFigure, ResidualIsRoundingWithEveryHarmonicAndNotWithTheFundamentalAlone) {
+  const frf::Substructure sub(test::paper_cantilever());
+  joints::Joint j{"tip",           7,  0, fem::Dof::uy, {joints::Term::k, joints::Term::k3},
+                  {4800.0, 1.6e8}, {}, {}};
+  j.fixed.assign(2, true);
+  identify::SimulationOptions o;
+  o.method = identify::SimulationMethod::harmonic_balance;
+  o.periods = 2;
+  o.steps_per_period = 256;
+  const auto simulated =
+      identify::simulate_sine_tests(sub, {j}, {7, fem::Dof::uy}, {{1.0, 80.0}, {4.0, 80.0}}, o);
+  std::vector<identify::SineTest> tests;
+  for (const auto& s : simulated)
+    tests.emplace_back(s.record);
+  const std::vector<fem::NodeDof> shown{{7, fem::Dof::uy}};
+  identify::MeasureOptions all;
+  all.harmonics = 9;
+  const io::Figure exact = io::harmonic_fit_figure(identify::measure(tests, all), shown);
+  ASSERT_EQ(exact.charts.size(), 2u);
+  for (const auto& chart : exact.charts) {
+    ASSERT_EQ(chart.series.size(), 2u);        // samples, fit
+    EXPECT_EQ(chart.series[0].x.size(), 256u); // one averaged period
+    EXPECT_LT(residual_percent(chart.title), 1e-8) << chart.title;
+  }
+  identify::MeasureOptions fundamental;
+  fundamental.harmonics = 1;
+  const io::Figure rough = io::harmonic_fit_figure(identify::measure(tests, fundamental), shown);
+  EXPECT_GT(residual_percent(rough.charts[0].title), 1.0) << rough.charts[0].title; // 1 Hz
+  // A DOF without a displacement channel: nothing to draw.
+  EXPECT_THROW(io::harmonic_fit_figure(identify::measure(tests, all), {{4, fem::Dof::uy}}),
+               std::invalid_argument);
+}
+
+} // namespace
