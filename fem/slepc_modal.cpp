@@ -211,16 +211,29 @@ Modes slepc_modal_analysis(const Model& model, const ModalOptions& o, const Slep
   const PetscErrorCode set_up = EPSSetUp(eps.get());
   const PetscErrorCode factorised = set_up != 0 ? set_up : KSPSetUp(ksp);
   if (block > 1) PetscOptionsClearValue(nullptr, block_option);
-  check(set_up, "EPSSetUp");
-  check(factorised, "factorising K - sigma M with MUMPS");
+  // A factorisation that breaks down (a zero or negative pivot) makes EPSSetUp fail with
+  // PETSc's "error in external library": say what that means before the generic error. MUMPS'
+  // INFOG(1) < 0 is its own verdict (-10: numerically singular) when PETSc records no reason.
   PCFailedReason failed = PC_NOERROR;
-  check(PCGetFailedReason(pc, &failed), "PCGetFailedReason");
-  if (failed != PC_NOERROR)
+  const bool reason_known = PCGetFailedReason(pc, &failed) == 0;
+  PetscInt mumps_status = 0;
+  if (set_up != 0 || factorised != 0) {
+    Mat factor = nullptr;
+    if (PCFactorGetMatrix(pc, &factor) == 0 && factor != nullptr)
+      MatMumpsGetInfog(factor, 1, &mumps_status);
+  }
+  if ((reason_known && failed != PC_NOERROR) || mumps_status < 0)
     throw std::invalid_argument(
         "SLEPc modal analysis: K + (2 pi " + std::to_string(o.shift_hz) +
-        " Hz)^2 M could not be factorised (" + PCFailedReasons[failed] +
+        " Hz)^2 M could not be factorised (" +
+        (reason_known && failed != PC_NOERROR
+             ? std::string(PCFailedReasons[failed])
+             : "MUMPS INFOG(1) = " + std::to_string(mumps_status) +
+                   (mumps_status == -10 ? ", numerically singular" : "")) +
         "); look for a DOF with neither stiffness nor mass (e.g. a rotation no element or "
         "spring holds), or a negative mass or stiffness");
+  check(set_up, "EPSSetUp");
+  check(factorised, "factorising K - sigma M with MUMPS");
   stats.factorize_s = seconds_since(start);
   Mat factor = nullptr;
   if (PCFactorGetMatrix(pc, &factor) == 0 && factor != nullptr) {

@@ -14,6 +14,7 @@
 #include <memory>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 namespace jointid {
 namespace {
@@ -144,6 +145,22 @@ TEST(SlepcModal, CallerMistakesThrow) {
   EXPECT_THROW(fem::slepc_modal_analysis(model, {.num_modes = 10000}), std::invalid_argument);
   EXPECT_THROW(fem::slepc_modal_analysis(model, {.num_modes = 4}, {.rows = {-1}}),
                std::invalid_argument);
+}
+
+TEST(SlepcModal, ADofWithNeitherStiffnessNorMassIsRefused) {
+  // A node held by a spring of zero stiffness and without mass: K − σM has a zero row, which
+  // MUMPS cannot factorise; the error says what to look for (every rank throws it).
+  fem::Model model = bench::frame_lattice(3, 2, 3, 1.0);
+  model.nodes.push_back({9999, Eigen::Vector3d(50.0, 50.0, 50.0)});
+  model.springs.push_back({9999, 0, fem::Dof::uy, 0.0});
+  try {
+    fem::slepc_modal_analysis(model, {.num_modes = 4});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("could not be factorised"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("neither stiffness nor mass"), std::string::npos)
+        << e.what();
+  }
 }
 
 } // namespace
