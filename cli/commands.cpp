@@ -471,26 +471,6 @@ void identify(const IdentifyOptions& o) {
   if (result.status != identify::FitStatus::ok) throw io::Error("identify: " + result.reason);
   if (!output_rank()) return;
   io::write_json(o.output, io::identify_result_json(result, {}, &measured));
-  if (!o.fit_png.empty()) {
-    std::vector<fem::NodeDof> shown;
-    for (const joints::Joint& j : file.joints)
-      for (const int node : {j.node, j.node_b})
-        if (node != 0 &&
-            std::find(shown.begin(), shown.end(), fem::NodeDof{node, j.dof}) == shown.end())
-          shown.push_back({node, j.dof});
-    std::string why;
-    if (!io::can_render_charts(&why)) {
-      warn("no " + o.fit_png.string() + ": " + why + " (run under xvfb-run -a)");
-    } else {
-      try {
-        io::write_chart_png(o.fit_png, io::harmonic_fit_figure(measured, shown));
-        fmt::print("wrote {}\n", o.fit_png.string());
-      } catch (const std::invalid_argument& e) {
-        warn("no " + o.fit_png.string() + ": " + e.what());
-      }
-    }
-  }
-
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
              "95 % interval");
   for (const auto& j : result.joints)
@@ -513,6 +493,25 @@ void identify(const IdentifyOptions& o) {
   for (const auto& sentence : result.identifiability)
     fmt::print("not determined: {}\n", sentence);
   fmt::print("wrote {}\n", o.output.string());
+  if (!o.fit_png.empty()) {
+    std::vector<fem::NodeDof> shown;
+    for (const joints::Joint& j : file.joints)
+      for (const int node : {j.node, j.node_b})
+        if (node != 0 &&
+            std::find(shown.begin(), shown.end(), fem::NodeDof{node, j.dof}) == shown.end())
+          shown.push_back({node, j.dof});
+    std::string why;
+    if (!io::can_render_charts(&why)) {
+      warn("no " + o.fit_png.string() + ": " + why + " (run under xvfb-run -a)");
+    } else {
+      try {
+        io::write_chart_png(o.fit_png, io::harmonic_fit_figure(measured, shown));
+        fmt::print("wrote {}\n", o.fit_png.string());
+      } catch (const std::invalid_argument& e) {
+        warn("no " + o.fit_png.string() + ": " + e.what());
+      }
+    }
+  }
   for (const auto& w : result.warnings)
     warn(w);
 }
