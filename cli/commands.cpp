@@ -454,13 +454,17 @@ void identify(const IdentifyOptions& o) {
   if (o.records.empty()) throw io::Error("expected at least one record or table (CSV file)");
   check_harmonics(o.harmonics, 0);
   check_output_file(o.output);
-  if (!o.fit_png.empty()) check_output_file(o.fit_png);
+  for (const fs::path& png : {o.fit_png, o.params_png})
+    if (!png.empty()) check_output_file(png);
+  if (!o.fit_png.empty() && o.fit_png == o.params_png)
+    throw io::Error("--fit-png and --params-png: expected two different files");
 
   const io::ModelFile file = io::read_model(o.model);
   if (file.joints.empty()) throw io::Error(o.model.string() + ": no [[joints]] to identify");
   const std::vector<identify::SineTest> tests = io::read_tests(o.records);
   io::check_not_an_input(o.output);
-  if (!o.fit_png.empty()) io::check_not_an_input(o.fit_png);
+  for (const fs::path& png : {o.fit_png, o.params_png})
+    if (!png.empty()) io::check_not_an_input(png);
   identify::FitOptions options;
   options.harmonics = o.harmonics;
   const std::vector<identify::Measurement> measured =
@@ -493,23 +497,32 @@ void identify(const IdentifyOptions& o) {
   for (const auto& sentence : result.identifiability)
     fmt::print("not determined: {}\n", sentence);
   fmt::print("wrote {}\n", o.output.string());
-  if (!o.fit_png.empty()) {
-    std::vector<fem::NodeDof> shown;
-    for (const joints::Joint& j : file.joints)
-      for (const int node : {j.node, j.node_b})
-        if (node != 0 &&
-            std::find(shown.begin(), shown.end(), fem::NodeDof{node, j.dof}) == shown.end())
-          shown.push_back({node, j.dof});
-    std::string why;
-    if (!io::can_render_charts(&why)) {
-      warn("no " + o.fit_png.string() + ": " + why + " (run under xvfb-run -a)");
-    } else {
-      try {
-        io::write_chart_png(o.fit_png, io::harmonic_fit_figure(measured, shown));
-        fmt::print("wrote {}\n", o.fit_png.string());
-      } catch (const std::invalid_argument& e) {
-        warn("no " + o.fit_png.string() + ": " + e.what());
-      }
+  // The pictures (each optional; one that cannot be drawn is a warning, the result stands).
+  std::vector<std::pair<fs::path, std::function<io::Figure()>>> pictures;
+  if (!o.fit_png.empty())
+    pictures.push_back({o.fit_png, [&] {
+                          std::vector<fem::NodeDof> shown;
+                          for (const joints::Joint& j : file.joints)
+                            for (const int node : {j.node, j.node_b})
+                              if (node != 0 && std::find(shown.begin(), shown.end(),
+                                                         fem::NodeDof{node, j.dof}) == shown.end())
+                                shown.push_back({node, j.dof});
+                          return io::harmonic_fit_figure(measured, shown);
+                        }});
+  if (!o.params_png.empty())
+    pictures.push_back({o.params_png, [&] { return io::parameter_figure(result, file.joints); }});
+  std::string why;
+  const bool drawable = pictures.empty() || io::can_render_charts(&why);
+  for (const auto& [png, figure] : pictures) {
+    if (!drawable) {
+      warn("no " + png.string() + ": " + why + " (run under xvfb-run -a)");
+      continue;
+    }
+    try {
+      io::write_chart_png(png, figure());
+      fmt::print("wrote {}\n", png.string());
+    } catch (const std::invalid_argument& e) {
+      warn("no " + png.string() + ": " + e.what());
     }
   }
   for (const auto& w : result.warnings)

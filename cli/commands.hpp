@@ -66,12 +66,14 @@ struct IdentifyOptions {
   std::vector<std::filesystem::path> records; ///< time records or stepped-sine tables
   std::filesystem::path output;
   std::vector<int> harmonics{1};
-  std::string engine = "auto";   ///< modes of a large model: auto or slepc (MPI)
-  std::filesystem::path fit_png; ///< not empty: the records with their harmonic fits
+  std::string engine = "auto";      ///< modes of a large model: auto or slepc (MPI)
+  std::filesystem::path fit_png;    ///< not empty: the records with their harmonic fits
+  std::filesystem::path params_png; ///< not empty: identified / model values with intervals
 };
 
 /// Identifies the joints' non-fixed terms from the tests; writes the JSON result and prints
-/// a table; with fit_png, a picture of each test's joint displacements and their harmonic fits.
+/// a table; with fit_png, a picture of each test's joint displacements and their harmonic fits;
+/// with params_png, the identified values against the model's with their intervals.
 void identify(const IdentifyOptions& options);
 
 struct DiscoverOptions {

@@ -194,6 +194,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   identify->add_option("--fit-png", ident.fit_png,
                        "Picture (PNG) of each test's joint displacements with their harmonic fits");
+  identify->add_option("--params-png", ident.params_png,
+                       "Picture (PNG) of the identified values / the model's, with 95 % intervals");
 
   cli::DiscoverOptions disc;
   auto* discover = app.add_subcommand(
@@ -368,7 +370,8 @@ int main(int argc, char** argv) {
     const cli::EngineSession session(cli::parse_engine(engine));
     const bool distributed = engine == "slepc";
     if (simulate->parsed()) cli::simulate(sim);
-    if (identify->parsed() && !ident.fit_png.empty() && !distributed) rerun_with_display(argv);
+    if (identify->parsed() && !(ident.fit_png.empty() && ident.params_png.empty()) && !distributed)
+      rerun_with_display(argv);
     if (identify->parsed()) cli::identify(ident);
     if (discover->parsed() && disc.plots && !distributed) rerun_with_display(argv);
     if (discover->parsed()) cli::discover(disc);

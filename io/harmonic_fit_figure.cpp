@@ -77,4 +77,56 @@ Figure harmonic_fit_figure(const std::vector<identify::Measurement>& tests,
   return figure;
 }
 
+Figure parameter_figure(const identify::FitResult& result,
+                        const std::vector<joints::Joint>& model_joints) {
+  Chart chart;
+  chart.title = "identified / model value, with the 95 % intervals";
+  chart.y_label = "identified / model";
+  chart.legend = false;
+  Series values;
+  values.style = Series::Style::points;
+  values.width = 6.0;
+  values.color = palette_color(0);
+  std::vector<Series> intervals;
+  for (const identify::JointEstimate& je : result.joints) {
+    const auto given = std::find_if(model_joints.begin(), model_joints.end(),
+                                    [&](const joints::Joint& j) { return j.name == je.name; });
+    if (given == model_joints.end()) continue;
+    for (const identify::TermEstimate& t : je.terms) {
+      const int at = given->term_index(t.term);
+      if (t.fixed || at < 0 || !given->has_value(static_cast<std::size_t>(at))) continue;
+      const double reference = given->values[static_cast<std::size_t>(at)];
+      if (reference == 0.0 || !std::isfinite(t.value)) continue;
+      const double x = static_cast<double>(chart.x_categories.size() + 1);
+      chart.x_categories.push_back(fmt::format("{} {}", je.name, joints::term_name(t.term)));
+      values.x.push_back(x);
+      values.y.push_back(t.value / reference);
+      Series interval;
+      interval.color = palette_color(0);
+      interval.x = {x, x};
+      interval.y = {t.ci_low / reference, t.ci_high / reference};
+      if (std::isfinite(interval.y[0]) && std::isfinite(interval.y[1]))
+        intervals.push_back(std::move(interval));
+    }
+  }
+  if (values.x.empty())
+    throw std::invalid_argument(
+        "parameters: no identified term has a non-zero value in the model to compare with");
+  Series one;
+  one.style = Series::Style::dashed;
+  one.color = {0, 0, 0};
+  one.width = 1.0;
+  one.x = {0.5, values.x.back() + 0.5};
+  one.y = {1.0, 1.0};
+  chart.series.push_back(std::move(one));
+  for (Series& s : intervals)
+    chart.series.push_back(std::move(s));
+  chart.series.push_back(std::move(values));
+  Figure figure;
+  figure.width = std::max(600, 110 * static_cast<int>(chart.x_categories.size()) + 200);
+  figure.height = 600;
+  figure.charts.push_back(std::move(chart));
+  return figure;
+}
+
 } // namespace jointid::io

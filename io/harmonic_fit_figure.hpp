@@ -1,7 +1,9 @@
 #pragma once
-/// Time records with their harmonic fits, as `jointid identify --fit-png` draws them: what the
-/// identification sees of each test.
+/// The pictures of `jointid identify`: the time records with their harmonic fits (--fit-png,
+/// what the identification sees of each test) and the identified values against the model's
+/// (--params-png).
 #include "fem/dof.hpp"
+#include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "io/chart.hpp"
 
@@ -18,5 +20,12 @@ namespace jointid::io {
 /// test has a displacement channel at any of `shown`.
 Figure harmonic_fit_figure(const std::vector<identify::Measurement>& tests,
                            const std::vector<fem::NodeDof>& shown);
+
+/// Every identified term whose value the model gives (a simulation's truth, or a prior guess),
+/// as identified / model value (points) with its 95 % interval (a vertical line) over the
+/// terms ("joint term"), and the line at 1. Throws std::invalid_argument when no identified
+/// term has a non-zero value in the model to compare with.
+Figure parameter_figure(const identify::FitResult& result,
+                        const std::vector<joints::Joint>& model_joints);
 
 } // namespace jointid::io

@@ -201,10 +201,12 @@ TEST_F(CliTest, IdentifyRecoversTheJoint) {
   // The records with their harmonic fits: a picture beside the result (the same values).
   const fs::path png = dir() / "fits.png", again = dir() / "result_again.json";
   args.back() = again.string();
-  args.insert(args.end(), {"--fit-png", png.string()});
+  const fs::path params = dir() / "params.png";
+  args.insert(args.end(), {"--fit-png", png.string(), "--params-png", params.string()});
   const Outcome with_png = jointid(args, dir());
   ASSERT_EQ(with_png.status, 0) << with_png.err;
   EXPECT_GT(fs::file_size(png), 10000u) << with_png.out << with_png.err;
+  EXPECT_GT(fs::file_size(params), 5000u) << with_png.out << with_png.err;
   EXPECT_EQ(json::parse(test::read_text(again))["joints"], j["joints"]);
 #endif
 }

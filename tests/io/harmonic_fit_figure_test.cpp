@@ -55,4 +55,32 @@ TEST(HarmonicFitFigure, ResidualIsRoundingWithEveryHarmonicAndNotWithTheFundamen
                std::invalid_argument);
 }
 
+TEST(ParameterFigure, RatiosAndIntervalsOfTheTermsTheModelGives) {
+  joints::Joint model{"tip",
+                      7,
+                      0,
+                      fem::Dof::uy,
+                      {joints::Term::k, joints::Term::c, joints::Term::k3},
+                      {4800.0, 20.0, 0.0},
+                      {false, true, false},
+                      {true, true, false}};
+  identify::FitResult r;
+  r.joints.push_back({"tip",
+                      {{joints::Term::k, 4896.0, 24.0, 4848.0, 4944.0, false, true},
+                       {joints::Term::c, 20.0, 0.0, 20.0, 20.0, true, true},
+                       {joints::Term::k3, 1.7e8, 1e6, 1.68e8, 1.72e8, false, true}}});
+  const io::Figure f = io::parameter_figure(r, {model});
+  ASSERT_EQ(f.charts.size(), 1u);
+  const io::Chart& c = f.charts[0];
+  // c is fixed and k3 has no value in the model: k alone, at 1.02 with [1.01, 1.03].
+  ASSERT_EQ(c.x_categories, std::vector<std::string>{"tip k"});
+  ASSERT_EQ(c.series.size(), 3u); // the line at 1, k's interval, the values
+  EXPECT_EQ(c.series[0].y, (std::vector<double>{1.0, 1.0}));
+  EXPECT_DOUBLE_EQ(c.series[1].y[0], 1.01);
+  EXPECT_DOUBLE_EQ(c.series[1].y[1], 1.03);
+  EXPECT_DOUBLE_EQ(c.series[2].y[0], 1.02);
+  model.given = {false, true, false};
+  EXPECT_THROW(io::parameter_figure(r, {model}), std::invalid_argument);
+}
+
 } // namespace
