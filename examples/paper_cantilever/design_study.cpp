@@ -12,6 +12,7 @@
 #include "identify/sine_tests.hpp"
 #include "io/model_file.hpp"
 #include "io/terminal_progress.hpp"
+#include "paper_cases.hpp"
 
 #include <fmt/format.h>
 
@@ -31,16 +32,12 @@ struct Named {
   std::vector<identify::SineTestPlan> tests;
 };
 
+// The paper's cases, named as in the table.
 std::vector<Named> paper_cases() {
-  Named c1{"case I (1–4.6 Hz, 80 N)", {}}, c2{"case II (17–20.6 Hz, 80 N)", {}},
-      c3{"case III (3 Hz, 10–100 N)", {}}, c4{"case IV (19 Hz, 10–100 N)", {}};
-  for (int i = 0; i < 10; ++i) {
-    c1.tests.push_back({1.0 + 0.4 * i, 80.0});
-    c2.tests.push_back({17.0 + 0.4 * i, 80.0});
-    c3.tests.push_back({3.0, 10.0 * (i + 1)});
-    c4.tests.push_back({19.0, 10.0 * (i + 1)});
-  }
-  return {c1, c2, c3, c4};
+  std::vector<Named> out;
+  for (const examples::PaperCase& c : examples::paper_cases())
+    out.push_back({"case " + c.name + " (" + c.description + ")", c.tests});
+  return out;
 }
 
 } // namespace

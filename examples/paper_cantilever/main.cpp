@@ -13,6 +13,7 @@
 #include "identify/sine_tests.hpp"
 #include "io/model_file.hpp"
 #include "io/results_json.hpp"
+#include "paper_cases.hpp"
 
 #include <array>
 #include <cmath>
@@ -27,21 +28,8 @@ using namespace jointid;
 
 namespace {
 
-struct Case {
-  const char* name;
-  std::vector<std::pair<double, double>> tests; // (frequency Hz, force amplitude N)
-};
-
-std::vector<Case> paper_cases() {
-  Case c1{"I", {}}, c2{"II", {}}, c3{"III", {}}, c4{"IV", {}};
-  for (int i = 0; i < 10; ++i) {
-    c1.tests.push_back({1.0 + 0.4 * i, 80.0});
-    c2.tests.push_back({17.0 + 0.4 * i, 80.0});
-    c3.tests.push_back({3.0, 10.0 * (i + 1)});
-    c4.tests.push_back({19.0, 10.0 * (i + 1)});
-  }
-  return {c1, c2, c3, c4};
-}
+using Case = examples::PaperCase;
+using examples::paper_cases;
 
 struct PaperModel {
   const char* name;
@@ -89,7 +77,7 @@ public:
         const auto records = measure(model, test_case);
         for (const std::vector<int>& harmonics : {std::vector<int>{1}, std::vector<int>{1, 2, 3}}) {
           const identify::FitResult r = identify(model, records, harmonics);
-          print_table(model, test_case.name, c, harmonics, r);
+          print_table(model, test_case.name.c_str(), c, harmonics, r);
           if (harmonics.size() == 1)
             for (std::size_t t = 0; t < model.terms.size(); ++t)
               worst_[model.name] = std::max(
@@ -123,7 +111,7 @@ private:
   // the stuck tests cause the bias.
   void diagnose_stick_slip(nlohmann::json& out) const {
     const PaperModel model = paper_models()[1];
-    Case slipping{"I (2.2-4.6 Hz)", {}};
+    Case slipping{"I (2.2-4.6 Hz)", "2.2–4.6 Hz, 80 N", {}};
     for (int i = 3; i < 10; ++i)
       slipping.tests.push_back({1.0 + 0.4 * i, 80.0});
     const auto records = measure(model, slipping);
@@ -160,9 +148,7 @@ private:
 
   // Step 2: "measure" every test of a case by time integration to the periodic steady state.
   std::vector<identify::Record> measure(const PaperModel& m, const Case& c) const {
-    std::vector<identify::SineTestPlan> plans;
-    for (const auto& [freq, amp] : c.tests)
-      plans.push_back({freq, amp});
+    const std::vector<identify::SineTestPlan>& plans = c.tests;
     identify::SimulationOptions options;
     options.steps_per_period = steps_;
     options.periods = 4;
