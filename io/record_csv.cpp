@@ -206,6 +206,11 @@ identify::Record read_record(const std::filesystem::path& path) {
                            "increase strictly)",
                            t[i], t[i - 1]));
   const double mean_step = (t[n - 1] - t[0]) / static_cast<double>(n - 1);
+  if (!std::isfinite(mean_step)) // the span overflows: then every deviation would be NaN
+    csv.fail(csv.rows[n - 1].number,
+             fmt::format("t runs from {} to {} s, a span beyond the range of a double (expected "
+                         "the times of a test, in s)",
+                         t[0], t[n - 1]));
   for (std::size_t i = 1; i < n; ++i) {
     const double deviation = std::abs((t[i] - t[i - 1]) - mean_step) / mean_step;
     if (deviation > 1e-6)

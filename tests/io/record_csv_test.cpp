@@ -187,6 +187,13 @@ TEST_F(RecordCsvTest, TimeMustIncreaseUniformly) {
   EXPECT_NO_THROW(read_record(write(test::replaced(good_csv, "0.375,", "0.37500001,"))));
 }
 
+// Fuzzing regression (docs/fuzzing.md): times near the limits of a double made the span
+// overflow, the mean step infinite and every deviation NaN, so non-uniform sampling passed.
+TEST_F(RecordCsvTest, TimeSpanBeyondTheRangeOfADoubleIsAnError) {
+  expect_error("t,x@7:uy\n-1e308,0\n-5e307,0\n0,0\n1e308,0\n", 5,
+               {"t runs from -1e+308 to 1e+308 s, a span beyond the range of a double"});
+}
+
 TEST_F(RecordCsvTest, CommentAfterHeader) {
   expect_error(test::replaced(good_csv, "0.25,0.0,3e-3\n", "0.25,0.0,3e-3\n# late\n"), 7,
                {"comment"});
