@@ -1,5 +1,6 @@
 // libFuzzer target: the measurement CSV readers on the same input, a time record
-// (io::read_record, then its fundamentals, io::stepped_sine_table) and a stepped-sine table
+// (io::read_record, then its fundamentals, io::stepped_sine_table, at its excitation_hz or at
+// the frequency estimated from it) and a stepped-sine table
 // (io::read_stepped_sine, then its tests). Contract: a result or io::Error; anything else
 // escaping is a finding, and so is a record or table that breaks what the reader promises
 // (record_contract.hpp; a table's frequencies > 0 and values finite).
@@ -14,7 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const auto record = jointid::io::read_record(path);
     jointid::fuzz::check_record(record);
-    if (record.excitation_hz) (void)jointid::io::stepped_sine_table({record});
+    (void)jointid::io::stepped_sine_table({record}); // excitation_hz, or estimated
   } catch (const jointid::io::Error&) {
   }
   try {
