@@ -211,11 +211,14 @@ void read_v4(GmshMesh& mesh, Reader& r) {
           s >> tag;
           for (int k = 0; k < nbox; ++k)
             s >> box[k];
-          std::size_t nphys = 0;
+          long long nphys = 0; // signed: "-3" must not wrap to a huge count
           if (!(s >> nphys))
             r.fail("expected an entity: tag, coordinates, number of physical tags");
+          if (nphys < 0)
+            r.fail("entity " + std::to_string(tag) +
+                   ": expected a number of physical tags >= 0, got " + std::to_string(nphys));
           std::vector<int> phys;
-          for (std::size_t k = 0; k < nphys; ++k) {
+          for (long long k = 0; k < nphys; ++k) {
             int p = 0;
             if (!(s >> p))
               r.fail("entity " + std::to_string(tag) + ": expected " + std::to_string(nphys) +
