@@ -34,12 +34,15 @@ for target in "${targets[@]}"; do
   dict=()
   [ -f "fuzz/$name.dict" ] && dict=(-dict="fuzz/$name.dict")
   echo "== $target: ${seconds} s (log: build-fuzz/logs/$target.log)"
-  if ! "build-fuzz/fuzz/$target" "$corpus" "fuzz/corpus/$target" "${dict[@]}" \
-      -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
-      -print_final_stats=1 -artifact_prefix="$findings/" >"build-fuzz/logs/$target.log" 2>&1; then
+  "build-fuzz/fuzz/$target" "$corpus" "fuzz/corpus/$target" "${dict[@]}" \
+    -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
+    -print_final_stats=1 -artifact_prefix="$findings/" >"build-fuzz/logs/$target.log" 2>&1 &
+  pid=$!
+  if ! wait "$pid"; then
     echo "   FOUND something: see build-fuzz/logs/$target.log and $findings/" >&2
     status=1
   fi
+  rm -rf "/dev/shm/jointid_fuzz.$pid" # the target's input directory, left behind by a crash
   grep -E '^stat::(number_of_executed_units|average_exec_per_sec|peak_rss_mb)' \
     "build-fuzz/logs/$target.log" | sed 's/^/   /' || true
   echo "   corpus: $(find "$corpus" -type f | wc -l) inputs"
