@@ -92,9 +92,13 @@ int whole_period_samples(const Eigen::VectorXd& t, double frequency_hz) {
   if (n < 2) return 0;
   const double dt = (t(n - 1) - t(0)) / (n - 1), T = 1.0 / frequency_hz;
   // The samples cover n·dt seconds (each sample stands for one interval).
-  const int periods = static_cast<int>(std::floor(n * dt / T + 1e-9));
-  if (periods < 1) return 0;
-  return std::min(n, static_cast<int>(std::lround(periods * T / dt)));
+  // In double until the count is known to fit an int: a frequency far above the sampling's (or
+  // NaN) must not overflow the conversion.
+  const double periods = std::floor(n * dt / T + 1e-9);
+  if (!(periods >= 1.0)) return 0;
+  const double samples = std::round(periods * T / dt);
+  if (!(samples >= 0.0)) return 0;
+  return samples >= n ? n : static_cast<int>(samples);
 }
 
 } // namespace jointid::identify

@@ -163,11 +163,14 @@ void read_v2(GmshMesh& mesh, Reader& r) {
         int id = 0, type = 0, ntags = 0;
         if (!(s >> id >> type >> ntags) || ntags < 0)
           r.fail("expected an element: id type ntags tags... nodes...");
-        std::vector<int> tags(ntags);
-        for (int& t : tags)
+        // Read one by one (not sized from ntags first): a line holds only so many tags.
+        std::vector<int> tags;
+        for (int t = 0, k = 0; k < ntags; ++k) {
           if (!(s >> t))
             r.fail("element " + std::to_string(id) + ": expected " + std::to_string(ntags) +
                    " tags");
+          tags.push_back(t);
+        }
         const int nn = nodes_of(type);
         if (nn < 0)
           r.fail("unknown element type " + std::to_string(type) + " for element " +
@@ -209,14 +212,20 @@ void read_v4(GmshMesh& mesh, Reader& r) {
           s >> tag;
           for (int k = 0; k < nbox; ++k)
             s >> box[k];
-          std::size_t nphys = 0;
+          long long nphys = 0; // signed: "-3" must not wrap to a huge count
           if (!(s >> nphys))
             r.fail("expected an entity: tag, coordinates, number of physical tags");
-          std::vector<int> phys(nphys);
-          for (int& p : phys)
+          if (nphys < 0)
+            r.fail("entity " + std::to_string(tag) +
+                   ": expected a number of physical tags >= 0, got " + std::to_string(nphys));
+          std::vector<int> phys;
+          for (long long k = 0; k < nphys; ++k) {
+            int p = 0;
             if (!(s >> p))
               r.fail("entity " + std::to_string(tag) + ": expected " + std::to_string(nphys) +
                      " physical tags");
+            phys.push_back(p);
+          }
           entity_groups[{dim, tag}] = phys;
         }
       r.expect("$EndEntities");
@@ -227,9 +236,12 @@ void read_v4(GmshMesh& mesh, Reader& r) {
         int dim = 0, tag = 0, parametric = 0;
         std::size_t count = 0;
         r.read("entityDim entityTag parametric numNodesInBlock", dim, tag, parametric, count);
-        std::vector<int> ids(count);
-        for (int& id : ids)
+        std::vector<int> ids; // one a line: not sized from `count` before the lines are there
+        for (std::size_t k = 0; k < count; ++k) {
+          int id = 0;
           r.read("a node tag", id);
+          ids.push_back(id);
+        }
         for (int id : ids) {
           std::istringstream s = r.line("node coordinates x y z");
           double x = 0, y = 0, z = 0;

@@ -28,6 +28,8 @@ std::string trimmed(const std::string& s) {
   return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
 }
 
+constexpr long long max_size = 10'000'000;
+
 std::string shortest(double value) {
   char buffer[32];
   const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
@@ -81,13 +83,19 @@ Eigen::SparseMatrix<double> read_matrix_market(const std::filesystem::path& path
     break;
   }
   if (rows < 0) fail(number, "no size line 'rows columns entries' before the end of the file");
-  if (rows > 2'000'000'000 || cols > 2'000'000'000)
-    fail(number, fmt::format("{} x {} is larger than jointid can index", rows, cols));
+  // The largest models jointid is sized for have 10^7 DOFs (docs/scaling.md); the matrix's
+  // column index is allocated whole, so a size line alone must not ask for more.
+  if (rows > max_size || cols > max_size)
+    fail(number, fmt::format("{} x {} is larger than jointid handles (at most {} rows and columns)",
+                             rows, cols, max_size));
   if (symmetric && rows != cols)
     fail(number, fmt::format("a symmetric matrix must be square, got {} x {}", rows, cols));
 
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(std::min<long long>(entries, 100'000'000)));
+  // Reserved for the entries the file can hold (a line `i j v` takes at least 6 bytes), not for
+  // the count the size line announces.
+  triplets.reserve(static_cast<std::size_t>(
+      std::min<long long>(entries, static_cast<long long>(text.size() / 6 + 1))));
   bool upper = false, lower_side = false;
   int first_upper = 0, first_lower = 0;
   long long read = 0;

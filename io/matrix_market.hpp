@@ -17,7 +17,8 @@
 
 namespace jointid::io {
 
-/// Throws io::Error naming the file, the line and what was expected.
+/// Throws io::Error naming the file, the line and what was expected; sizes above 10^7 rows or
+/// columns are refused (the largest models jointid is sized for, docs/scaling.md).
 Eigen::SparseMatrix<double> read_matrix_market(const std::filesystem::path& path);
 
 /// Writes A (square) as `coordinate real symmetric` (the lower triangle; A must be symmetric to

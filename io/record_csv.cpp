@@ -206,6 +206,11 @@ identify::Record read_record(const std::filesystem::path& path) {
                            "increase strictly)",
                            t[i], t[i - 1]));
   const double mean_step = (t[n - 1] - t[0]) / static_cast<double>(n - 1);
+  if (!std::isfinite(mean_step)) // the span overflows: then every deviation would be NaN
+    csv.fail(csv.rows[n - 1].number,
+             fmt::format("t runs from {} to {} s, a span beyond the range of a double (expected "
+                         "the times of a test, in s)",
+                         t[0], t[n - 1]));
   for (std::size_t i = 1; i < n; ++i) {
     const double deviation = std::abs((t[i] - t[i - 1]) - mean_step) / mean_step;
     if (deviation > 1e-6)
@@ -366,8 +371,17 @@ SteppedSineTable stepped_sine_table(const std::vector<identify::Record>& records
                                r.t, r.all(identify::Quantity::force).empty()
                                         ? r.channels.front().samples
                                         : r.all(identify::Quantity::force).front()->samples);
+    const double nyquist = 0.5 / r.dt();
+    if (!(f < nyquist))
+      throw Error(fmt::format("{}: the excitation, {} Hz, is not below the Nyquist frequency of "
+                              "its sampling, {} Hz (step {} s): its fundamental cannot be fitted",
+                              r.source, f, nyquist, r.dt()));
     const int n = identify::whole_period_samples(r.t, f);
     if (n == 0) throw Error(fmt::format("{}: shorter than one period of {} Hz", r.source, f));
+    if (n < 3)
+      throw Error(fmt::format("{}: its whole periods of {} Hz hold {} samples; fitting the "
+                              "fundamental needs at least 3 (a longer record or faster sampling)",
+                              r.source, f, n));
     table.freq_hz.push_back(f);
     for (std::size_t c = 0; c < r.channels.size(); ++c)
       table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) =

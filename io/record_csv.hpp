@@ -49,7 +49,9 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path);
 /// The fundamentals of sine-test records as a stepped-sine table: each channel's complex
 /// amplitude at its record's excitation frequency (a least-squares fit over the record's whole
 /// periods), one row per record. The records must have the same channels in the same order;
-/// throws io::Error naming the first that differs, or one shorter than a period.
+/// throws io::Error naming the first that differs, one shorter than a period, one whose
+/// frequency is not below the Nyquist frequency of its sampling, or one whose whole periods hold
+/// fewer than 3 samples.
 SteppedSineTable stepped_sine_table(const std::vector<identify::Record>& records);
 
 /// The CSV text of a stepped-sine table: each comment as `# ...` lines, the header and one row

@@ -1344,11 +1344,31 @@ std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& fu
       g.record.t.resize(n);
       for (Eigen::Index i = 0; i < n; ++i)
         g.record.t(i) = t0 + static_cast<double>(i) * dt;
+      // The sample times must stay finite, increasing and uniform in double precision: an
+      // increment lost against a large minimum, or times beyond the range of a double, are not.
+      const auto& t = g.record.t;
+      const double mean_step = (t(n - 1) - t(0)) / static_cast<double>(n - 1);
+      for (Eigen::Index i = 1; i < n; ++i) {
+        const double step = t(i) - t(i - 1);
+        if (!std::isfinite(t(i)) || !(step > 0.0) || !std::isfinite(mean_step) ||
+            std::abs(step - mean_step) > 1e-6 * mean_step)
+          throw Error(fmt::format(
+              "{}: record 7 fields 4–5 (abscissa minimum, increment) are {} and {} s: the {} "
+              "sample times are not finite, increasing and uniform in double precision (sample "
+              "{} is at {} s); a time record starts near 0 with a step that is not lost against "
+              "its start",
+              where(path, f), t0, dt, n, i + 1, t(i)));
+      }
       groups.push_back(std::move(g));
       group = groups.end() - 1;
     }
     identify::Channel channel{c.quantity, c.at,
                               c.factor == 1.0 ? f.data : Eigen::VectorXd(c.factor * f.data)};
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (!std::isfinite(channel.samples(i)))
+        throw Error(fmt::format("{}: record 12 (data values) value {} is {}, which is {} in SI "
+                                "units (factor {}): not a finite number",
+                                where(path, f), i + 1, f.data(i), channel.samples(i), c.factor));
     for (std::size_t k = 0; k < group->record.channels.size(); ++k)
       if (group->record.channels[k].name() == channel.name()) {
         const Uff58Function& other = *group->members[k];

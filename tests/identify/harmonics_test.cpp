@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 using namespace jointid::identify;
@@ -88,4 +89,9 @@ TEST(WholePeriodSamples, CountsWholePeriods) {
   const Eigen::VectorXd t = times(1050, 1e-3, 0.0); // 1.05 s
   EXPECT_EQ(whole_period_samples(t, 2.0), 1000);    // 2 whole periods of 0.5 s
   EXPECT_EQ(whole_period_samples(t, 0.5), 0);       // shorter than one period
+  // Frequencies far above the sampling's, infinite or NaN no longer overflow the conversion to
+  // int (UBSan; seen while fixing what fuzzing found in io::stepped_sine_table).
+  EXPECT_EQ(whole_period_samples(t, 1e300), 1050);
+  EXPECT_EQ(whole_period_samples(t, std::numeric_limits<double>::infinity()), 0);
+  EXPECT_EQ(whole_period_samples(t, std::numeric_limits<double>::quiet_NaN()), 0);
 }

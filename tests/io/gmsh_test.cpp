@@ -212,3 +212,18 @@ TEST(Gmsh, ErrorsNameFileLineAndProblem) {
   expect_error(replace(msh22, "2.2 0 8", "3.0 0 8"), "unsupported .msh format 3.0", "2");
   expect_error(replace(msh22, "2.2 0 8", "2.2 1 8"), "binary", "2");
 }
+
+// Fuzzing regressions (docs/fuzzing.md): counts read from the file (tags of an element,
+// physical tags of an entity, nodes of a block) sized vectors before their values were read, so a
+// short file asked for gigabytes; now the values are read one by one and the file's end says.
+TEST(Gmsh, CountsBeyondTheFileAreErrorsNotAllocations) {
+  expect_error(replace(msh22, "5 1 2 21 2 3 4", "5 1 2000000000 21 2 3 4"),
+               "element 5: expected 2000000000 tags", "24");
+  expect_error(replace(msh41, "1 0 0 0 1 10", "1 0 0 0 99999999999 10"),
+               "entity 1: expected 99999999999 physical tags", "13");
+  expect_error(replace(msh41, "0 1 0 1\n", "0 1 0 99999999999\n"), "expected a node tag", "");
+  // The input fuzz_gmsh found in 6 s on the old reader (std::length_error): a point entity whose
+  // number of physical tags is -3, read into an unsigned count.
+  expect_error(replace(msh41, "2 2 3 0 1 11", "2 2 3  1 -3"),
+               "entity 2: expected a number of physical tags >= 0, got -3", "14");
+}

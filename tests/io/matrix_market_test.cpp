@@ -145,6 +145,27 @@ TEST(MatrixMarket, MalformedFilesNameTheLineAndWhatWasExpected) {
             std::string::npos);
 }
 
+// Fuzzing regressions (docs/fuzzing.md): a size line alone asked for gigabytes, the matrix's
+// column index for its size and the entries' storage for the count it announced.
+TEST(MatrixMarket, SizeLineDoesNotAllocateWhatTheFileCannotHold) {
+  test::TempDir dir;
+  const std::string head = "%%MatrixMarket matrix coordinate real general\n";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {head + "1000000000 1000000000 0\n",
+       ":2: 1000000000 x 1000000000 is larger than jointid handles (at most 10000000 rows and "
+       "columns)"},
+      {head + "2 10000001 0\n", ":2: 2 x 10000001 is larger than jointid handles"},
+      {head + "1 1 100000000\n1 1 1\n", ":3: the size line announces 100000000 entries, the "
+                                        "file has 1"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const fs::path p = dir / ("big" + std::to_string(i) + ".mtx");
+    test::write_text(p, cases[i].first);
+    const std::string e = error_of([&] { io::read_matrix_market(p); });
+    EXPECT_NE(e.find(p.filename().string() + cases[i].second), std::string::npos) << i << ": " << e;
+  }
+}
+
 TEST(MatrixMarket, DofTableErrors) {
   test::TempDir dir;
   test::write_text(dir / "d1.txt", "1:uy\n1:rz # ok\n\n1:uy\n");

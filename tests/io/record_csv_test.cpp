@@ -187,6 +187,13 @@ TEST_F(RecordCsvTest, TimeMustIncreaseUniformly) {
   EXPECT_NO_THROW(read_record(write(test::replaced(good_csv, "0.375,", "0.37500001,"))));
 }
 
+// Fuzzing regression (docs/fuzzing.md): times near the limits of a double made the span
+// overflow, the mean step infinite and every deviation NaN, so non-uniform sampling passed.
+TEST_F(RecordCsvTest, TimeSpanBeyondTheRangeOfADoubleIsAnError) {
+  expect_error("t,x@7:uy\n-1e308,0\n-5e307,0\n0,0\n1e308,0\n", 5,
+               {"t runs from -1e+308 to 1e+308 s, a span beyond the range of a double"});
+}
+
 TEST_F(RecordCsvTest, CommentAfterHeader) {
   expect_error(test::replaced(good_csv, "0.25,0.0,3e-3\n", "0.25,0.0,3e-3\n# late\n"), 7,
                {"comment"});
@@ -588,6 +595,39 @@ TEST_F(RecordCsvTest, SteppedSineTableFromRecordsHoldsTheFundamentals) {
     EXPECT_EQ(std::string(e.what()), short_record.source + ": shorter than one period of 2.5 Hz");
   }
   EXPECT_TRUE(stepped_sine_table({}).freq_hz.empty());
+}
+
+// Fuzzing regressions (docs/fuzzing.md): stepped_sine_table let std::invalid_argument escape from
+// fit_harmonics when the whole periods of a record hold 2 samples (7.1 Hz sampled at 16 Hz, the
+// input fuzz_record_csv found), and a frequency above the sampling's reached an int conversion
+// that overflowed.
+TEST_F(RecordCsvTest, SteppedSineTableRefusesRecordsItCannotFit) {
+  const std::string found = "# sine test\n"
+                            "# excitation_hz = 7.1\n"
+                            "t,f@7:uy,x@7:uy,a@4:rz\n"
+                            "0,0,0.001,1\n"
+                            "0.0625,7.07,0.0007,2\n"
+                            "0.125,10,0,3\n"
+                            "0.1875,7.07,-0.000707,8\n";
+  const auto error_of = [&](const std::string& text) {
+    const identify::Record record = read_record(write(text));
+    try {
+      stepped_sine_table({record});
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  std::string e = error_of(found);
+  EXPECT_NE(e.find("f3.4.csv: its whole periods of 7.1 Hz hold 2 samples; fitting the fundamental "
+                   "needs at least 3"),
+            std::string::npos)
+      << e;
+  e = error_of(test::replaced(found, "= 7.1", "= 1e300"));
+  EXPECT_NE(e.find("f3.4.csv: the excitation, 1e+300 Hz, is not below the Nyquist frequency of "
+                   "its sampling, 8 Hz (step 0.0625 s)"),
+            std::string::npos)
+      << e;
 }
 
 } // namespace

@@ -423,6 +423,32 @@ std::string time_response(int node, int direction, int data_type, int exponents_
   return out + "    -1\n";
 }
 
+// Fuzzing regressions (docs/fuzzing.md): records whose values were read finite but came out of
+// uff58_tests broken. An increment lost against a large abscissa minimum gave sample times that
+// are not uniform; a dataset 164 length factor of 1e-300 turned finite values into
+// infinite ones in SI.
+TEST_F(Uff58Test, SampleTimesAndSiValuesMustStayFiniteAndUniform) {
+  expect_test_error(
+      test::replaced(hand_written, "  0.00000E+00  1.25000E-02", "  1.00000E+10  1.25000E-02"),
+      {"record 7 fields 4–5 (abscissa minimum, increment) are 10000000000 and 0.0125 "
+       "s: the 8 sample times are not finite, increasing and uniform"});
+  const std::string tiny_metre = "    -1\n"
+                                 "   164\n"
+                                 "         1tiny                          2\n"
+                                 "  1.0E-300  1.0E+00  1.0E+00\n"
+                                 "  0.0E+00\n"
+                                 "    -1\n";
+  std::string text =
+      test::replaced(hand_written, "Displacement         mm  ", "Displacement         NONE");
+  text = test::replaced(text, "  2.50000E+00 -3.25000E+00", "  2.50000E+10 -3.25000E+00");
+  const auto path = write(tiny_metre + text, "tiny.uff");
+  const std::string e = error_of([&] { uff58_tests(read_uff58(path), path); });
+  EXPECT_NE(e.find("tiny.uff: dataset 2 (line 7): record 12 (data values) value 2 is 24999999488, "
+                   "which is inf in SI units"),
+            std::string::npos)
+      << e;
+}
+
 TEST_F(Uff58Test, SeveralDatasetsWithOthersBetweenAndUnits) {
   Uff58Function velocity; // a 58b among the ASCII ones
   velocity.response_node = 7;

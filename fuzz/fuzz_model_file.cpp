@@ -1,0 +1,28 @@
+// libFuzzer target: the model file (TOML) reader, io::read_model, with its [modal] and
+// [matrices] tables. Contract: a result or io::Error; anything else escaping is a finding.
+// Beside the input lie the files a model may reference (copied from examples/ at start):
+// portal.msh (the portal frame's mesh) and k.mtx, m.mtx, dofs.txt (the cantilever's matrices).
+#include "fuzz_input.hpp"
+#include "io/files.hpp"
+#include "io/model_file.hpp"
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  const std::filesystem::path examples = std::filesystem::path(JOINTID_SOURCE_DIR) / "examples";
+  for (const auto& file :
+       {examples / "portal_frame" / "portal.msh", examples / "matrices" / "k.mtx",
+        examples / "matrices" / "m.mtx", examples / "matrices" / "dofs.txt"})
+    std::filesystem::copy_file(file, jointid::fuzz::input_directory() / file.filename(),
+                               std::filesystem::copy_options::overwrite_existing);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size > 64 * 1024) return -1; // model files are small; larger inputs only slow the search
+  const auto path = jointid::fuzz::input_file("model.toml", data, size);
+  try {
+    const auto file = jointid::io::read_model(path);
+    (void)file;
+  } catch (const jointid::io::Error&) {
+  }
+  return 0;
+}
