@@ -615,6 +615,11 @@ void write_modes_without_mesh(const ModesOptions& o, const fem::Modes& modes, in
 
 void modes(const ModesOptions& o) {
   if (o.count < 1) throw io::Error(fmt::format("--count: expected at least 1, got {}", o.count));
+  if (!(o.tolerance > 0.0 && o.tolerance < 1.0))
+    throw io::Error(
+        fmt::format("--tolerance: expected a relative residual in (0, 1), got {}", o.tolerance));
+  if (o.max_restarts < 1)
+    throw io::Error(fmt::format("--max-restarts: expected at least 1, got {}", o.max_restarts));
   check_output_dir(o.output_dir);
   const io::ModelFile file = io::read_model(o.model);
   for (const char* name : {"modes.json", "mesh.vtu", "modes.vtu"})
@@ -639,6 +644,8 @@ void modes(const ModesOptions& o) {
                                           : fem::DofMap(file.model).num_equations());
   fem::ModalOptions options;
   options.num_modes = count;
+  options.tolerance = o.tolerance;
+  options.max_iterations = o.max_restarts;
   const fem::Modes modes =
       compute_modes(file.model, sub ? sub->system() : nullptr, options, engine);
   if (modes.status != fem::ModalStatus::success)

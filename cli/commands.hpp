@@ -98,6 +98,10 @@ struct ModesOptions {
   int count = 10;
   int pictures = 4;            ///< modes drawn in DIR/modes.png (0: no picture)
   std::string engine = "auto"; ///< auto, dense, sparse or slepc (MPI, distributed)
+  /// Iterative engines (sparse, slepc): relative residual at which a mode has converged, and
+  /// the restarts allowed (the defaults of fem::ModalOptions); the dense engine has neither.
+  double tolerance = 1e-10;
+  int max_restarts = 1000;
 };
 
 /// Writes DIR/modes.json with the lowest `count` natural frequencies (and warnings about

@@ -236,6 +236,15 @@ int main(int argc, char** argv) {
   modes->add_option("--count", mod.count, "Number of modes")->capture_default_str();
   modes->add_option("--pictures", mod.pictures, "Modes drawn in DIR/modes.png (0: none)")
       ->capture_default_str();
+  modes
+      ->add_option("--tolerance", mod.tolerance,
+                   "sparse and slepc engines: relative residual at which a mode has converged")
+      ->capture_default_str();
+  modes
+      ->add_option("--max-restarts", mod.max_restarts,
+                   "sparse and slepc engines: restarts of the Lanczos (Krylov-Schur) iteration "
+                   "before it gives up")
+      ->capture_default_str();
 
   cli::ResponseOptions resp;
   auto* response = app.add_subcommand(

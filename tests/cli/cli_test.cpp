@@ -429,6 +429,27 @@ TEST_F(CliTest, SimulateChecksEverythingBeforeWriting) {
   EXPECT_FALSE(fs::exists(dir() / "never"));
 }
 
+TEST_F(CliTest, ModesThatDoNotConvergeSayWhyAndWriteNothing) {
+  // The portal frame's Lanczos iteration held to one restart at a tolerance no residual meets:
+  // the command fails with the engine's reason and leaves no modes.json behind. The same run
+  // with the defaults converges (so the failure is the limit's, not the model's).
+  const fs::path portal = fs::path(JOINTID_SOURCE_DIR) / "examples/portal_frame/portal.toml";
+  const fs::path out = dir() / "modes_unconverged";
+  const Outcome failed =
+      jointid({"modes", portal.string(), "--engine", "sparse", "--count", "6", "--max-restarts",
+               "1", "--tolerance", "1e-300", "--pictures", "0", "-o", out.string()},
+              dir());
+  EXPECT_EQ(failed.status, 1) << failed.err;
+  EXPECT_EQ(failed.err, "jointid: modal analysis failed: shift-invert Lanczos (Spectra) "
+                        "did not converge to 6 modes in 1 restarts (tolerance 1e-300)\n");
+  EXPECT_FALSE(fs::exists(out / "modes.json"));
+  const Outcome converged = jointid({"modes", portal.string(), "--engine", "sparse", "--count", "6",
+                                     "--pictures", "0", "-o", out.string()},
+                                    dir());
+  ASSERT_EQ(converged.status, 0) << converged.err;
+  EXPECT_EQ(json::parse(test::read_text(out / "modes.json"))["modes"].size(), 6u);
+}
+
 TEST_F(CliTest, ForceAtAOneNodeGmshGroup) {
   // examples/portal_frame: Physical Point("corner") is mesh node 2, "base" holds both feet.
   const fs::path portal = fs::path(JOINTID_SOURCE_DIR) / "examples/portal_frame/portal.toml";
@@ -1279,6 +1300,16 @@ TEST_F(CliTest, OptionsOutOfRangeAreNamedBeforeAnythingIsRead) {
   expect_one_line_error(
       jointid({"modes", model_path, "--count", "0", "--pictures", "0", "-o", out.string()}, dir()),
       "jointid: --count: expected at least 1, got 0");
+  for (const std::string t : {"0", "1", "-1e-9"})
+    expect_one_line_error(
+        jointid({"modes", model_path, "--tolerance", t, "--pictures", "0", "-o", out.string()},
+                dir()),
+        "jointid: --tolerance: expected a relative residual in (0, 1), got " +
+            std::string(t == "-1e-9" ? "-1e-09" : t));
+  expect_one_line_error(
+      jointid({"modes", model_path, "--max-restarts", "0", "--pictures", "0", "-o", out.string()},
+              dir()),
+      "jointid: --max-restarts: expected at least 1, got 0");
   for (const std::string k : {"0", "201"})
     expect_one_line_error(
         jointid({"response", model_path, "--force", "7:uy", "--amplitude", "10", "--freq-range",
