@@ -247,6 +247,15 @@ public:
             jobs.push_back(
                 [&, name = j.name, t] { return consider_term(state, current, name, t); });
       if (o_.substructure_damping) jobs.push_back([&] { return consider_damping(state); });
+      // What the library cannot add: a term of the model whose coefficient changes between
+      // tests (with four tests or more: fewer leave too little to tell a trend from a fit).
+      if (tests_.size() >= 4)
+        for (const auto& j : state.joints)
+          for (std::size_t t = 0; t < j.terms.size(); ++t)
+            if (!j.fixed[t])
+              jobs.push_back([&, name = j.name, term = j.terms[t]] {
+                return consider_variation(state, current, name, term);
+              });
       if (jobs.empty()) {
         out.stop_reason = "no candidate is left to try: every joint already has every term "
                           "asked for, and the substructure's damping is not tried";
@@ -270,7 +279,7 @@ public:
         });
         std::vector<std::size_t> finalists;
         for (std::size_t i : by)
-          if (std::isfinite(ranking[i].criterion) && ranking[i].converged &&
+          if (std::isfinite(ranking[i].criterion) && ranking[i].converged && !ranking[i].varies &&
               finalists.size() < static_cast<std::size_t>(o_.finalists))
             finalists.push_back(i);
         std::vector<std::function<State()>> refinements;
@@ -304,13 +313,17 @@ public:
       std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
         return ranking[a].criterion < ranking[b].criterion;
       });
-      if (step == 0) out.diagnosis = diagnose(state, ranking);
 
       std::optional<std::size_t> chosen;
-      std::optional<double> cv_now; // < 0: the folds cannot be identified
+      std::optional<double> cv_now;       // < 0: the folds cannot be identified
+      std::optional<std::size_t> outside; // the best explanation is a varying coefficient
       for (std::size_t i : order) {
         Candidate& c = ranking[i];
         if (!c.rejected.empty()) continue;
+        if (c.varies) {
+          outside = i;
+          break;
+        }
         if (!cv_now) cv_now = cross_validated(state.joints, state.damping_scale);
         c.cv_gap = cross_validated(states[i].joints, states[i].damping_scale);
         if (*cv_now >= 0.0 && c.cv_gap >= 0.0 && !(c.cv_gap < *cv_now)) {
@@ -322,9 +335,33 @@ public:
         chosen = i;
         break;
       }
+      if (step == 0) {
+        std::vector<Candidate> additions;
+        for (const auto& c : ranking)
+          if (!c.varies) additions.push_back(c);
+        out.diagnosis = diagnose(state, additions, outside ? &ranking[*outside] : nullptr);
+      }
       Step s;
       for (std::size_t i : order)
         s.ranking.push_back(ranking[i]);
+      if (outside) {
+        const Candidate& c = ranking[*outside];
+        std::string library = "no term of the library is admissible";
+        for (std::size_t i : order)
+          if (!ranking[i].varies && std::isfinite(ranking[i].gap)) {
+            library = fmt::format("the best term of the library, {}, leaves {}{}",
+                                  ranking[i].name(), number(ranking[i].gap),
+                                  ranking[i].rejected.empty() ? "" : " and is not admissible");
+            break;
+          }
+        out.stop_reason = fmt::format(
+            "the best explanation is not in the library: {} (a value per test leaves a gap of {} "
+            "from {}; {})",
+            c.name(), number(c.gap), number(state.gap), library);
+        out.diagnosis.findings.push_back(c.varies->description);
+        out.last_ranking = std::move(s.ranking);
+        break;
+      }
       if (!chosen) {
         const Candidate& best = ranking[order.front()];
         out.stop_reason = fmt::format(
@@ -452,15 +489,24 @@ private:
   // Simulates every test with these joints.
   State evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim,
                  const State* warm = nullptr) const {
+    return evaluate_each(joints, {}, sim, warm);
+  }
+  // The same with test i's joints `per_test[i]` where given (the state holds `joints` and
+  // counts, for the criterion, one parameter per test for the term that varies).
+  State evaluate_each(const std::vector<joints::Joint>& joints,
+                      const std::vector<std::vector<joints::Joint>>& per_test, const Simulator& sim,
+                      const State* warm = nullptr) const {
     State s;
     s.joints = joints;
     s.damping_scale = sim.scale;
-    s.parameters = parameters(joints, sim.scale);
+    s.parameters = parameters(joints, sim.scale) +
+                   (per_test.empty() ? 0 : static_cast<int>(per_test.size()) - 1);
     s.X.assign(tests_.size(), Eigen::MatrixXcd());
     s.Y.assign(tests_.size(), Eigen::MatrixXcd());
     for (std::size_t i = 0; i < tests_.size(); ++i) {
       const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
-      const frf::HarmonicBalanceResult r = solve(sim, static_cast<int>(i), joints, start);
+      const frf::HarmonicBalanceResult r =
+          solve(sim, static_cast<int>(i), per_test.empty() ? joints : per_test[i], start);
       s.converged = s.converged && r.converged && r.X.allFinite();
       s.X[i] = r.X.topRows(K_ + 1);
       s.Y[i] = r.Y;
@@ -922,6 +968,135 @@ private:
     }
   }
 
+  // The joint's `term` identified from each test alone (every other term held at the state's
+  // value), and every test simulated at its own value: does the coefficient change between
+  // tests, beyond the noise, and with what? Admissible when the values disagree (χ² about
+  // their weighted mean more than 3 standard deviations above its degrees of freedom).
+  Outcome consider_variation(const State& state, const Simulator& sim, const std::string& joint,
+                             joints::Term term) const {
+    Candidate c;
+    c.joint = joint;
+    c.term = term;
+    Variation v;
+    std::vector<joints::Joint> held = state.joints;
+    std::size_t jj = 0;
+    for (std::size_t j = 0; j < held.size(); ++j)
+      for (std::size_t t = 0; t < held[j].terms.size(); ++t) {
+        const bool free = held[j].name == joint && held[j].terms[t] == term;
+        held[j].fixed[t] = !free;
+        if (free) jj = j;
+      }
+    std::vector<std::vector<joints::Joint>> per_test;
+    for (std::size_t i = 0; i < tests_.size(); ++i) {
+      try {
+        const identify::FitResult fit = identify(held, sim, {static_cast<int>(i)});
+        Candidate one;
+        take_fit(one, fit, joint, term);
+        if (!std::isfinite(one.std) || !(one.std > 0.0))
+          return refused(std::move(c), state,
+                         fmt::format("not determined by {} alone", tests_[i].source));
+        per_test.push_back(fit.identified(held));
+        v.value.push_back(one.value);
+        v.std.push_back(one.std);
+      } catch (const std::invalid_argument& e) {
+        return refused(
+            std::move(c), state,
+            fmt::format("cannot be identified from {} alone: {}", tests_[i].source, e.what()));
+      }
+      if (std::string problem = physical_problem(per_test.back()); !problem.empty())
+        return refused(std::move(c), state, tests_[i].source + ": " + problem);
+      if (std::string problem = friction_problem(per_test.back()); !problem.empty())
+        return refused(std::move(c), state, tests_[i].source + ": " + problem);
+      v.tests.push_back(tests_[i].source);
+      v.amplitude.push_back(std::abs(measured_start_[i](1, static_cast<Eigen::Index>(jj))));
+      v.frequency_hz.push_back(tests_[i].frequency_hz);
+    }
+    State s = evaluate_each(state.joints, per_test, sim, &state);
+    double sw = 0.0, swv = 0.0;
+    for (std::size_t i = 0; i < v.value.size(); ++i)
+      sw += 1.0 / (v.std[i] * v.std[i]), swv += v.value[i] / (v.std[i] * v.std[i]);
+    c.value = swv / sw;
+    c.std = std::sqrt(1.0 / sw);
+    c.ci_low = c.value - 1.96 * c.std;
+    c.ci_high = c.value + 1.96 * c.std;
+    for (std::size_t i = 0; i < v.value.size(); ++i)
+      v.chi2 += std::pow((v.value[i] - c.value) / v.std[i], 2);
+    v.dof = static_cast<int>(v.value.size()) - 1;
+    v.amplitude_correlation = rank_correlation(v.value, v.amplitude);
+    v.frequency_correlation = rank_correlation(v.value, v.frequency_hz);
+    v.description = describe(v, c, state.joints[jj]);
+    fill(c, s);
+    if (c.rejected.empty() && !(v.chi2 > v.dof + 3.0 * std::sqrt(2.0 * v.dof)))
+      c.rejected = fmt::format("its values agree between the tests (χ² {} for {} degrees of "
+                               "freedom)",
+                               number(v.chi2), v.dof);
+    c.varies = std::move(v);
+    return {std::move(c), std::move(s)};
+  }
+
+  // Spearman's rank correlation (ties get their mean rank); 0 when either side is constant.
+  static double rank_correlation(const std::vector<double>& a, const std::vector<double>& b) {
+    auto ranks = [](const std::vector<double>& x) {
+      std::vector<std::size_t> order(x.size());
+      std::iota(order.begin(), order.end(), std::size_t{0});
+      std::sort(order.begin(), order.end(),
+                [&](std::size_t p, std::size_t q) { return x[p] < x[q]; });
+      Eigen::VectorXd r(static_cast<Eigen::Index>(x.size()));
+      for (std::size_t i = 0; i < order.size();) {
+        std::size_t j = i;
+        while (j + 1 < order.size() && x[order[j + 1]] == x[order[i]])
+          ++j;
+        for (std::size_t q = i; q <= j; ++q)
+          r(static_cast<Eigen::Index>(order[q])) = 0.5 * static_cast<double>(i + j);
+        i = j + 1;
+      }
+      return r;
+    };
+    const Eigen::VectorXd ra = ranks(a), rb = ranks(b);
+    const Eigen::VectorXd da = ra.array() - ra.mean(), db = rb.array() - rb.mean();
+    const double d = da.norm() * db.norm();
+    return d > 0.0 ? da.dot(db) / d : 0.0;
+  }
+
+  // "fc at 'spring' is not one number: identified from each test alone it goes from 0.5963 N at
+  // the smallest deformation amplitude (0.98 mm) to 0.3412 N at the largest (2.94 mm), …"
+  static std::string describe(const Variation& v, const Candidate& c, const joints::Joint& j) {
+    const bool by_amplitude =
+        std::abs(v.amplitude_correlation) >= std::abs(v.frequency_correlation);
+    const std::vector<double>& x = by_amplitude ? v.amplitude : v.frequency_hz;
+    const auto lo = std::min_element(x.begin(), x.end()) - x.begin();
+    const auto hi = std::max_element(x.begin(), x.end()) - x.begin();
+    const bool rotational = fem::is_rotation(j.dof);
+    const joints::TermInfo& info = joints::term_info(*c.term);
+    const std::string unit(rotational ? info.rotational_unit : info.unit);
+    auto where = [&](std::ptrdiff_t i) {
+      return by_amplitude ? fmt::format("{} {}", number(v.amplitude[i]), rotational ? "rad" : "m")
+                          : fmt::format("{} Hz", number(v.frequency_hz[i]));
+    };
+    const double rho = by_amplitude ? v.amplitude_correlation : v.frequency_correlation;
+    std::string law;
+    if (std::abs(rho) >= 0.7)
+      law = fmt::format(
+          "; it {} with the {} (rank correlation {:+.2f}): the joint needs a {} whose coefficient "
+          "depends on the {}{}",
+          rho < 0 ? "falls" : "grows", by_amplitude ? "deformation amplitude" : "frequency", rho,
+          joints::term_effect(*c.term), by_amplitude ? "amplitude" : "frequency",
+          *c.term == joints::Term::fc && by_amplitude
+              ? " (e.g. a contact whose normal load changes as the vibration grows)"
+              : "");
+    else
+      law = fmt::format("; it follows neither the amplitude (rank correlation {:+.2f}) nor the "
+                        "frequency ({:+.2f})",
+                        v.amplitude_correlation, v.frequency_correlation);
+    return fmt::format(
+        "{} at '{}' is not one number: identified from each test alone it goes from {} {} at the "
+        "{} {} ({}) to {} {} at the {} ({}), beyond the noise (χ² {} for {} degrees of freedom)"
+        "{}. No term of the library has such a coefficient.",
+        joints::term_name(*c.term), j.name, number(v.value[lo]), unit, "smallest",
+        by_amplitude ? "amplitude" : "frequency", where(lo), number(v.value[hi]), unit, "largest",
+        where(hi), number(v.chi2), v.dof, law);
+  }
+
   // The substructure's damping scaled by s: ln s is searched by a coarse scan and a golden
   // section on the criterion, every joint term identified again at each trial.
   Outcome consider_damping(const State& state) const {
@@ -1196,7 +1371,9 @@ private:
     return out;
   }
 
-  Diagnosis diagnose(const State& s, const std::vector<Candidate>& ranking) const {
+  // `outside`: the best explanation, when it is a coefficient that changes between tests.
+  Diagnosis diagnose(const State& s, const std::vector<Candidate>& ranking,
+                     const Candidate* outside) const {
     Diagnosis d;
     // Which channel disagrees most.
     std::map<std::string, std::pair<double, double>> per_channel; // error², measured²
@@ -1272,6 +1449,20 @@ private:
                                        d.channel, pct(d.channel_error)));
     for (const auto& f : level_evidence())
       d.findings.push_back(f);
+    if (outside) {
+      const auto best = std::min_element(
+          ranking.begin(), ranking.end(),
+          [](const Candidate& a, const Candidate& b) { return a.criterion < b.criterion; });
+      d.joint = outside->joint;
+      d.findings.push_back(fmt::format(
+          "No addition explains it as well as a coefficient that changes between tests: {} "
+          "explains {} of it{}.",
+          outside->name(), pct(outside->explained),
+          best != ranking.end() && std::isfinite(best->gap)
+              ? fmt::format(", the best addition ({}) {}", best->name(), pct(best->explained))
+              : std::string()));
+      return d;
+    }
     if (!significant) {
       d.findings.push_back(
           "No candidate explains a significant share of the disagreement: nothing is missing "
@@ -1464,17 +1655,21 @@ private:
 std::string Candidate::name() const {
   if (refit) return "refit of the starting values";
   if (!term) return "substructure damping";
+  if (varies) return fmt::format("{} at '{}', a value per test", joints::term_name(*term), joint);
   return fmt::format("{} at '{}'", joints::term_name(*term), joint);
 }
 
 std::string Candidate::effect() const {
   if (refit) return "linear terms identified again";
   if (!term) return "substructure damping";
+  if (varies)
+    return fmt::format("{} that changes between tests (no term of the library)",
+                       joints::term_effect(*term));
   return std::string(joints::term_effect(*term));
 }
 
 bool Candidate::linear() const {
-  return refit || !term || joints::is_linear(*term);
+  return !varies && (refit || !term || joints::is_linear(*term));
 }
 
 Result discover(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,

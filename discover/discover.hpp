@@ -34,6 +34,15 @@
 ///  4. it explains at least min_explained (5 %) of the squared gap, and
 ///  5. it predicts held-out tests better: the cross-validated gap (leave one test out, or
 ///     `folds` folds above 30 tests) falls.
+/// Besides these additions, every non-fixed term of the model is tried with a value per test
+/// (identified from that test alone, the other terms held; with four tests or more), counted as
+/// one parameter per test: a coefficient that changes with the amplitude or the frequency, which
+/// no term of the library has (e.g. a friction whose normal load falls as the vibration grows).
+/// It is admissible when the per-test values disagree beyond their intervals (and by rules 3 and
+/// 4); it is never added, but when it is the best admissible candidate the loop stops and says
+/// which coefficient changes, with what, and how much of the gap that explains (Variation).
+/// The per-test values show the trend; where the held terms took over part of the effect in
+/// the all-test fit (a viscous c absorbing friction), they are biased towards the mean.
 /// The admissible candidate with the lowest criterion is added. The loop stops at the noise
 /// level — χ²/N at most 3 standard deviations (3 √(2/N)) above 1, overall and for every compared
 /// harmonic on its own — when no candidate is admissible, or after max_steps.
@@ -70,15 +79,34 @@ struct Options {
   int curve_points = 30;
 };
 
+/// A term whose value, identified from each test alone (the other terms held), changes between
+/// the tests beyond their intervals: a coefficient that depends on the amplitude or the
+/// frequency, which no term of the library has. Such a candidate is never added to the model;
+/// when it is the best admissible explanation of the gap, the loop stops and says so.
+struct Variation {
+  std::vector<std::string> tests;
+  std::vector<double> value, std; ///< per test: the term from that test alone (SI)
+  std::vector<double> amplitude;  ///< per test: |Y_1| of the joint's deformation (m or rad)
+  std::vector<double> frequency_hz;
+  double chi2 = 0.0;                  ///< of the values about their weighted mean
+  int dof = 0;                        ///< tests − 1
+  double amplitude_correlation = 0.0; ///< Spearman's rank correlation of value and amplitude
+  double frequency_correlation = 0.0; ///< and of value and frequency
+  std::string description;            ///< what it says, in one sentence
+};
+
 /// One candidate addition to the model, and what it gave.
 struct Candidate {
   std::string joint;                ///< joint name; "substructure" for the damping scale
   std::optional<joints::Term> term; ///< empty: the substructure's damping scale; or a refit
   bool refit = false;               ///< no addition: the starting values identified again
-  std::string name() const;         ///< "k3 at 'tip'", "substructure damping", "refit"
-  std::string effect() const;       ///< "cubic stiffness", "substructure damping", …
-  bool linear() const;              ///< k, c, a refit or the damping scale
-  double value = 0.0;               ///< identified coefficient (SI), or the damping scale
+  /// Not an addition: the joint's `term` given a value per test (Variation). Its state
+  /// simulates each test at its own value; `value` is their weighted mean.
+  std::optional<Variation> varies;
+  std::string name() const;   ///< "k3 at 'tip'", "substructure damping", "refit"
+  std::string effect() const; ///< "cubic stiffness", "substructure damping", …
+  bool linear() const;        ///< k, c, a refit or the damping scale
+  double value = 0.0;         ///< identified coefficient (SI), or the damping scale
   double std = 0.0;
   double ci_low = 0.0, ci_high = 0.0;
   double gap = 0.0;       ///< after adding it

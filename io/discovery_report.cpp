@@ -205,6 +205,23 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     md += "\n";
   }
   md += fmt::format("Stopped: {}.\n\n", r.stop_reason);
+  // A coefficient that changes between tests, when that was the best explanation: its values.
+  for (const auto& c : r.last_ranking)
+    if (c.rejected.empty()) {
+      if (c.varies) {
+        md += fmt::format("{}, identified from each test alone (the other terms held):\n\n"
+                          "| test | frequency (Hz) | deformation amplitude | value | std |\n"
+                          "|---|---|---|---|---|\n",
+                          c.name());
+        const discover::Variation& v = *c.varies;
+        for (std::size_t i = 0; i < v.tests.size(); ++i)
+          md +=
+              fmt::format("| {} | {} | {} | {} | {} |\n", fs::path(v.tests[i]).filename().string(),
+                          g4(v.frequency_hz[i]), g4(v.amplitude[i]), g4(v.value[i]), g4(v.std[i]));
+        md += "\n";
+      }
+      break;
+    }
 
   // The gap per step.
   {

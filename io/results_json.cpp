@@ -37,6 +37,22 @@ Json candidate_json(const discover::Candidate& c) {
   j["converged"] = c.converged;
   j["admissible"] = c.rejected.empty();
   if (!c.rejected.empty()) j["rejected"] = c.rejected;
+  if (c.varies) {
+    const discover::Variation& v = *c.varies;
+    Json per_test = Json::array();
+    for (std::size_t i = 0; i < v.tests.size(); ++i)
+      per_test.push_back({{"test", v.tests[i]},
+                          {"frequency_hz", number(v.frequency_hz[i])},
+                          {"amplitude", number(v.amplitude[i])},
+                          {"value", number(v.value[i])},
+                          {"std", number(v.std[i])}});
+    j["varies"] = {{"per_test", std::move(per_test)},
+                   {"chi2", number(v.chi2)},
+                   {"dof", v.dof},
+                   {"amplitude_correlation", number(v.amplitude_correlation)},
+                   {"frequency_correlation", number(v.frequency_correlation)},
+                   {"description", v.description}};
+  }
   return j;
 }
 

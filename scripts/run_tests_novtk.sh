@@ -2,11 +2,25 @@
 # The build without VTK and without the SLEPc engine (what a headless node without PETSc gets):
 # configures ./build-novtk with -DJOINTID_WITH_VTK=OFF -DJOINTID_WITH_SLEPC=OFF (no benchmarks),
 # builds it and runs its tests: everything but the VTK files and pictures, plus the checks that
-# `modes`, `discover` and `--engine slepc` say what this build lacks. Extra arguments go to cmake.
+# `modes`, `discover` and `--engine slepc` say what this build lacks.
+#   --sanitize: the same build under AddressSanitizer (with LeakSanitizer) and
+#     UndefinedBehaviorSanitizer, in ./build-novtk-sanitize (scripts/sanitizer_env.sh); any
+#     finding fails its test. This is what CI runs (.ci/run): one build serves both checks.
+# Other arguments go to cmake.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+root=$(pwd)
+build=build-novtk
+config=(-DCMAKE_BUILD_TYPE=Release)
+if [[ "${1:-}" == "--sanitize" ]]; then
+  shift
+  # shellcheck source=scripts/sanitizer_env.sh
+  source scripts/sanitizer_env.sh # exported for the build too: gtest_discover_tests runs the tests
+  build=build-novtk-sanitize
+  config=("${sanitize_cmake_args[@]}")
+fi
 bash scripts/setup.sh
-cmake -S . -B build-novtk -DCMAKE_BUILD_TYPE=Release -DJOINTID_WITH_VTK=OFF \
-  -DJOINTID_WITH_SLEPC=OFF -DJOINTID_BUILD_TESTS=ON -DJOINTID_BUILD_BENCH=OFF "$@" >/dev/null
-cmake --build build-novtk -j "$(nproc)"
-ctest --test-dir build-novtk --output-on-failure -j "$(nproc)"
+cmake -S . -B "$build" "${config[@]}" -DJOINTID_WITH_VTK=OFF -DJOINTID_WITH_SLEPC=OFF \
+  -DJOINTID_BUILD_TESTS=ON -DJOINTID_BUILD_BENCH=OFF "$@" >/dev/null
+cmake --build "$build" -j "$(nproc)"
+ctest --test-dir "$build" --output-on-failure --timeout 1800 -j "$(nproc)"

@@ -374,6 +374,68 @@ TEST(Discover, OnAOneModeModalModelWithDriftingLevels) {
   EXPECT_FALSE(r.stop_reason.find("maximum") != std::string::npos) << r.stop_reason;
 }
 
+TEST(Discover, AFrictionThatFallsWithTheAmplitudeIsNamedAsOutsideTheLibrary) {
+  // The effect of the paper's experiment (examples/polyethylene) on the paper's cantilever: every
+  // force level has its own Coulomb friction, the lower the larger the level (a contact whose
+  // normal load falls as the vibration grows). No term of the library explains that; a friction
+  // with a value per test does. Discovery must say so, at the tip, with the trend, and add
+  // nothing to the model.
+  std::vector<identify::Measurement> tests;
+  // One frequency near the first mode, six levels: the amplitude grows with the level (at
+  // several frequencies around a resonance it would not, and the friction here is set per level).
+  const std::vector<std::pair<double, double>> levels{{20.0, 3.0}, {30.0, 2.7}, {40.0, 2.4},
+                                                      {50.0, 2.1}, {60.0, 1.9}, {80.0, 1.5}};
+  const std::vector<double> frequencies{3.2};
+  for (const auto& [level, fc] : levels) {
+    Data d;
+    d.truth = {joint("tip", 7, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, fc})};
+    d.levels = {level};
+    d.frequencies = frequencies;
+    for (auto& m : measure(d))
+      tests.push_back(std::move(m));
+  }
+  // The linear part is known (k and c held: with one frequency a viscous c that changes per
+  // test and a friction that does cannot be told apart); the friction's value is not given.
+  joints::Joint start = joint("tip", 7, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, 0.0});
+  start.fixed = {true, true, false};
+  start.given = {true, true, false};
+  const discover::Result r =
+      discover::discover(frf::Substructure(test::paper_cantilever()), {start}, tests);
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.steps.empty());
+  EXPECT_NE(r.stop_reason.find("not in the library: fc at 'tip', a value per test"),
+            std::string::npos)
+      << r.stop_reason;
+  ASSERT_FALSE(r.last_ranking.empty());
+  const discover::Candidate& best = r.last_ranking.front();
+  ASSERT_TRUE(best.varies.has_value()) << best.name();
+  EXPECT_EQ(best.term, Term::fc);
+  EXPECT_TRUE(best.rejected.empty()) << best.rejected;
+  const discover::Variation& v = *best.varies;
+  ASSERT_EQ(v.value.size(), tests.size());
+  // Each test's own value is its level's friction, to the noise (k and c are right).
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    const double truth = levels[i].second;
+    EXPECT_NEAR(v.value[i], truth, 4.0 * v.std[i] + 0.01 * truth) << v.tests[i];
+  }
+  EXPECT_LT(v.amplitude_correlation, -0.99);
+  EXPECT_GT(v.chi2, v.dof + 3.0 * std::sqrt(2.0 * v.dof));
+  // It explains more than any addition of the library, and the diagnosis says so.
+  for (const auto& c : r.last_ranking)
+    if (!c.varies && std::isfinite(c.gap)) {
+      EXPECT_GT(c.gap, best.gap) << c.name();
+    }
+  const std::string findings = [&] {
+    std::string all;
+    for (const auto& f : r.diagnosis.findings)
+      all += f + "\n";
+    return all;
+  }();
+  EXPECT_NE(findings.find("fc at 'tip' is not one number"), std::string::npos) << findings;
+  EXPECT_NE(findings.find("it falls with the deformation amplitude"), std::string::npos)
+      << findings;
+}
+
 TEST(Discover, BadInputIsRefusedWithTheReason) {
   Data d;
   d.truth = {joint("tip", 7, {Term::k, Term::c}, {4800.0, 20.0})};
