@@ -624,6 +624,11 @@ void modes(const ModesOptions& o) {
   const io::ModelFile file = io::read_model(o.model);
   for (const char* name : {"modes.json", "mesh.vtu", "modes.vtu"})
     io::check_not_an_input(o.output_dir / name);
+  if (file.measured)
+    throw io::Error(o.model.string() +
+                    ": the substructure is given by measured FRFs ([frf]): there are no modes to "
+                    "compute (identify, discover, simulate --method hb, response and frf read "
+                    "the FRFs)");
   if (file.modal) { // a substructure given by its modes: report them; no mesh to draw
     fem::Modes modes;
     modes.omega = 2.0 * std::numbers::pi * file.modal->frequencies_hz;

@@ -102,7 +102,29 @@ public:
       response_eq_.push_back(std::move(responses));
       f_max = std::max(f_max, m.frequency_hz);
     }
-    f_max_ = frf::synthesis_band_hz(f_max, 2 * o.balance.harmonics); // refined: twice K
+    // Measured FRFs end at their band: the re-simulations keep to the harmonics whose doubles
+    // (the refined simulations) stay in it.
+    if (const frf::MeasuredReceptance* measured = sub.measured()) {
+      const double top = measured->band_top_hz(synthesis_dofs_);
+      const int reach = std::isfinite(top)
+                            ? static_cast<int>(std::floor(top / f_max * (1.0 + 1e-12)))
+                            : 2 * o_.balance.harmonics;
+      const int usable = std::min(o_.balance.harmonics, reach / 2);
+      if (usable < K_)
+        throw std::invalid_argument(fmt::format(
+            "discover: the measured FRFs reach {} Hz; the re-simulations need harmonic {} (twice "
+            "the {} compared, to estimate their own error) of the highest test frequency, {} Hz: "
+            "{} Hz. Measure to that, or compare fewer harmonics",
+            top, 2 * K_, K_, f_max, 2 * K_ * f_max));
+      if (usable < o_.balance.harmonics) {
+        notes_.push_back(fmt::format(
+            "the measured FRFs reach {} Hz: the re-simulations use {} harmonics (not {}), so "
+            "that the refined ones (twice as many) at {} Hz stay in the band",
+            top, usable, o_.balance.harmonics, f_max));
+        o_.balance.harmonics = usable;
+      }
+    }
+    f_max_ = frf::synthesis_band_hz(f_max, 2 * o_.balance.harmonics); // refined: twice K
     // The force that drives each re-simulation: the measured harmonics, except those that are
     // noise (a force harmonic within 5 standard deviations of 0 is taken as 0): driven through
     // a resonance, noise alone would give the model responses the structure never had.
@@ -119,14 +141,14 @@ public:
     const std::vector<int> set2 = joints::joint_dof_set(start, dofs_);
     const Eigen::MatrixXd B = joints::joint_coordinates_on(start, dofs_, set2);
     for (const auto& m : tests) {
-      Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(o.balance.harmonics + 1, B.cols());
+      Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(o_.balance.harmonics + 1, B.cols());
       for (std::size_t d = 0; d < set2.size(); ++d) {
         const int r = m.response_index(dofs_.node_dof(set2[d]));
         if (r < 0)
           throw std::invalid_argument(m.source + ": no response channel at joint DOF " +
                                       fem::to_string(dofs_.node_dof(set2[d])) +
                                       " (discovery needs x, v or a at every joint DOF)");
-        for (int k = 0; k <= std::min(m.harmonics, o.balance.harmonics); ++k) {
+        for (int k = 0; k <= std::min(m.harmonics, o_.balance.harmonics); ++k) {
           if (!m.has_harmonic(k) || (k == 0 && !m.has_mean[r])) continue;
           Y.row(k) += m.X(k, r) * B.row(static_cast<Eigen::Index>(d)).cast<Complex>();
         }
@@ -246,7 +268,8 @@ public:
           if (j.term_index(t) < 0)
             jobs.push_back(
                 [&, name = j.name, t] { return consider_term(state, current, name, t); });
-      if (o_.substructure_damping) jobs.push_back([&] { return consider_damping(state); });
+      if (o_.substructure_damping && !base_->measured())
+        jobs.push_back([&] { return consider_damping(state); });
       // What the library cannot add: a term of the model whose coefficient changes between
       // tests (with four tests or more: fewer leave too little to tell a trend from a fit).
       if (tests_.size() >= 4)

@@ -83,7 +83,22 @@ ModalSynthesis::ModalSynthesis(const ModalModel& modal, std::vector<int> dofs)
         residual_(i, j) = modal.residual_flexibility(dofs_[i], dofs_[j]);
 }
 
+ModalSynthesis::ModalSynthesis(std::shared_ptr<const MeasuredReceptance> measured,
+                               std::vector<int> dofs)
+    : dofs_(std::move(dofs)), measured_(std::move(measured)) {
+  const int n = static_cast<int>(measured_->data().dofs.size());
+  for (int e : dofs_)
+    if (e < 0 || e >= n)
+      throw std::invalid_argument("receptance: equation " + std::to_string(e) +
+                                  " out of range (the measured FRFs have " + std::to_string(n) +
+                                  " DOFs)");
+  phi_.resize(static_cast<Eigen::Index>(dofs_.size()), 0);
+  residual_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dofs_.size()),
+                                    static_cast<Eigen::Index>(dofs_.size()));
+}
+
 ModalSynthesis ModalSynthesis::with_damping_scale(double factor) const {
+  if (measured_) throw std::logic_error("receptance: measured FRFs have no modal damping to scale");
   if (!(factor > 0.0) || !std::isfinite(factor))
     throw std::invalid_argument(
         "modal synthesis: a damping scale factor must be finite and > 0, got " +
@@ -120,6 +135,13 @@ int ModalSynthesis::position(int equation) const {
 
 CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows,
                                    std::span<const int> cols) const {
+  if (measured_) {
+    for (const int e : rows)
+      (void)position(e); // served equations only, as from modes
+    for (const int e : cols)
+      (void)position(e);
+    return measured_->receptance(omega, rows, cols);
+  }
   const int m = static_cast<int>(omega_.size());
   CVector modal(m);
   for (int r = 0; r < m; ++r)

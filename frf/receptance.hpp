@@ -4,10 +4,12 @@
 /// and by a direct sparse solve of (K − ω²M + iωC), the cross-check.
 #include "fem/damping.hpp"
 #include "fem/modal.hpp"
+#include "frf/measured_frf.hpp"
 #include "frf/modal_model.hpp"
 
 #include <Eigen/Core>
 #include <complex>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -47,9 +49,16 @@ public:
   /// ratios, and the residual flexibility (if given) restricted to `dofs`. Validates `modal`;
   /// throws std::invalid_argument for it or for an equation out of range.
   ModalSynthesis(const ModalModel& modal, std::vector<int> dofs);
+  /// From a substructure given by measured FRFs (equation e is measured->data().dofs[e]):
+  /// receptance() reads and interpolates them (frf/measured_frf.hpp); there are no modes
+  /// (num_modes() 0, no residual). Throws std::invalid_argument for an equation out of range.
+  ModalSynthesis(std::shared_ptr<const MeasuredReceptance> measured, std::vector<int> dofs);
   /// A copy with every mode's damping 2ζ_rω_r multiplied by `factor` (> 0; else
   /// std::invalid_argument): "the substructure's damping is off by a factor".
+  /// Measured FRFs have no modal damping to scale: std::logic_error (check measured()).
   ModalSynthesis with_damping_scale(double factor) const;
+  /// The measured FRFs behind the synthesis, or nullptr when it comes from modes.
+  const MeasuredReceptance* measured() const { return measured_.get(); }
   /// Rows and columns are equation numbers, each one of `dofs`.
   CMatrix receptance(double omega, std::span<const int> rows, std::span<const int> cols) const;
   Blocks blocks(double omega, const Partition& partition) const;
@@ -73,6 +82,7 @@ private:
   Eigen::VectorXd modal_damping_; ///< 2 ζ_r ω_r, 1/s (finite for rigid modes under αM damping)
   Eigen::MatrixXd residual_;      ///< |dofs| × |dofs|
   bool has_residual_ = false;
+  std::shared_ptr<const MeasuredReceptance> measured_;
 };
 
 /// Direct receptance (K − ω²M + iωC)⁻¹ restricted to rows × cols, by a complex sparse LU

@@ -76,6 +76,18 @@ Substructure::Substructure(ModalModel modal) {
   modal_ = std::move(modal);
 }
 
+Substructure::Substructure(MeasuredFrf frf) {
+  measured_ = std::make_shared<const MeasuredReceptance>(std::move(frf));
+  modal_dofs_ = fem::DofMap::from_dofs(measured_->data().dofs);
+}
+
+const char* Substructure::given_by() const {
+  return measured_ ? "measured FRFs ([frf])"
+         : modal_  ? "its modes ([modal])"
+         : model_  ? "a finite element model"
+                   : "its matrices ([matrices])";
+}
+
 const fem::DofMap& Substructure::dofs() const {
   return system_ ? system_->dofs : modal_dofs_;
 }
@@ -93,6 +105,17 @@ const fem::Modes& Substructure::all_modes() const {
 ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
                                        std::vector<std::string>* notes) const {
   if (modal_) return ModalSynthesis(*modal_, std::move(dofs));
+  if (measured_) {
+    ModalSynthesis synthesis(measured_, dofs);
+    std::string where;
+    const double error = measured_->interpolation_error(dofs, &where);
+    if (notes && error > 1e-3)
+      notes->push_back("measured FRFs: between lines the receptance is interpolated, with an "
+                       "estimated error up to " +
+                       number(std::round(error * 1e4) / 1e4) + " of the FRF's peak (" + where +
+                       "): measure with a finer frequency step, or at the tests' frequencies");
+    return synthesis;
+  }
   const int n = system_->dofs.num_equations();
   for (int e : dofs)
     if (e < 0 || e >= n)
@@ -124,8 +147,9 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
 
 fem::SparseMatrix Substructure::damping_matrix() const {
   if (!system_)
-    throw std::logic_error("time integration needs a finite element model; this substructure "
-                           "is given by its modes ([modal])");
+    throw std::logic_error(std::string("time integration needs a finite element model; this "
+                                       "substructure is given by ") +
+                           given_by());
   const fem::Damping& damping = damping_;
   if (damping.kind != fem::Damping::Kind::modal) return fem::damping_matrix(*system_, damping);
   const int n = system_->dofs.num_equations();

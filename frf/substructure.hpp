@@ -1,6 +1,7 @@
 #pragma once
 /// The linear substructure as the analyses see it: a finite element model (assembled K, M and
-/// its damping) or a modal model given by its modes at a few DOFs. SI units; frequencies in Hz.
+/// its damping), K and M given by another program, a modal model given by its modes at a few
+/// DOFs, or FRFs measured at a few DOFs. SI units; frequencies in Hz.
 #include "fem/assembly.hpp"
 #include "fem/modal.hpp"
 #include "fem/model.hpp"
@@ -8,6 +9,7 @@
 #include "frf/receptance.hpp"
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,12 +34,21 @@ public:
   /// size, not finite, not symmetric (to 1e-10 of the largest entry) or with a negative mass on
   /// the diagonal, naming the matrix and the entry.
   Substructure(fem::Assembled system, fem::Damping damping);
+  /// Measured FRFs (frf/measured_frf.hpp); equations are numbered as frf.dofs. Validates
+  /// (std::invalid_argument). No modes: response curves (which need them for stability) and
+  /// time integration refuse it; identification and harmonic balance read H from it.
+  explicit Substructure(MeasuredFrf frf);
 
   /// The equations: the FE model's free DOFs, or fem::DofMap::from_dofs(modal.dofs).
   const fem::DofMap& dofs() const;
   const fem::Model* model() const { return model_ ? &*model_ : nullptr; } ///< nullptr: modal, K/M
   const fem::Assembled* system() const { return system_ ? &*system_ : nullptr; } ///< ditto
   const ModalModel* modal() const { return modal_ ? &*modal_ : nullptr; }        ///< nullptr: FE
+  /// The measured FRFs, or nullptr.
+  const MeasuredReceptance* measured() const { return measured_.get(); }
+  /// How it is given, for messages: "a finite element model", "its matrices ([matrices])",
+  /// "its modes ([modal])" or "measured FRFs ([frf])".
+  const char* given_by() const;
   /// The FE model's (or the given matrices') damping; none for a modal model.
   const fem::Damping& damping() const { return damping_; }
 
@@ -49,7 +60,8 @@ public:
   /// 12 of 3000 modes without residual flexibility (the model has rigid-body modes): the modes
   /// left out are ignored". Throws std::runtime_error when the modal analysis fails, saying why
   /// (its status and reason), std::invalid_argument for an
-  /// equation outside the model or f_max_hz <= 0 where it is needed.
+  /// equation outside the model or f_max_hz <= 0 where it is needed. Measured FRFs: notes
+  /// receive the estimated interpolation error when it exceeds 1e-3 of a function's peak.
   ModalSynthesis synthesis(std::vector<int> dofs, double f_max_hz,
                            std::vector<std::string>* notes = nullptr) const;
 
@@ -75,6 +87,7 @@ private:
   std::optional<fem::Model> model_;
   std::optional<fem::Assembled> system_;
   std::optional<ModalModel> modal_;
+  std::shared_ptr<const MeasuredReceptance> measured_;
   fem::Damping damping_; // of the FE model, or of the given matrices
   fem::DofMap modal_dofs_;
   mutable std::optional<fem::Modes> all_modes_; // a cache: not safe for concurrent first use

@@ -1,7 +1,8 @@
-// libFuzzer target: the model file (TOML) reader, io::read_model, with its [modal] and
-// [matrices] tables. Contract: a result or io::Error; anything else escaping is a finding.
-// Beside the input lie the files a model may reference (copied from examples/ at start):
-// portal.msh (the portal frame's mesh) and k.mtx, m.mtx, dofs.txt (the cantilever's matrices).
+// libFuzzer target: the model file (TOML) reader, io::read_model, with its [modal], [matrices]
+// and [frf] tables. Contract: a result or io::Error; anything else escaping is a finding.
+// Beside the input lie the files a model may reference (copied at start): portal.msh (the
+// portal frame's mesh), k.mtx, m.mtx, dofs.txt (the cantilever's matrices) and h.csv (a
+// mobility table of fuzz/corpus/fuzz_frf_csv).
 #include "fuzz_input.hpp"
 #include "io/files.hpp"
 #include "io/model_file.hpp"
@@ -13,6 +14,10 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
         examples / "matrices" / "m.mtx", examples / "matrices" / "dofs.txt"})
     std::filesystem::copy_file(file, jointid::fuzz::input_directory() / file.filename(),
                                std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::copy_file(std::filesystem::path(JOINTID_SOURCE_DIR) / "fuzz" / "corpus" /
+                                 "fuzz_frf_csv" / "mobility.csv",
+                             jointid::fuzz::input_directory() / "h.csv",
+                             std::filesystem::copy_options::overwrite_existing);
   return 0;
 }
 

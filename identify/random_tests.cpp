@@ -54,8 +54,9 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
                            const ForceInput& in, const ForcedOptions& o) {
   // 1. Checks.
   if (!sub.system())
-    throw std::invalid_argument("time simulation needs a finite element model; this substructure "
-                                "is given by its modes");
+    throw std::invalid_argument(std::string("time simulation needs a finite element model; this "
+                                            "substructure is given by ") +
+                                sub.given_by());
   if (!(std::isfinite(in.sample_rate_hz) && in.sample_rate_hz > 0.0))
     throw std::invalid_argument(
         fmt::format("force history: expected a sample rate > 0 Hz, got {}", in.sample_rate_hz));

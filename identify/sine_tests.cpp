@@ -106,8 +106,9 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
       throw std::invalid_argument("simulate: force is always written; responses are x, v or a");
   const bool time_domain = o.method == SimulationMethod::time_integration;
   if (time_domain && !sub.system())
-    throw std::invalid_argument("simulate: time integration needs a finite element model; this "
-                                "substructure is given by its modes (use harmonic balance)");
+    throw std::invalid_argument(std::string("simulate: time integration needs a finite element "
+                                            "model; this substructure is given by ") +
+                                sub.given_by() + " (use harmonic balance)");
 
   const fem::DofMap& dofs = sub.dofs();
   joints::validate_joints(joints, dofs);

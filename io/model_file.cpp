@@ -5,6 +5,7 @@
 #include "io/files.hpp"
 #include "io/gmsh.hpp"
 #include "io/matrix_market.hpp"
+#include "io/measured_frf_file.hpp"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -262,13 +263,24 @@ public:
   ModelFile read() {
     Table root(file_, root_, "",
                {"model", "materials", "sections", "mesh", "element_sets", "supports", "masses",
-                "springs", "damping", "options", "joints", "modal", "matrices"});
-    if (root.has("modal") && root.has("matrices"))
-      root.fail_at(*root.get("matrices"), "[matrices]",
-                   "give the substructure either by its modes ([modal]) or by its matrices "
-                   "([matrices]), not both");
+                "springs", "damping", "options", "joints", "modal", "matrices", "frf"});
+    {
+      const toml::node* second = nullptr;
+      std::vector<std::string> given;
+      for (const char* key : {"modal", "matrices", "frf"})
+        if (const toml::node* n = root.get(key)) {
+          given.push_back(std::string("[") + key + "]");
+          if (given.size() == 2) second = n;
+        }
+      if (second)
+        root.fail_at(*second, given[1],
+                     "give the substructure one way only: by its modes ([modal]), its matrices "
+                     "([matrices]) or measured FRFs ([frf]); this file has " +
+                         given[0] + " and " + given[1]);
+    }
     if (root.has("modal")) return read_modal_file(root);
     if (root.has("matrices")) return read_matrices_file(root);
+    if (root.has("frf")) return read_frf_file(root);
     read_model_table(root);
     read_materials(root);
     read_sections(root);
@@ -304,6 +316,7 @@ private:
       t.fail_at(n, label,
                 modal_      ? fmt::format("node {} is not among the [modal] dofs", id)
                 : matrices_ ? fmt::format("node {} is not in the [matrices] DOF table", id)
+                : frf_      ? fmt::format("node {} has no measured FRF in [frf]", id)
                             : fmt::format("node {} does not exist in [mesh] nodes", id));
     return id;
   }
@@ -313,10 +326,12 @@ private:
   // The nodes of a named Gmsh physical group (points, or every node of a group of lines).
   std::vector<int> group_nodes(const Table& t, const toml::node& n, const std::string& label) {
     const std::string name = t.to_string(n, label);
-    if (modal_ || matrices_)
+    if (modal_ || matrices_ || frf_)
       t.fail_at(n, label,
-                std::string("expected a node id; a substructure given by its ") +
-                    (modal_ ? "modes ([modal])" : "matrices ([matrices])") +
+                std::string("expected a node id; a substructure given by ") +
+                    (modal_      ? "its modes ([modal])"
+                     : matrices_ ? "its matrices ([matrices])"
+                                 : "measured FRFs ([frf])") +
                     " has no groups such as " + shown(n));
     if (!mesh_)
       t.fail_at(n, label,
@@ -421,6 +436,47 @@ private:
     read_joints(root);
     check_joints(system.dofs);
     out_.matrices = std::move(matrices_);
+    return std::move(out_);
+  }
+
+  // A substructure given by measured FRFs: [frf] files = [...] (universal files or CSV tables,
+  // relative to the model file), an optional [model] and the joints; the finite element tables
+  // and [damping] are errors (the damping is in the measurement).
+  ModelFile read_frf_file(const Table& root) {
+    reject_finite_element_keys(root, false, "[frf]: the substructure is given by measured FRFs");
+    if (root.has("model")) read_model_table(root);
+    Table t(file_, *table(root, "frf"), "[frf]", {"files"});
+    frf_ = true;
+    const int line = t.line();
+    const toml::node& n = t.need("files", "the FRF files: a list such as [\"drive_7uy.uff\", "
+                                          "\"drive_4uy.csv\"] (universal files or CSV tables)");
+    std::vector<std::filesystem::path> files;
+    if (n.is_string()) {
+      files.push_back(directory_ / t.to_string(n, "key 'files'"));
+    } else {
+      const toml::array& list = t.to_array(n, "key 'files'", "file names");
+      for (std::size_t i = 0; i < list.size(); ++i)
+        files.push_back(directory_ /
+                        t.to_string(list[i], fmt::format("key 'files', entry {}", i + 1)));
+      if (files.empty()) t.fail_at(n, "key 'files'", "expected at least one file");
+    }
+    frf::MeasuredFrf frf = read_measured_frf(files); // its errors name the data file and line
+    if (root.has("model") && model().dimension == 2)
+      for (const fem::NodeDof& nd : frf.dofs)
+        if (nd.dof != fem::Dof::ux && nd.dof != fem::Dof::uy && nd.dof != fem::Dof::rz)
+          file_.fail(line, "[frf]: a planar model (dimension = 2) has only ux, uy and rz, the "
+                           "FRFs have " +
+                               fem::to_string(nd));
+    try {
+      frf.validate();
+    } catch (const std::invalid_argument& e) {
+      file_.fail(line, std::string("[frf]: ") + e.what());
+    }
+    for (const fem::NodeDof& nd : frf.dofs)
+      node_lines_.emplace(nd.node, line);
+    read_joints(root);
+    check_joints(fem::DofMap::from_dofs(frf.dofs));
+    out_.measured = std::move(frf);
     return std::move(out_);
   }
 
@@ -1050,6 +1106,7 @@ private:
   std::vector<int> joint_lines_;
   std::optional<frf::ModalModel> modal_; // [modal], while it is read
   int modal_line_ = 0;
+  bool frf_ = false; // [frf], while it is read
 };
 
 } // namespace
@@ -1071,6 +1128,7 @@ ModelFile read_model(const std::filesystem::path& path) {
 frf::Substructure ModelFile::substructure() const {
   if (modal) return frf::Substructure(*modal);
   if (matrices) return frf::Substructure(*matrices, model.damping);
+  if (measured) return frf::Substructure(*measured);
   return frf::Substructure(model);
 }
 

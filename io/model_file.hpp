@@ -22,8 +22,10 @@ struct ModelFile {
   std::optional<frf::ModalModel> modal; ///< the substructure given by its modes ([modal])
   /// The substructure given by K and M ([matrices]: MatrixMarket files and a DOF table).
   std::optional<fem::Assembled> matrices;
+  /// The substructure given by measured FRFs ([frf]: universal files or CSV tables).
+  std::optional<frf::MeasuredFrf> measured;
 
-  /// The linear substructure: the modal model or the matrices if given, else the finite
+  /// The linear substructure: the modal model, the matrices or the FRFs if given, else the finite
   /// element model (validated and assembled on each call).
   frf::Substructure substructure() const;
 };
@@ -36,7 +38,9 @@ struct ModelFile {
 /// errors, [model] is optional (dimension = 2 allows only ux, uy, rz) and the joints must be on
 /// the listed DOFs (fem::DofMap::from_dofs). With [matrices] (K = "k.mtx", M = "m.mtx", dofs =
 /// "dofs.txt" or a list; paths relative to the model file) the same holds, [damping] is allowed,
-/// and the matrices are checked (sizes against the DOF table, symmetry, masses).
+/// and the matrices are checked (sizes against the DOF table, symmetry, masses). With [frf]
+/// (files = ["h.uff", "h.csv"], io/measured_frf_file.hpp) the DOFs are those the FRFs measure,
+/// [damping] is an error, and joints must be on them.
 /// Throws io::Error naming the file, line, key and what was expected.
 ModelFile read_model(const std::filesystem::path& path);
 

@@ -1160,6 +1160,83 @@ struct ChannelOf {
   int excitation_line = 0; ///< the ID line (1–5) that gave it
 };
 
+// What an ordinate axis (record 9, or the denominator's record 10) holds, and the factor that
+// makes its values SI: the quantity from the specific data type, the unit from the axis units
+// label or, without one, from the file's dataset 164. `rotation`: at a rotational DOF.
+struct AxisScale {
+  identify::Quantity quantity = identify::Quantity::force;
+  double factor = 1.0;
+};
+
+template <class Error>
+AxisScale axis_scale(const Uff58Function& f, const Uff58Axis& o, int record, bool rotation,
+                     const Error& error) {
+  AxisScale c;
+  // The quantity from the specific data type.
+  int length_exponent = 0, force_exponent = 0;
+  Unit unit = Unit::length;
+  switch (o.data_type) {
+  case uff_data_type::excitation_force:
+    c.quantity = identify::Quantity::force;
+    unit = rotation ? Unit::moment : Unit::force;
+    length_exponent = rotation ? 1 : 0;
+    force_exponent = 1;
+    break;
+  case uff_data_type::displacement:
+    c.quantity = identify::Quantity::displacement;
+    unit = rotation ? Unit::angle : Unit::length;
+    length_exponent = rotation ? 0 : 1;
+    break;
+  case uff_data_type::velocity:
+    c.quantity = identify::Quantity::velocity;
+    unit = rotation ? Unit::angular_velocity : Unit::velocity;
+    length_exponent = rotation ? 0 : 1;
+    break;
+  case uff_data_type::acceleration:
+    c.quantity = identify::Quantity::acceleration;
+    unit = rotation ? Unit::angular_acceleration : Unit::acceleration;
+    length_exponent = rotation ? 0 : 1;
+    break;
+  default:
+    throw error(fmt::format("record {} field 1 ({} specific data type) is {} ({}): cannot tell the "
+                            "quantity; expected 13 (excitation force), 8 (displacement), 11 "
+                            "(velocity) or 12 (acceleration)",
+                            record, record == 9 ? "ordinate" : "denominator", o.data_type,
+                            uff_data_type_name(o.data_type)));
+  }
+
+  // Unit exponents: not given (0 0 0), or those of the standard's Addendum A.
+  const bool none = o.length_exponent == 0 && o.force_exponent == 0 && o.temperature_exponent == 0;
+  const bool addendum = o.length_exponent == length_exponent &&
+                        o.force_exponent == force_exponent && o.temperature_exponent == 0;
+  if (!none && !addendum)
+    throw error(
+        fmt::format("record {} fields 2–4 (length, force, temperature units exponents) are {} {} "
+                    "{}, which do not fit {} at a {} DOF (expected {} {} 0 as in the standard's "
+                    "Addendum A, or 0 0 0)",
+                    record, o.length_exponent, o.force_exponent, o.temperature_exponent,
+                    uff_data_type_name(o.data_type), rotation ? "rotational" : "translational",
+                    length_exponent, force_exponent));
+
+  // Scale to SI: the units label says the unit; without one, the unit system of dataset 164.
+  if (!no_label(o.units_label)) {
+    const std::string label = normalise_unit(trim(o.units_label));
+    const auto units = known_units(unit);
+    const auto it = std::find_if(units.begin(), units.end(),
+                                 [&](const KnownUnit& k) { return k.label == label; });
+    if (it == units.end())
+      throw error(
+          fmt::format("record {} field 6 (axis units label) '{}' is not a unit of {} that jointid "
+                      "reads ({}); convert the data to one of these or to SI",
+                      record, trim(o.units_label), unit_noun(unit), unit_list(unit)));
+    c.factor = it->to_si;
+  } else if (f.units) {
+    c.factor = 1.0 / (std::pow(f.units->length, length_exponent) *
+                      std::pow(f.units->force, force_exponent));
+  }
+  return c;
+}
+
 ChannelOf channel_of(const Uff58Function& f, const std::filesystem::path& path) {
   const std::string at = where(path, f);
   const auto error = [&](const std::string& what) {
@@ -1168,8 +1245,8 @@ ChannelOf channel_of(const Uff58Function& f, const std::filesystem::path& path) 
   if (f.function_type != uff_function_type::time_response)
     throw error(
         fmt::format("record 6 field 1 (function type) is {} ({}): only time responses (1) are "
-                    "sine tests; FRFs and spectra are for the substructure, which is not read "
-                    "from UFF files yet",
+                    "sine tests; measured FRFs (4) describe the substructure: give them in the "
+                    "model file's [frf] section",
                     f.function_type, uff_function_type_name(f.function_type)));
   if (f.is_complex())
     throw error(
@@ -1208,69 +1285,9 @@ ChannelOf channel_of(const Uff58Function& f, const std::filesystem::path& path) 
           fem::all_dofs[static_cast<std::size_t>(std::abs(f.response_direction) - 1)]};
   const bool rotation = fem::is_rotation(c.at.dof);
 
-  // Quantity from record 9's specific data type.
-  int length_exponent = 0, force_exponent = 0;
-  Unit unit = Unit::length;
-  switch (f.ordinate.data_type) {
-  case uff_data_type::excitation_force:
-    c.quantity = identify::Quantity::force;
-    unit = rotation ? Unit::moment : Unit::force;
-    length_exponent = rotation ? 1 : 0;
-    force_exponent = 1;
-    break;
-  case uff_data_type::displacement:
-    c.quantity = identify::Quantity::displacement;
-    unit = rotation ? Unit::angle : Unit::length;
-    length_exponent = rotation ? 0 : 1;
-    break;
-  case uff_data_type::velocity:
-    c.quantity = identify::Quantity::velocity;
-    unit = rotation ? Unit::angular_velocity : Unit::velocity;
-    length_exponent = rotation ? 0 : 1;
-    break;
-  case uff_data_type::acceleration:
-    c.quantity = identify::Quantity::acceleration;
-    unit = rotation ? Unit::angular_acceleration : Unit::acceleration;
-    length_exponent = rotation ? 0 : 1;
-    break;
-  default:
-    throw error(
-        fmt::format("record 9 field 1 (ordinate specific data type) is {} ({}): cannot tell the "
-                    "channel's quantity; expected 13 (excitation force), 8 (displacement), 11 "
-                    "(velocity) or 12 (acceleration)",
-                    f.ordinate.data_type, uff_data_type_name(f.ordinate.data_type)));
-  }
-
-  // Unit exponents: not given (0 0 0), or those of the standard's Addendum A.
-  const Uff58Axis& o = f.ordinate;
-  const bool none = o.length_exponent == 0 && o.force_exponent == 0 && o.temperature_exponent == 0;
-  const bool addendum = o.length_exponent == length_exponent &&
-                        o.force_exponent == force_exponent && o.temperature_exponent == 0;
-  if (!none && !addendum)
-    throw error(
-        fmt::format("record 9 fields 2–4 (length, force, temperature units exponents) are {} {} "
-                    "{}, which do not fit {} at a {} DOF (expected {} {} 0 as in the standard's "
-                    "Addendum A, or 0 0 0)",
-                    o.length_exponent, o.force_exponent, o.temperature_exponent,
-                    uff_data_type_name(o.data_type), rotation ? "rotational" : "translational",
-                    length_exponent, force_exponent));
-
-  // Scale to SI: the units label says the unit; without one, the unit system of dataset 164.
-  if (!no_label(o.units_label)) {
-    const std::string label = normalise_unit(trim(o.units_label));
-    const auto units = known_units(unit);
-    const auto it = std::find_if(units.begin(), units.end(),
-                                 [&](const KnownUnit& k) { return k.label == label; });
-    if (it == units.end())
-      throw error(
-          fmt::format("record 9 field 6 (axis units label) '{}' is not a unit of {} that jointid "
-                      "reads ({}); convert the data to one of these or to SI",
-                      trim(o.units_label), unit_noun(unit), unit_list(unit)));
-    c.factor = it->to_si;
-  } else if (f.units) {
-    c.factor = 1.0 / (std::pow(f.units->length, length_exponent) *
-                      std::pow(f.units->force, force_exponent));
-  }
+  const AxisScale scale = axis_scale(f, f.ordinate, 9, rotation, error);
+  c.quantity = scale.quantity;
+  c.factor = scale.factor;
   if (f.response_direction < 0) c.factor = -c.factor;
 
   // The abscissa: time in s (the unit systems of dataset 164 do not scale time).
@@ -1464,6 +1481,112 @@ std::vector<Uff58Function> uff58_from_record(const identify::Record& record) {
     functions.push_back(std::move(f));
   }
   return functions;
+}
+
+std::vector<frf::MeasuredFunction> uff58_frfs(const std::vector<Uff58Function>& functions,
+                                              const std::filesystem::path& path) {
+  if (functions.empty())
+    throw Error(fmt::format("{}: no dataset 58 (function at nodal DOF) in the file; expected "
+                            "FRFs (function type 4)",
+                            path.string()));
+  std::vector<frf::MeasuredFunction> out;
+  for (const Uff58Function& f : functions) {
+    const std::string at = where(path, f);
+    const auto error = [&](const std::string& what) {
+      return Error(fmt::format("{}: {}", at, what));
+    };
+    if (f.function_type != uff_function_type::frequency_response)
+      throw error(fmt::format("record 6 field 1 (function type) is {} ({}): the substructure's "
+                              "FRFs are frequency response functions (4)",
+                              f.function_type, uff_function_type_name(f.function_type)));
+    if (!f.is_complex())
+      throw error(fmt::format("record 7 field 1 (ordinate data type) is {} ({}): an FRF must be "
+                              "complex (5 or 6)",
+                              f.ordinate_type, ordinate_type_text(f.ordinate_type)));
+    frf::MeasuredFunction m;
+    m.source = at;
+    const auto dof_of = [&](int node, int direction, int field, const char* what) {
+      if (node <= 0)
+        throw error(fmt::format("record 6 field {} ({} node) is {}: expected a node id > 0", field,
+                                what, node));
+      if (direction == 0 || std::abs(direction) > 6)
+        throw error(fmt::format("record 6 field {} ({} direction) is {}: an FRF needs a "
+                                "direction ±1…6 (X, Y, Z, RX, RY, RZ)",
+                                field + 1, what, direction_text(direction)));
+      return fem::NodeDof{node, fem::all_dofs[static_cast<std::size_t>(std::abs(direction) - 1)]};
+    };
+    m.response = dof_of(f.response_node, f.response_direction, 6, "response");
+    m.drive = dof_of(f.reference_node, f.reference_direction, 9, "reference");
+    // Numerator: displacement, velocity or acceleration; denominator: the force (or moment).
+    const AxisScale num = axis_scale(f, f.ordinate, 9, fem::is_rotation(m.response.dof), error);
+    if (num.quantity == identify::Quantity::force)
+      throw error("record 9 field 1 (ordinate specific data type) is 13 (excitation force): an "
+                  "FRF's numerator is the response (8 displacement, 11 velocity, 12 "
+                  "acceleration)");
+    AxisScale den;
+    if (f.denominator.data_type == uff_data_type::unknown && no_label(f.denominator.units_label))
+      den.factor = f.units ? 1.0 / (fem::is_rotation(m.drive.dof) ? f.units->length * f.units->force
+                                                                  : f.units->force)
+                           : 1.0; // not given: a force in the file's units
+    else
+      den = axis_scale(f, f.denominator, 10, fem::is_rotation(m.drive.dof), error);
+    if (den.quantity != identify::Quantity::force)
+      throw error(fmt::format("record 10 field 1 (denominator specific data type) is {} ({}): an "
+                              "FRF is per excitation force (13)",
+                              f.denominator.data_type,
+                              uff_data_type_name(f.denominator.data_type)));
+    double sign = num.factor / den.factor;
+    if ((f.response_direction < 0) != (f.reference_direction < 0)) sign = -sign;
+    // Abscissa: frequency in Hz.
+    const Uff58Axis& a = f.abscissa;
+    if (a.data_type != uff_data_type::frequency && a.data_type != uff_data_type::unknown &&
+        a.data_type != uff_data_type::general)
+      throw error(fmt::format("record 8 field 1 (abscissa specific data type) is {} ({}): an "
+                              "FRF's abscissa is frequency (18)",
+                              a.data_type, uff_data_type_name(a.data_type)));
+    if (!no_label(a.units_label)) {
+      const std::string label = normalise_unit(trim(a.units_label));
+      if (label != "Hz" && label != "hz" && label != "Frequency" && label != "frequency")
+        throw error(fmt::format("record 8 field 6 (axis units label) '{}' is not a unit of "
+                                "frequency that jointid reads (Hz)",
+                                trim(a.units_label)));
+    }
+    const Eigen::Index n = f.complex_data.size();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double freq = f.even ? f.abscissa_min + static_cast<double>(i) * f.abscissa_increment
+                                 : f.abscissa_values(i);
+      if (!std::isfinite(freq) || freq < 0.0)
+        throw error(fmt::format("record {} (abscissa) point {} is at {} Hz: expected a finite "
+                                "frequency >= 0",
+                                f.even ? 7 : 12, i + 1, freq));
+      if (!m.frequencies_hz.empty() && !(freq > m.frequencies_hz.back()))
+        throw error(fmt::format("record 12 (data values) point {} is at {} Hz, not above the "
+                                "previous point ({} Hz): the frequencies must increase",
+                                i + 1, freq, m.frequencies_hz.back()));
+      std::complex<double> v = sign * f.complex_data(i);
+      const double w = 2.0 * std::numbers::pi * freq;
+      if (num.quantity != identify::Quantity::displacement && freq == 0.0)
+        continue; // mobility and accelerance say nothing of the receptance at 0 Hz
+      if (num.quantity == identify::Quantity::velocity) v /= std::complex<double>(0.0, w);
+      if (num.quantity == identify::Quantity::acceleration) v /= -w * w;
+      if (!std::isfinite(v.real()) || !std::isfinite(v.imag()))
+        throw error(fmt::format("record 12 (data values) point {} ({} Hz) is {}{:+}i, not a "
+                                "finite receptance in SI units",
+                                i + 1, freq, f.complex_data(i).real(), f.complex_data(i).imag()));
+      m.frequencies_hz.push_back(freq);
+      m.receptance.push_back(v);
+    }
+    if (m.frequencies_hz.size() < 2)
+      throw error(fmt::format("record 7 field 2 (number of points) gives {} usable line(s): an "
+                              "FRF needs at least 2",
+                              m.frequencies_hz.size()));
+    for (const frf::MeasuredFunction& other : out)
+      if (other.response == m.response && other.drive == m.drive)
+        throw error(fmt::format("the FRF {}/{} (response/reference) is already in {}",
+                                fem::to_string(m.response), fem::to_string(m.drive), other.source));
+    out.push_back(std::move(m));
+  }
+  return out;
 }
 
 } // namespace jointid::io

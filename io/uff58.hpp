@@ -37,6 +37,7 @@
 /// as E16.8, five a line; record 7's minimum, increment and z value as E13.5 when that is exact,
 /// else E25.16. Readers that split fields at blanks read these files; readers that cut the
 /// standard's fixed columns (E20.12) need the binary form, which is exact and standard.
+#include "frf/measured_frf.hpp"
 #include "identify/measurement.hpp"
 #include "identify/record.hpp"
 
@@ -190,6 +191,25 @@ void write_uff58(const std::filesystem::path& path, const std::vector<Uff58Funct
 /// record, no function at all.
 std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& functions,
                                             const std::filesystem::path& path);
+
+/// The FRFs of a universal file (function type 4) as the substructure's measured receptance
+/// (frf::MeasuredFunction, SI, x(t) = Re(H F e^{iωt})), one per dataset, in file order; source
+/// "<path>: dataset N (line L)".
+///  - Response = record 6's response node and direction, drive = its reference node and
+///    direction (1..6 → ux uy uz rx ry rz); a negative direction at either end flips the sign.
+///  - Record 9 (numerator): 8 displacement (receptance), 11 velocity (mobility: H = Y / iω),
+///    12 acceleration (accelerance: H = A / (iω)² = −A / ω²; "g" in the label is 9.80665 m/s²);
+///    record 10 (denominator): 13 excitation force, or 0 with no label (a force in the file's
+///    units). Units as for time responses: each axis' units label, else dataset 164, else SI.
+///  - Record 8: frequency (18, or 0/1 unspecified) in Hz; even or uneven spacing; complex single
+///    or double values. A mobility or accelerance line at 0 Hz is dropped (it does not give the
+///    receptance there).
+/// Throws io::Error naming the file, the dataset and its line, the record and field: another
+/// function type, real data, a response (not a force) as the denominator or a force as the
+/// numerator, a unit or axis it does not read, frequencies that are negative or do not
+/// increase, non-finite values, the same response and reference twice, fewer than 2 lines.
+std::vector<frf::MeasuredFunction> uff58_frfs(const std::vector<Uff58Function>& functions,
+                                              const std::filesystem::path& path);
 
 /// Records 8–11 of a channel of `quantity` at a translation or rotation: data types 13/8/11/12,
 /// the exponents of the standard's Addendum A (length, force, temperature) and SI units labels

@@ -211,6 +211,51 @@ TEST_F(CliTest, IdentifyRecoversTheJoint) {
 #endif
 }
 
+TEST_F(CliTest, IdentifyThroughMeasuredFrfsAsThroughTheModel) {
+  // A test engineer's route: the substructure's FRFs (here written by `jointid frf` from the
+  // model, 0.01 Hz lines, as accelerance: the usual sensor) in a universal file named by [frf];
+  // the records' frequencies (3.4, 4.2, 5 Hz) lie on the lines, so identify gives the model
+  // file's values to rounding. `modes` has nothing to compute; time integration needs elements.
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path h = dir() / "measured_h";
+  const Outcome frf =
+      jointid({"frf", model().string(), "--drive", "7:uy", "--freq-range", "0:10", "--points",
+               "1001", "--kind", "accelerance", "--no-plot", "-o", h.string()},
+              dir());
+  ASSERT_EQ(frf.status, 0) << frf.err;
+  const fs::path measured = dir() / "measured.toml";
+  test::write_text(measured, "[model]\ndimension = 2\n\n[frf]\nfiles = [\"measured_h/frf.uff\"]\n\n"
+                             "[[joints]]\nname = \"tip\"\nnode = 7\ndof = \"uy\"\n"
+                             "terms = [\"k\", \"c\", \"k3\"]\n"
+                             "values = { k = 4800.0, c = 20.0, k3 = 1.6e8 }\n");
+  std::vector<json> results;
+  for (const fs::path& m : {model(), measured}) {
+    const fs::path result = dir() / (m.stem().string() + "_result.json");
+    std::vector<std::string> args{"identify", m.string()};
+    for (const auto& f : record_files())
+      args.push_back(f);
+    args.insert(args.end(), {"-o", result.string()});
+    const Outcome run = jointid(args, dir());
+    ASSERT_EQ(run.status, 0) << run.err;
+    results.push_back(json::parse(test::read_text(result)));
+  }
+  for (std::size_t t = 0; t < 3; ++t) {
+    const double a = results[0]["joints"][0]["terms"][t]["value"].get<double>(),
+                 b = results[1]["joints"][0]["terms"][t]["value"].get<double>();
+    EXPECT_NEAR(b, a, 1e-9 * std::abs(a)) << t;
+  }
+  const Outcome modes =
+      jointid({"modes", measured.string(), "-o", (dir() / "m_modes").string()}, dir());
+  expect_one_line_error(modes, "the substructure is given by measured FRFs ([frf]): there are no "
+                               "modes to compute");
+  EXPECT_FALSE(fs::exists(dir() / "m_modes" / "modes.json"));
+  const Outcome time = jointid({"simulate", measured.string(), "--force", "7:uy", "--freq", "4",
+                                "--amplitude", "10", "-o", (dir() / "m_sim").string()},
+                               dir());
+  expect_one_line_error(time, "time integration needs a finite element model; this substructure "
+                              "is given by measured FRFs ([frf]) (use harmonic balance)");
+}
+
 TEST_F(CliTest, ModesMatchTheCantileverTheory) {
   const fs::path out = dir() / "modes";
   const Outcome run =

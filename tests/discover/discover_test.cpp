@@ -202,6 +202,57 @@ INSTANTIATE_TEST_SUITE_P(AtTheTip, HiddenTerm,
                            return std::string(joints::term_name(info.param.term));
                          });
 
+TEST(Discover, ThroughMeasuredFrfsAsThroughTheModel) {
+  // The substructure given by its measured FRF at the tip (sampled from the model every
+  // 0.005 Hz up to 80 Hz: the tests at 2–5 Hz lie on the lines), the cubic stiffness hidden.
+  // Discovery names and values it as through the model; its re-simulations keep to the 8
+  // harmonics whose doubles stay in the band (said in a warning), the model's use 15.
+  Data d;
+  d.truth = {joint("tip", 7, {Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})};
+  const std::vector<identify::Measurement> tests = measure(d);
+  const frf::Substructure model(d.model);
+  const int tip = model.dofs().equation({7, fem::Dof::uy});
+  const frf::ModalSynthesis H = model.synthesis({tip}, 100.0);
+  frf::MeasuredFrf frf;
+  frf.dofs = {{7, fem::Dof::uy}};
+  frf::MeasuredFunction f{{7, fem::Dof::uy}, {7, fem::Dof::uy}, {}, {}, "sampled from the model"};
+  for (int i = 0; i <= 16000; ++i) {
+    const int e[] = {tip};
+    f.frequencies_hz.push_back(0.005 * i);
+    f.receptance.push_back(H.receptance(2.0 * std::numbers::pi * 0.005 * i, e, e)(0, 0));
+  }
+  frf.functions.push_back(f);
+  const discover::Result a = discover::discover(model, {linear_start("tip", 7)}, tests);
+  const discover::Result b =
+      discover::discover(frf::Substructure(frf), {linear_start("tip", 7)}, tests);
+  SCOPED_TRACE(describe(b));
+  ASSERT_EQ(b.steps.size(), 1u);
+  ASSERT_TRUE(b.steps[0].added.term.has_value());
+  EXPECT_EQ(*b.steps[0].added.term, Term::k3);
+  EXPECT_NEAR(value_of(b, "tip", Term::k3), 1.6e8, 0.005 * 1.6e8);
+  EXPECT_LT(std::abs(value_of(b, "tip", Term::k3) - value_of(a, "tip", Term::k3)),
+            std_of(a, "tip", Term::k3));
+  expect_at_noise_level(b);
+  EXPECT_NE(std::find_if(b.warnings.begin(), b.warnings.end(),
+                         [](const std::string& w) {
+                           return w.find("the re-simulations use 8 harmonics (not 15)") !=
+                                  std::string::npos;
+                         }),
+            b.warnings.end());
+  // A band too short for the harmonics compared is refused, saying how far to measure.
+  frf.functions[0].frequencies_hz.resize(4001); // to 20 Hz
+  frf.functions[0].receptance.resize(4001);
+  try {
+    (void)discover::discover(frf::Substructure(frf), {linear_start("tip", 7)}, tests);
+    ADD_FAILURE() << "a band to 20 Hz was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "discover: the measured FRFs reach 20 Hz; the re-simulations need "
+                           "harmonic 6 (twice the 3 compared, to estimate their own error) of "
+                           "the highest test frequency, 5 Hz: 30 Hz. Measure to that, or compare "
+                           "fewer harmonics");
+  }
+}
+
 TEST(Discover, NothingHiddenAddsNothing) {
   Data d;
   d.truth = {joint("tip", 7, {Term::k, Term::c}, {4800.0, 20.0})};
