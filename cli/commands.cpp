@@ -629,6 +629,10 @@ void modes(const ModesOptions& o) {
                     ": the substructure is given by measured FRFs ([frf]): there are no modes to "
                     "compute (identify, discover, simulate --method hb, response and frf read "
                     "the FRFs)");
+  if (!file.parts.empty())
+    throw io::Error(o.model.string() +
+                    ": the substructure is made of several ([[substructures]]), which the "
+                    "joints alone connect: run `jointid modes` on each substructure's file");
   if (file.modal) { // a substructure given by its modes: report them; no mesh to draw
     fem::Modes modes;
     modes.omega = 2.0 * std::numbers::pi * file.modal->frequencies_hz;

@@ -104,11 +104,8 @@ public:
     }
     // Measured FRFs end at their band: the re-simulations keep to the harmonics whose doubles
     // (the refined simulations) stay in it.
-    if (const frf::MeasuredReceptance* measured = sub.measured()) {
-      const double top = measured->band_top_hz(synthesis_dofs_);
-      const int reach = std::isfinite(top)
-                            ? static_cast<int>(std::floor(top / f_max * (1.0 + 1e-12)))
-                            : 2 * o_.balance.harmonics;
+    if (const double top = sub.band_top_hz(synthesis_dofs_); std::isfinite(top)) {
+      const int reach = static_cast<int>(std::floor(top / f_max * (1.0 + 1e-12)));
       const int usable = std::min(o_.balance.harmonics, reach / 2);
       if (usable < K_)
         throw std::invalid_argument(fmt::format(
@@ -268,7 +265,7 @@ public:
           if (j.term_index(t) < 0)
             jobs.push_back(
                 [&, name = j.name, t] { return consider_term(state, current, name, t); });
-      if (o_.substructure_damping && !base_->measured())
+      if (o_.substructure_damping && base_->num_modes() > 0)
         jobs.push_back([&] { return consider_damping(state); });
       // What the library cannot add: a term of the model whose coefficient changes between
       // tests (with four tests or more: fewer leave too little to tell a trend from a fit).

@@ -111,6 +111,10 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
     out.note = "not determined: exact dry friction has no derivative while a joint sticks";
     return out;
   }
+  if (H.measured()) {
+    out.note = "not determined: measured FRFs have no modes for Floquet's method";
+    return out;
+  }
   const int nj = static_cast<int>(joints.size());
   if (r.Y.cols() != nj || r.Y.rows() < 2 || !(r.frequency_hz > 0.0))
     throw std::invalid_argument("floquet_stability: the steady state does not fit the joints");

@@ -85,8 +85,8 @@ ModalSynthesis::ModalSynthesis(const ModalModel& modal, std::vector<int> dofs)
 
 ModalSynthesis::ModalSynthesis(std::shared_ptr<const MeasuredReceptance> measured,
                                std::vector<int> dofs)
-    : dofs_(std::move(dofs)), measured_(std::move(measured)) {
-  const int n = static_cast<int>(measured_->data().dofs.size());
+    : dofs_(std::move(dofs)) {
+  const int n = static_cast<int>(measured->data().dofs.size());
   for (int e : dofs_)
     if (e < 0 || e >= n)
       throw std::invalid_argument("receptance: equation " + std::to_string(e) +
@@ -95,10 +95,56 @@ ModalSynthesis::ModalSynthesis(std::shared_ptr<const MeasuredReceptance> measure
   phi_.resize(static_cast<Eigen::Index>(dofs_.size()), 0);
   residual_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dofs_.size()),
                                     static_cast<Eigen::Index>(dofs_.size()));
+  measured_.push_back({std::move(measured), dofs_});
+}
+
+ModalSynthesis ModalSynthesis::block_diagonal(const std::vector<ModalSynthesis>& parts,
+                                              const std::vector<std::vector<int>>& equations) {
+  if (parts.size() != equations.size())
+    throw std::invalid_argument("block_diagonal: one list of equations per part");
+  ModalSynthesis out;
+  Eigen::Index d = 0, m = 0;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (equations[p].size() != parts[p].dofs_.size())
+      throw std::invalid_argument("block_diagonal: part " + std::to_string(p + 1) + " serves " +
+                                  std::to_string(parts[p].dofs_.size()) + " equations, given " +
+                                  std::to_string(equations[p].size()));
+    for (const int e : equations[p]) {
+      if (std::find(out.dofs_.begin(), out.dofs_.end(), e) != out.dofs_.end())
+        throw std::invalid_argument("block_diagonal: equation " + std::to_string(e) +
+                                    " is served by two parts");
+      out.dofs_.push_back(e);
+    }
+    m += parts[p].phi_.cols();
+  }
+  d = static_cast<Eigen::Index>(out.dofs_.size());
+  out.phi_ = Eigen::MatrixXd::Zero(d, m);
+  out.omega_.resize(m);
+  out.modal_damping_.resize(m);
+  out.residual_ = Eigen::MatrixXd::Zero(d, d);
+  Eigen::Index row = 0, col = 0;
+  for (const ModalSynthesis& part : parts) {
+    const Eigen::Index n = static_cast<Eigen::Index>(part.dofs_.size()), k = part.phi_.cols();
+    out.phi_.block(row, col, n, k) = part.phi_;
+    out.omega_.segment(col, k) = part.omega_;
+    out.modal_damping_.segment(col, k) = part.modal_damping_;
+    out.residual_.block(row, row, n, n) = part.residual_;
+    out.has_residual_ = out.has_residual_ || part.has_residual_;
+    for (const MeasuredBlock& b : part.measured_) {
+      MeasuredBlock shifted{b.frf, std::vector<int>(static_cast<std::size_t>(d), -1)};
+      for (Eigen::Index i = 0; i < n; ++i)
+        shifted.local[static_cast<std::size_t>(row + i)] = b.local[static_cast<std::size_t>(i)];
+      out.measured_.push_back(std::move(shifted));
+    }
+    row += n;
+    col += k;
+  }
+  return out;
 }
 
 ModalSynthesis ModalSynthesis::with_damping_scale(double factor) const {
-  if (measured_) throw std::logic_error("receptance: measured FRFs have no modal damping to scale");
+  if (phi_.cols() == 0 && !measured_.empty())
+    throw std::logic_error("receptance: measured FRFs have no modal damping to scale");
   if (!(factor > 0.0) || !std::isfinite(factor))
     throw std::invalid_argument(
         "modal synthesis: a damping scale factor must be finite and > 0, got " +
@@ -135,13 +181,6 @@ int ModalSynthesis::position(int equation) const {
 
 CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows,
                                    std::span<const int> cols) const {
-  if (measured_) {
-    for (const int e : rows)
-      (void)position(e); // served equations only, as from modes
-    for (const int e : cols)
-      (void)position(e);
-    return measured_->receptance(omega, rows, cols);
-  }
   const int m = static_cast<int>(omega_.size());
   CVector modal(m);
   for (int r = 0; r < m; ++r)
@@ -160,6 +199,21 @@ CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows,
                             .sum();
       H(i, j) = h + residual_(pi, pj);
     }
+  }
+  // Measured FRFs, in their block: the entries whose row and column are both theirs.
+  for (const MeasuredBlock& b : measured_) {
+    std::vector<int> r_at, c_at, r_local, c_local;
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (const int l = b.local[static_cast<std::size_t>(position(rows[i]))]; l >= 0)
+        r_at.push_back(static_cast<int>(i)), r_local.push_back(l);
+    for (std::size_t j = 0; j < cols.size(); ++j)
+      if (const int l = b.local[static_cast<std::size_t>(position(cols[j]))]; l >= 0)
+        c_at.push_back(static_cast<int>(j)), c_local.push_back(l);
+    if (r_at.empty() || c_at.empty()) continue;
+    const CMatrix Hm = b.frf->receptance(omega, r_local, c_local);
+    for (std::size_t i = 0; i < r_at.size(); ++i)
+      for (std::size_t j = 0; j < c_at.size(); ++j)
+        H(r_at[i], c_at[j]) += Hm(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
   }
   return H;
 }

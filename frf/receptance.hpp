@@ -53,12 +53,22 @@ public:
   /// receptance() reads and interpolates them (frf/measured_frf.hpp); there are no modes
   /// (num_modes() 0, no residual). Throws std::invalid_argument for an equation out of range.
   ModalSynthesis(std::shared_ptr<const MeasuredReceptance> measured, std::vector<int> dofs);
+  /// Several substructures side by side (frf::Substructure of [[substructures]]): H is block
+  /// diagonal, part p serving the equations equations[p] (its own dofs() in the same order:
+  /// entry i of parts[p].dofs() is equation equations[p][i] here). The modes of every part
+  /// together (each shape zero outside its part), their residuals block by block, and the
+  /// measured FRFs of each part in its block. Throws std::invalid_argument when the sizes
+  /// differ or an equation is served twice.
+  static ModalSynthesis block_diagonal(const std::vector<ModalSynthesis>& parts,
+                                       const std::vector<std::vector<int>>& equations);
   /// A copy with every mode's damping 2ζ_rω_r multiplied by `factor` (> 0; else
   /// std::invalid_argument): "the substructure's damping is off by a factor".
   /// Measured FRFs have no modal damping to scale: std::logic_error (check measured()).
   ModalSynthesis with_damping_scale(double factor) const;
-  /// The measured FRFs behind the synthesis, or nullptr when it comes from modes.
-  const MeasuredReceptance* measured() const { return measured_.get(); }
+  /// The (first) measured FRFs behind the synthesis, or nullptr when it comes from modes only.
+  const MeasuredReceptance* measured() const {
+    return measured_.empty() ? nullptr : measured_.front().frf.get();
+  }
   /// Rows and columns are equation numbers, each one of `dofs`.
   CMatrix receptance(double omega, std::span<const int> rows, std::span<const int> cols) const;
   Blocks blocks(double omega, const Partition& partition) const;
@@ -75,6 +85,7 @@ public:
   Eigen::MatrixXd residual_flexibility(std::span<const int> rows, std::span<const int> cols) const;
 
 private:
+  ModalSynthesis() = default; // for block_diagonal
   int position(int equation) const;
   std::vector<int> dofs_;
   Eigen::MatrixXd phi_; ///< |dofs| × n_modes
@@ -82,7 +93,13 @@ private:
   Eigen::VectorXd modal_damping_; ///< 2 ζ_r ω_r, 1/s (finite for rigid modes under αM damping)
   Eigen::MatrixXd residual_;      ///< |dofs| × |dofs|
   bool has_residual_ = false;
-  std::shared_ptr<const MeasuredReceptance> measured_;
+  /// Measured FRFs serving some of dofs_: local[i] is the equation of the FRFs for dofs_[i], or
+  /// -1 when dofs_[i] is not theirs (H between them and it is 0).
+  struct MeasuredBlock {
+    std::shared_ptr<const MeasuredReceptance> frf;
+    std::vector<int> local;
+  };
+  std::vector<MeasuredBlock> measured_;
 };
 
 /// Direct receptance (K − ω²M + iωC)⁻¹ restricted to rows × cols, by a complex sparse LU

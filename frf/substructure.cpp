@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace jointid::frf {
@@ -81,7 +83,55 @@ Substructure::Substructure(MeasuredFrf frf) {
   modal_dofs_ = fem::DofMap::from_dofs(measured_->data().dofs);
 }
 
+Substructure::Substructure(std::vector<Substructure> parts, std::vector<int> node_offsets)
+    : parts_(std::move(parts)), node_offsets_(std::move(node_offsets)) {
+  if (parts_.empty()) throw std::invalid_argument("substructures: none given");
+  if (parts_.size() != node_offsets_.size())
+    throw std::invalid_argument("substructures: one node offset per part");
+  std::vector<fem::NodeDof> dofs;
+  std::map<int, std::size_t> node_part; // node (offset) → the part that has it
+  for (std::size_t p = 0; p < parts_.size(); ++p) {
+    const Substructure& part = parts_[p];
+    if (!part.parts_.empty())
+      throw std::invalid_argument("substructure " + std::to_string(p + 1) +
+                                  " is itself made of substructures: list its parts instead");
+    if (node_offsets_[p] < 0)
+      throw std::invalid_argument("substructure " + std::to_string(p + 1) +
+                                  ": the node offset must be >= 0, got " +
+                                  std::to_string(node_offsets_[p]));
+    const fem::DofMap& map = part.dofs();
+    for (int e = 0; e < map.num_equations(); ++e) {
+      fem::NodeDof nd = map.node_dof(e);
+      nd.node += node_offsets_[p];
+      const auto [at, fresh] = node_part.emplace(nd.node, p);
+      if (!fresh && at->second != p)
+        throw std::invalid_argument("node " + std::to_string(nd.node) + " is in substructure " +
+                                    std::to_string(at->second + 1) + " and in substructure " +
+                                    std::to_string(p + 1) + ": give one of them a node offset");
+      dofs.push_back(nd);
+      part_of_.push_back(static_cast<int>(p));
+      local_of_.push_back(e);
+    }
+  }
+  modal_dofs_ = fem::DofMap::from_dofs(dofs);
+}
+
+double Substructure::band_top_hz(const std::vector<int>& equations) const {
+  if (measured_) return measured_->band_top_hz(equations);
+  double top = std::numeric_limits<double>::infinity();
+  if (parts_.empty()) return top;
+  std::vector<std::vector<int>> local(parts_.size());
+  for (const int e : equations)
+    if (e >= 0 && e < static_cast<int>(part_of_.size()))
+      local[static_cast<std::size_t>(part_of_[static_cast<std::size_t>(e)])].push_back(
+          local_of_[static_cast<std::size_t>(e)]);
+  for (std::size_t p = 0; p < parts_.size(); ++p)
+    top = std::min(top, parts_[p].band_top_hz(local[p]));
+  return top;
+}
+
 const char* Substructure::given_by() const {
+  if (!parts_.empty()) return "several substructures ([[substructures]])";
   return measured_ ? "measured FRFs ([frf])"
          : modal_  ? "its modes ([modal])"
          : model_  ? "a finite element model"
@@ -105,6 +155,30 @@ const fem::Modes& Substructure::all_modes() const {
 ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
                                        std::vector<std::string>* notes) const {
   if (modal_) return ModalSynthesis(*modal_, std::move(dofs));
+  if (!parts_.empty()) { // each part's synthesis of its equations, side by side
+    std::vector<std::vector<int>> local(parts_.size()), here(parts_.size());
+    for (const int e : dofs) {
+      if (e < 0 || e >= static_cast<int>(part_of_.size()))
+        throw std::invalid_argument("receptance: equation " + std::to_string(e) +
+                                    " is outside the substructures (" +
+                                    std::to_string(part_of_.size()) + " equations)");
+      const auto p = static_cast<std::size_t>(part_of_[static_cast<std::size_t>(e)]);
+      local[p].push_back(local_of_[static_cast<std::size_t>(e)]);
+      here[p].push_back(e);
+    }
+    std::vector<ModalSynthesis> syntheses;
+    std::vector<std::vector<int>> served;
+    for (std::size_t p = 0; p < parts_.size(); ++p) {
+      if (local[p].empty()) continue;
+      std::vector<std::string> part_notes;
+      syntheses.push_back(parts_[p].synthesis(local[p], f_max_hz, &part_notes));
+      served.push_back(here[p]);
+      if (notes)
+        for (const std::string& note : part_notes)
+          notes->push_back("substructure " + std::to_string(p + 1) + ": " + note);
+    }
+    return ModalSynthesis::block_diagonal(syntheses, served);
+  }
   if (measured_) {
     ModalSynthesis synthesis(measured_, dofs);
     std::string where;

@@ -38,6 +38,12 @@ public:
   /// (std::invalid_argument). No modes: response curves (which need them for stability) and
   /// time integration refuse it; identification and harmonic balance read H from it.
   explicit Substructure(MeasuredFrf frf);
+  /// Several substructures side by side, not connected except by the joints between them: H is
+  /// block diagonal (frf::ModalSynthesis::block_diagonal). Part p's node n is node
+  /// n + node_offsets[p] here. Equations: part 1's in its order, then part 2's, … Throws
+  /// std::invalid_argument for no parts, sizes that differ, a negative offset, a part that is
+  /// itself composite, or a node of two parts (naming both: "give one a node offset").
+  Substructure(std::vector<Substructure> parts, std::vector<int> node_offsets);
 
   /// The equations: the FE model's free DOFs, or fem::DofMap::from_dofs(modal.dofs).
   const fem::DofMap& dofs() const;
@@ -46,8 +52,14 @@ public:
   const ModalModel* modal() const { return modal_ ? &*modal_ : nullptr; }        ///< nullptr: FE
   /// The measured FRFs, or nullptr.
   const MeasuredReceptance* measured() const { return measured_.get(); }
+  /// The parts of a composite substructure (empty otherwise).
+  const std::vector<Substructure>& parts() const { return parts_; }
+  /// The highest frequency (Hz) up to which every measured FRF among `equations` is known
+  /// (infinity when none of them comes from measured FRFs).
+  double band_top_hz(const std::vector<int>& equations) const;
   /// How it is given, for messages: "a finite element model", "its matrices ([matrices])",
-  /// "its modes ([modal])" or "measured FRFs ([frf])".
+  /// "its modes ([modal])", "measured FRFs ([frf])" or "several substructures
+  /// ([[substructures]])".
   const char* given_by() const;
   /// The FE model's (or the given matrices') damping; none for a modal model.
   const fem::Damping& damping() const { return damping_; }
@@ -78,7 +90,12 @@ public:
   using BandSolver = std::function<fem::Modes(const fem::Model&, const fem::Assembled&,
                                               const fem::ModalOptions&, const std::vector<int>&)>;
   /// Replaces the default band solver (fem::modal_analysis, sparse engine); empty: default.
-  void set_band_solver(BandSolver solver) { band_solver_ = std::move(solver); }
+  /// Also for every part of a composite substructure.
+  void set_band_solver(BandSolver solver) {
+    for (Substructure& part : parts_)
+      part.set_band_solver(solver);
+    band_solver_ = std::move(solver);
+  }
 
 private:
   /// Every mode of the FE model (dense engine), computed once and kept.
@@ -88,7 +105,10 @@ private:
   std::optional<fem::Assembled> system_;
   std::optional<ModalModel> modal_;
   std::shared_ptr<const MeasuredReceptance> measured_;
-  fem::Damping damping_; // of the FE model, or of the given matrices
+  std::vector<Substructure> parts_;
+  std::vector<int> node_offsets_;
+  std::vector<int> part_of_, local_of_; // a composite's equation → its part and equation there
+  fem::Damping damping_;                // of the FE model, or of the given matrices
   fem::DofMap modal_dofs_;
   mutable std::optional<fem::Modes> all_modes_; // a cache: not safe for concurrent first use
   BandSolver band_solver_;

@@ -29,9 +29,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (int e = 0; e < n; ++e)
       all[static_cast<std::size_t>(e)] = e;
     const double two_pi = 2.0 * std::numbers::pi;
-    for (const double freq : {f.frequencies_hz.front(),
-                              0.5 * (f.frequencies_hz[0] + f.frequencies_hz[1]),
-                              f.frequencies_hz.back() * 2.0 + 1.0, 0.0})
+    for (const double freq :
+         {f.frequencies_hz.front(), 0.5 * (f.frequencies_hz[0] + f.frequencies_hz[1]),
+          f.frequencies_hz.back() * 2.0 + 1.0, 0.0})
       try {
         const Eigen::MatrixXcd h = H.receptance(two_pi * freq, all, all);
         (void)h;

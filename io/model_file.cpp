@@ -263,11 +263,12 @@ public:
   ModelFile read() {
     Table root(file_, root_, "",
                {"model", "materials", "sections", "mesh", "element_sets", "supports", "masses",
-                "springs", "damping", "options", "joints", "modal", "matrices", "frf"});
+                "springs", "damping", "options", "joints", "modal", "matrices", "frf",
+                "substructures"});
     {
       const toml::node* second = nullptr;
       std::vector<std::string> given;
-      for (const char* key : {"modal", "matrices", "frf"})
+      for (const char* key : {"modal", "matrices", "frf", "substructures"})
         if (const toml::node* n = root.get(key)) {
           given.push_back(std::string("[") + key + "]");
           if (given.size() == 2) second = n;
@@ -275,12 +276,14 @@ public:
       if (second)
         root.fail_at(*second, given[1],
                      "give the substructure one way only: by its modes ([modal]), its matrices "
-                     "([matrices]) or measured FRFs ([frf]); this file has " +
+                     "([matrices]), measured FRFs ([frf]) or as several ([[substructures]]); this "
+                     "file has " +
                          given[0] + " and " + given[1]);
     }
     if (root.has("modal")) return read_modal_file(root);
     if (root.has("matrices")) return read_matrices_file(root);
     if (root.has("frf")) return read_frf_file(root);
+    if (root.has("substructures")) return read_composite_file(root);
     read_model_table(root);
     read_materials(root);
     read_sections(root);
@@ -477,6 +480,70 @@ private:
     read_joints(root);
     check_joints(fem::DofMap::from_dofs(frf.dofs));
     out_.measured = std::move(frf);
+    return std::move(out_);
+  }
+
+  // Several substructures side by side: [[substructures]] file = "part.toml" (any model file
+  // but another composite), node_offset = N (added to its node ids and its joints' nodes), an
+  // optional [model], and the joints between them. The parts' own joints come along.
+  ModelFile read_composite_file(const Table& root) {
+    reject_finite_element_keys(root, false,
+                               "[[substructures]]: the substructure is made of the files it lists");
+    if (root.has("model")) read_model_table(root);
+    const auto list = tables(root, "substructures");
+    if (list.empty()) root.fail("[[substructures]]: expected at least one substructure");
+    std::vector<fem::NodeDof> dofs;
+    std::map<int, std::size_t> node_part;
+    std::vector<int> part_lines;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Table t(file_, *list[i], fmt::format("[[substructures]] entry {}", i + 1),
+              {"file", "node_offset"});
+      const std::filesystem::path path = directory_ / t.string("file");
+      int offset = 0;
+      if (const toml::node* n = t.get("node_offset")) {
+        offset = t.to_integer(*n, "key 'node_offset'");
+        if (offset < 0)
+          t.fail_at(*n, "key 'node_offset'",
+                    fmt::format("expected an integer >= 0, got {}", offset));
+      }
+      ModelFile part = read_model(path); // its errors name its own file and line
+      if (!part.parts.empty())
+        t.fail_at(*t.get("file"), "key 'file'",
+                  path.filename().string() +
+                      " is itself made of substructures: list its parts here instead");
+      const fem::DofMap map = part.dof_map();
+      for (int e = 0; e < map.num_equations(); ++e) {
+        fem::NodeDof nd = map.node_dof(e);
+        nd.node += offset;
+        const auto [at, fresh] = node_part.emplace(nd.node, i);
+        if (!fresh && at->second != i)
+          t.fail_at(*t.get("file"), "key 'file'",
+                    fmt::format("node {} of {} (node {} + node_offset {}) is also a node of "
+                                "substructure {} ({}): give one of them a node_offset",
+                                nd.node, path.filename().string(), nd.node - offset, offset,
+                                at->second + 1, out_.parts[at->second].path.filename().string()));
+        node_lines_.emplace(nd.node, t.line());
+        dofs.push_back(nd);
+      }
+      part_lines.push_back(t.line());
+      out_.parts.push_back(std::move(part));
+      out_.node_offsets.push_back(offset);
+    }
+    read_joints(root);
+    check_joints(fem::DofMap::from_dofs(dofs));
+    // The parts' own joints, their nodes moved by the offset; names stay unique.
+    for (std::size_t p = 0; p < out_.parts.size(); ++p)
+      for (joints::Joint j : out_.parts[p].joints) {
+        j.node += out_.node_offsets[p];
+        if (j.node_b != 0) j.node_b += out_.node_offsets[p];
+        for (const joints::Joint& other : out_.joints)
+          if (other.name == j.name)
+            file_.fail(part_lines[p],
+                       fmt::format("[[substructures]] entry {}: joint '{}' of {} has the name of "
+                                   "another joint; rename one of them",
+                                   p + 1, j.name, out_.parts[p].path.filename().string()));
+        out_.joints.push_back(std::move(j));
+      }
     return std::move(out_);
   }
 
@@ -1125,7 +1192,32 @@ ModelFile read_model(const std::filesystem::path& path) {
   return out;
 }
 
+fem::DofMap ModelFile::dof_map() const {
+  if (modal) return fem::DofMap::from_dofs(modal->dofs);
+  if (matrices) return matrices->dofs;
+  if (measured) return fem::DofMap::from_dofs(measured->dofs);
+  if (!parts.empty()) {
+    std::vector<fem::NodeDof> dofs;
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      const fem::DofMap map = parts[p].dof_map();
+      for (int e = 0; e < map.num_equations(); ++e) {
+        fem::NodeDof nd = map.node_dof(e);
+        nd.node += node_offsets[p];
+        dofs.push_back(nd);
+      }
+    }
+    return fem::DofMap::from_dofs(dofs);
+  }
+  return fem::DofMap(model);
+}
+
 frf::Substructure ModelFile::substructure() const {
+  if (!parts.empty()) {
+    std::vector<frf::Substructure> subs;
+    for (const ModelFile& part : parts)
+      subs.push_back(part.substructure());
+    return frf::Substructure(std::move(subs), node_offsets);
+  }
   if (modal) return frf::Substructure(*modal);
   if (matrices) return frf::Substructure(*matrices, model.damping);
   if (measured) return frf::Substructure(*measured);

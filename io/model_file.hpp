@@ -24,6 +24,13 @@ struct ModelFile {
   std::optional<fem::Assembled> matrices;
   /// The substructure given by measured FRFs ([frf]: universal files or CSV tables).
   std::optional<frf::MeasuredFrf> measured;
+  /// Several substructures side by side ([[substructures]]): the model files, and the offset
+  /// added to each one's node ids. `joints` holds the parts' joints too (nodes offset).
+  std::vector<ModelFile> parts;
+  std::vector<int> node_offsets;
+
+  /// The substructure's DOFs without assembling it: equation e as substructure().dofs().
+  fem::DofMap dof_map() const;
 
   /// The linear substructure: the modal model, the matrices or the FRFs if given, else the finite
   /// element model (validated and assembled on each call).
@@ -40,7 +47,10 @@ struct ModelFile {
 /// "dofs.txt" or a list; paths relative to the model file) the same holds, [damping] is allowed,
 /// and the matrices are checked (sizes against the DOF table, symmetry, masses). With [frf]
 /// (files = ["h.uff", "h.csv"], io/measured_frf_file.hpp) the DOFs are those the FRFs measure,
-/// [damping] is an error, and joints must be on them.
+/// [damping] is an error, and joints must be on them. With [[substructures]] (file = "a.toml",
+/// node_offset = 1000; any model file but another composite) the parts are read, their nodes
+/// offset (a node in two parts is an error naming both), their joints taken along, and the
+/// file's joints may join them.
 /// Throws io::Error naming the file, line, key and what was expected.
 ModelFile read_model(const std::filesystem::path& path);
 

@@ -254,6 +254,13 @@ TEST_F(CliTest, IdentifyThroughMeasuredFrfsAsThroughTheModel) {
                                dir());
   expect_one_line_error(time, "time integration needs a finite element model; this substructure "
                               "is given by measured FRFs ([frf]) (use harmonic balance)");
+  // A model made of substructures has no modes of its own either.
+  const fs::path parts = dir() / "parts.toml";
+  test::write_text(parts, "[[substructures]]\nfile = \"cantilever.toml\"\n");
+  expect_one_line_error(
+      jointid({"modes", parts.string(), "-o", (dir() / "p_modes").string()}, dir()),
+      "the substructure is made of several ([[substructures]]), which the "
+      "joints alone connect: run `jointid modes` on each substructure's file");
 }
 
 TEST_F(CliTest, ModesMatchTheCantileverTheory) {
