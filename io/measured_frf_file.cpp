@@ -74,6 +74,9 @@ std::vector<frf::MeasuredFunction> read_frf_csv(const std::filesystem::path& pat
     } catch (const std::invalid_argument&) {
       throw fail(line, fmt::format("expected the drive as NODE:DOF such as 7:uy, got '{}'", dof));
     }
+    if (drive->node <= 0)
+      throw fail(line, fmt::format("the drive {} has node id {}: expected > 0 (0 means ground)",
+                                   dof, drive->node));
     drive_line = line;
   };
   while (pos <= text.size()) {
@@ -132,6 +135,10 @@ std::vector<frf::MeasuredFunction> read_frf_csv(const std::filesystem::path& pat
           throw fail(line_no, fmt::format("column {} ('{}'): expected NODE:DOF.re such as 7:uy.re",
                                           c + 1, re));
         }
+        if (at.node <= 0)
+          throw fail(line_no, fmt::format("column {} ('{}'): node id {}: expected > 0 (0 means "
+                                          "ground)",
+                                          c + 1, re, at.node));
         if (std::find(responses.begin(), responses.end(), at) != responses.end())
           throw fail(line_no,
                      fmt::format("response {} has two pairs of columns", fem::to_string(at)));
@@ -166,6 +173,12 @@ std::vector<frf::MeasuredFunction> read_frf_csv(const std::filesystem::path& pat
       std::complex<double> h(v[1 + 2 * r], v[2 + 2 * r]);
       if (kind == frf::FrfKind::mobility) h /= std::complex<double>(0.0, w);
       if (kind == frf::FrfKind::accelerance) h /= -w * w;
+      if (!std::isfinite(h.real()) || !std::isfinite(h.imag()))
+        throw fail(line_no, fmt::format("columns {} and {}: {} {} at {} Hz is not a finite "
+                                        "receptance (H = {} / {})",
+                                        2 + 2 * r, 3 + 2 * r, v[1 + 2 * r], v[2 + 2 * r], freq,
+                                        kind == frf::FrfKind::mobility ? "Y" : "A",
+                                        kind == frf::FrfKind::mobility ? "iω" : "−ω²"));
       out[r].frequencies_hz.push_back(freq);
       out[r].receptance.push_back(h);
     }

@@ -175,6 +175,14 @@ TEST(MeasuredFrfFile, MalformedFilesNameTheFileLineAndWhatWasExpected) {
   EXPECT_EQ(csv("# drive = 7:uy\n# kind = inertance\nfreq_hz,7:uy.re,7:uy.im\n"),
             p + ":2: unknown FRF kind 'inertance' (expected receptance, mobility or "
                 "accelerance)");
+  // Found by fuzz_frf_csv (fuzz/corpus/fuzz_frf_csv/found_ground_drive.csv): a drive at node 0
+  // passed the reader and was refused only later, by the substructure's validation.
+  EXPECT_EQ(csv("# accelerance from a force at 0:uy: x(t)\nfreq_hz,7:uy.re,7:uy.im\n1,0,0\n"),
+            p + ":1: the drive 0:uy has node id 0: expected > 0 (0 means ground)");
+  EXPECT_EQ(csv("# drive = 7:uy\nfreq_hz,0:uy.re,0:uy.im\n1,0,0\n"),
+            p + ":2: column 2 ('0:uy.re'): node id 0: expected > 0 (0 means ground)");
+  EXPECT_EQ(csv("# drive = 7:uy\n# kind = accelerance\nfreq_hz,7:uy.re,7:uy.im\n1e-300,1,0\n"),
+            p + ":4: columns 2 and 3: 1 0 at 1e-300 Hz is not a finite receptance (H = A / −ω²)");
   // A universal file's time response is a sine test, not an FRF.
   const Cantilever c;
   identify::Record r;
@@ -215,7 +223,8 @@ TEST(MeasuredFrfFile, ModelFileErrorsNameTheCulprit) {
                   "shapes = [[1.0]]\n\n" +
                   Cantilever::model("[\"h.uff\"]").substr(23)),
             m + ":7: [frf]: give the substructure one way only: by its modes ([modal]), its "
-                "matrices ([matrices]) or measured FRFs ([frf]); this file has [modal] and [frf]");
+                "matrices ([matrices]), measured FRFs ([frf]) or as several ([[substructures]]); "
+                "this file has [modal] and [frf]");
   std::string on_5 = Cantilever::model("[\"h.uff\"]");
   on_5.replace(on_5.find("node = 7"), 8, "node = 5");
   EXPECT_EQ(model(on_5),
