@@ -12,6 +12,7 @@
 #include "identify/design.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
+#include "identify/output_error.hpp"
 #include "identify/random_tests.hpp"
 #include "identify/sine_tests.hpp"
 #include "io/chart.hpp"
@@ -453,6 +454,13 @@ void simulate(const SimulateOptions& o) {
 void identify(const IdentifyOptions& o) {
   if (o.records.empty()) throw io::Error("expected at least one record or table (CSV file)");
   check_harmonics(o.harmonics, 0);
+  if (o.output_error) {
+    const int K = *std::max_element(o.harmonics.begin(), o.harmonics.end());
+    if (o.balance_harmonics < std::max(K, 1) || o.balance_harmonics > 200)
+      throw io::Error(fmt::format("--hb-harmonics: expected from {} (the largest of --harmonics) "
+                                  "to 200, got {}",
+                                  std::max(K, 1), o.balance_harmonics));
+  }
   check_output_file(o.output);
   for (const fs::path& png : {o.fit_png, o.params_png})
     if (!png.empty()) check_output_file(png);
@@ -471,7 +479,12 @@ void identify(const IdentifyOptions& o) {
       identify::measure(tests, identify::measure_options(options));
   frf::Substructure sub = file.substructure();
   use_engine(sub, parse_engine(o.engine));
-  const identify::FitResult result = identify::fit(sub, file.joints, measured, options);
+  identify::OutputErrorOptions oe;
+  oe.harmonics = o.harmonics;
+  oe.balance.harmonics = o.balance_harmonics;
+  const identify::FitResult result =
+      o.output_error ? identify::output_error(sub, file.joints, measured, options, oe)
+                     : identify::fit(sub, file.joints, measured, options);
   if (result.status != identify::FitStatus::ok) throw io::Error("identify: " + result.reason);
   if (!output_rank()) return;
   io::write_json(o.output, io::identify_result_json(result, {}, &measured));
@@ -490,6 +503,9 @@ void identify(const IdentifyOptions& o) {
   fmt::print("intervals: {}{}\n",
              result.interval_method == "residual"
                  ? "from the residual (the records' noise is unknown or negligible)"
+             : result.interval_method == "output error"
+                 ? "output error (maximum likelihood with the records' noise: its Cramér–Rao "
+                   "bound)"
                  : "from the records' noise, propagated (generalised least squares)",
              std::isfinite(result.chi2_per_dof)
                  ? fmt::format("; chi2 per degree of freedom {:.3g}", result.chi2_per_dof)

@@ -69,6 +69,8 @@ struct IdentifyOptions {
   std::string engine = "auto";      ///< modes of a large model: auto or slepc (MPI)
   std::filesystem::path fit_png;    ///< not empty: the records with their harmonic fits
   std::filesystem::path params_png; ///< not empty: identified / model values with intervals
+  bool output_error = false;        ///< refine by output error (identify/output_error.hpp)
+  int balance_harmonics = 15;       ///< its harmonic balance
 };
 
 /// Identifies the joints' non-fixed terms from the tests; writes the JSON result and prints

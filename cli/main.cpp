@@ -196,6 +196,14 @@ int main(int argc, char** argv) {
                        "Picture (PNG) of each test's joint displacements with their harmonic fits");
   identify->add_option("--params-png", ident.params_png,
                        "Picture (PNG) of the identified values / the model's, with 95 % intervals");
+  identify->add_flag("--output-error", ident.output_error,
+                     "Refine by output error (maximum likelihood: the harmonic balance of the "
+                     "model fitted to the measured harmonics, each weighted by its noise); needs "
+                     "records of two or more periods");
+  identify
+      ->add_option("--hb-harmonics", ident.balance_harmonics,
+                   "Harmonics of the output-error model's harmonic balance")
+      ->capture_default_str();
 
   cli::DiscoverOptions disc;
   auto* discover = app.add_subcommand(

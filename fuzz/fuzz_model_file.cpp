@@ -1,8 +1,9 @@
-// libFuzzer target: the model file (TOML) reader, io::read_model, with its [modal], [matrices]
-// and [frf] tables. Contract: a result or io::Error; anything else escaping is a finding.
-// Beside the input lie the files a model may reference (copied at start): portal.msh (the
+// libFuzzer target: the model file (TOML) reader, io::read_model, with its [modal], [matrices],
+// [frf] and [[substructures]] tables. Contract: a result or io::Error; anything else escaping is a
+// finding. Beside the input lie the files a model may reference (copied at start): portal.msh (the
 // portal frame's mesh), k.mtx, m.mtx, dofs.txt (the cantilever's matrices) and h.csv (a
-// mobility table of fuzz/corpus/fuzz_frf_csv).
+// mobility table of fuzz/corpus/fuzz_frf_csv), and frf_part.toml (the [frf] seed, a part for
+// [[substructures]]; a model listing itself is refused, not read forever).
 #include "fuzz_input.hpp"
 #include "io/files.hpp"
 #include "io/model_file.hpp"
@@ -17,6 +18,11 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   std::filesystem::copy_file(std::filesystem::path(JOINTID_SOURCE_DIR) / "fuzz" / "corpus" /
                                  "fuzz_frf_csv" / "mobility.csv",
                              jointid::fuzz::input_directory() / "h.csv",
+                             std::filesystem::copy_options::overwrite_existing);
+  // A part for [[substructures]]: the [frf] model of the seeds (its FRFs are h.csv).
+  std::filesystem::copy_file(std::filesystem::path(JOINTID_SOURCE_DIR) / "fuzz" / "corpus" /
+                                 "fuzz_model_file" / "frf.toml",
+                             jointid::fuzz::input_directory() / "frf_part.toml",
                              std::filesystem::copy_options::overwrite_existing);
   return 0;
 }

@@ -487,6 +487,17 @@ private:
   // but another composite), node_offset = N (added to its node ids and its joints' nodes), an
   // optional [model], and the joints between them. The parts' own joints come along.
   ModelFile read_composite_file(const Table& root) {
+    // A part that lists substructures itself (or the file itself, read again as its own part)
+    // is refused here, before its parts are read: no recursion.
+    static thread_local int depth = 0;
+    if (depth > 0)
+      root.fail_at(*root.get("substructures"), "[[substructures]]",
+                   "this file is a part of a model made of substructures and may not list "
+                   "substructures itself: list its parts in that model instead");
+    struct Depth {
+      Depth() { ++depth; }
+      ~Depth() { --depth; }
+    } const inside;
     reject_finite_element_keys(root, false,
                                "[[substructures]]: the substructure is made of the files it lists");
     if (root.has("model")) read_model_table(root);
@@ -507,10 +518,6 @@ private:
                     fmt::format("expected an integer >= 0, got {}", offset));
       }
       ModelFile part = read_model(path); // its errors name its own file and line
-      if (!part.parts.empty())
-        t.fail_at(*t.get("file"), "key 'file'",
-                  path.filename().string() +
-                      " is itself made of substructures: list its parts here instead");
       const fem::DofMap map = part.dof_map();
       for (int e = 0; e < map.num_equations(); ++e) {
         fem::NodeDof nd = map.node_dof(e);

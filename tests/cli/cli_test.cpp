@@ -263,6 +263,34 @@ TEST_F(CliTest, IdentifyThroughMeasuredFrfsAsThroughTheModel) {
       "joints alone connect: run `jointid modes` on each substructure's file");
 }
 
+TEST_F(CliTest, IdentifyByOutputError) {
+  // The suite's records (time integration, no noise) identified by output error on harmonics
+  // 1–3: the model's values to the time integrator's own error (its period elongation at 512
+  // steps a period, about 1e-4), the method named, the misfit beyond the (tiny) noise said.
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path result = dir() / "output_error.json";
+  std::vector<std::string> args{"identify", model().string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(), {"--harmonics", "1,2,3", "--output-error", "-o", result.string()});
+  const Outcome run = jointid(args, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json j = json::parse(test::read_text(result));
+  EXPECT_EQ(j["interval_method"], "output error");
+  EXPECT_EQ(j["equations"], 3 * 3 * 2 * 2); // tests × harmonics × (re, im) × (x, v)
+  EXPECT_EQ(j["unknowns"], 3 + 3 * 2);      // k, c, k3 and each test's force fundamental
+  const std::vector<double> truth{4800.0, 20.0, 1.6e8};
+  for (std::size_t i = 0; i < truth.size(); ++i)
+    EXPECT_NEAR(j["joints"][0]["terms"][i]["value"].get<double>(), truth[i], 2e-4 * truth[i]) << i;
+  EXPECT_NE(run.err.find("output error: the model misses the data by more than their noise"),
+            std::string::npos)
+      << run.err;
+  args.insert(args.end() - 2, {"--hb-harmonics", "2"});
+  expect_one_line_error(
+      jointid(args, dir()),
+      "--hb-harmonics: expected from 3 (the largest of --harmonics) to 200, got 2");
+}
+
 TEST_F(CliTest, ModesMatchTheCantileverTheory) {
   const fs::path out = dir() / "modes";
   const Outcome run =

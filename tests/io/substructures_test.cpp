@@ -195,9 +195,15 @@ TEST(Substructures, ErrorsNameTheFileAndTheParts) {
   EXPECT_EQ(model(TwoBeams::composite("b.toml") + "\n[damping]\nmodal = 0.02\n"),
             m + ":19: key 'damping': not used with [[substructures]]: the substructure is made of "
                 "the files it lists");
-  EXPECT_EQ(model("[model]\ndimension = 2\n\n[[substructures]]\nfile = \"parts.toml\"\n"),
-            m + ":5: [[substructures]] entry 1: key 'file': parts.toml is itself made of "
-                "substructures: list its parts here instead");
+  const std::string nested = (x.dir / "parts.toml").string() +
+                             ":4: [[substructures]]: this file is a part of a model made of "
+                             "substructures and may not list substructures itself: list its "
+                             "parts in that model instead";
+  EXPECT_EQ(model("[model]\ndimension = 2\n\n[[substructures]]\nfile = \"parts.toml\"\n"), nested);
+  // A file that lists itself is refused the same way, not read forever.
+  EXPECT_EQ(model("[[substructures]]\nfile = \"m.toml\"\n"),
+            m + ":1: [[substructures]]: this file is a part of a model made of substructures and "
+                "may not list substructures itself: list its parts in that model instead");
   std::string far = TwoBeams::composite("b.toml");
   far.replace(far.find("node_b = 107"), 12, "node_b = 108");
   EXPECT_EQ(model(far).find(m + ":"), 0u);

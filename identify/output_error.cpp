@@ -1,0 +1,439 @@
+#include "identify/output_error.hpp"
+
+#include "identify/harmonics.hpp"
+#include "identify/statistics.hpp"
+#include "joints/basis.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+
+namespace jointid::identify {
+
+namespace {
+
+using Complex = std::complex<double>;
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// One compared value: harmonic k of the displacement (or, from a separate velocity channel, of
+// the velocity: ikω X_k) at output `out` of test `test`.
+struct Entry {
+  int test, k, out;
+  bool velocity;
+  Complex measured;
+  double sigma; // of each of its real and imaginary parts (of the real mean for k = 0)
+};
+
+// One test as the output-error fit drives and compares it.
+struct Test {
+  std::unique_ptr<frf::HarmonicBalance> balance;
+  Eigen::MatrixXcd F;           // harmonics of the forces, the fundamental replaced
+  std::vector<int> outputs;     // response equations compared
+  Eigen::VectorXcd F1_measured; // per force channel
+  Eigen::VectorXd F1_sigma;     // per force channel, each part
+  mutable Eigen::MatrixXcd Y;   // the last solution (warm start)
+};
+
+} // namespace
+
+FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
+                       const std::vector<joints::Joint>& joints,
+                       const std::vector<Measurement>& measurements, const FitResult& start,
+                       const OutputErrorOptions& o) {
+  if (start.status != FitStatus::ok)
+    throw std::invalid_argument("output error: the equation-error start failed: " + start.reason);
+  if (measurements.empty()) throw std::invalid_argument("output error: no tests");
+  if (o.harmonics.empty()) throw std::invalid_argument("output error: no harmonics to compare");
+  const int K = *std::max_element(o.harmonics.begin(), o.harmonics.end());
+  if (o.balance.harmonics < K)
+    throw std::invalid_argument("output error: the harmonic balance needs at least the " +
+                                std::to_string(K) + " harmonics compared");
+  std::vector<joints::Joint> model = start.identified(joints);
+
+  // The parameters: every non-fixed term, then Re and Im of each test's force fundamentals.
+  struct Param {
+    std::size_t joint, term;
+  };
+  std::vector<Param> params;
+  for (std::size_t j = 0; j < model.size(); ++j)
+    for (std::size_t t = 0; t < model[j].terms.size(); ++t)
+      if (!model[j].fixed[t]) params.push_back({j, t});
+  const auto np = static_cast<Eigen::Index>(params.size());
+
+  const std::vector<int> set2 = joint_dof_set(model, dofs);
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(model, dofs, set2);
+  // The tests, the compared entries and the nuisances.
+  std::vector<Test> tests;
+  std::vector<Entry> entries;
+  Eigen::Index nuisances = 0;
+  for (std::size_t i = 0; i < measurements.size(); ++i) {
+    const Measurement& m = measurements[i];
+    if (m.fundamental_only || m.X_variance.size() == 0 || m.F_variance.size() == 0)
+      throw std::invalid_argument(m.source + ": output error needs the record's noise (a "
+                                             "stepped-sine table's is unknown)");
+    Test t;
+    std::vector<int> forces;
+    std::vector<Eigen::Index> force_columns;
+    for (std::size_t c = 0; c < m.force_at.size(); ++c)
+      if (dofs.state(m.force_at[c]) == fem::DofMap::State::free) {
+        forces.push_back(dofs.equation(m.force_at[c]));
+        force_columns.push_back(static_cast<Eigen::Index>(c));
+      }
+    if (forces.empty())
+      throw std::invalid_argument(m.source + ": no force on a free DOF of the model");
+    const auto nf = static_cast<Eigen::Index>(forces.size());
+    t.F = Eigen::MatrixXcd::Zero(m.F.rows(), nf);
+    t.F1_measured.resize(nf);
+    t.F1_sigma.resize(nf);
+    for (Eigen::Index c = 0; c < nf; ++c) {
+      const Eigen::Index mc = force_columns[static_cast<std::size_t>(c)];
+      for (Eigen::Index k = 0; k < m.F.rows(); ++k) {
+        const double var = m.F_variance(k, mc);
+        if (k == 1 || !(std::norm(m.F(k, mc)) <= 25.0 * var)) t.F(k, c) = m.F(k, mc);
+      }
+      const double var = m.F_variance(1, mc);
+      if (!(std::isfinite(var) && var > 0.0))
+        throw std::invalid_argument(m.source +
+                                    ": output error needs the noise of force channel f@" +
+                                    fem::to_string(m.force_at[static_cast<std::size_t>(mc)]) +
+                                    " (a record of two or more whole periods)");
+      t.F1_measured(c) = m.F(1, mc);
+      t.F1_sigma(c) = std::sqrt(var / 2.0);
+    }
+    nuisances += 2 * nf;
+    for (std::size_t r = 0; r < m.response_at.size(); ++r) {
+      if (dofs.state(m.response_at[r]) != fem::DofMap::State::free) continue;
+      const int out = static_cast<int>(t.outputs.size());
+      bool used = false;
+      const auto rc = static_cast<Eigen::Index>(r);
+      for (const int k : o.harmonics) {
+        if (k > m.harmonics || (k == 0 && !m.has_mean[r])) continue;
+        const double var = m.X_variance(k, rc);
+        if (!(std::isfinite(var) && var > 0.0)) continue;
+        entries.push_back(
+            {static_cast<int>(i), k, out, false, m.X(k, rc), std::sqrt(k == 0 ? var : var / 2.0)});
+        used = true;
+      }
+      // A separately measured velocity carries its own noise: its harmonics are data too.
+      const double sv = r < m.velocity_noise.size() ? m.velocity_noise[r] : nan;
+      if (std::isfinite(sv) && sv > 0.0 && m.t.size() > 2 * K) {
+        const double omega = 2.0 * std::numbers::pi * m.frequency_hz;
+        const Eigen::VectorXcd V = fit_harmonics(m.t, Eigen::VectorXd(m.v.col(rc)), omega, K);
+        const double var =
+            4.0 * sv * sv / (static_cast<double>(m.t.size()) * std::max(m.periods_averaged, 1));
+        for (const int k : o.harmonics)
+          if (k >= 1 && k <= m.harmonics) {
+            entries.push_back({static_cast<int>(i), k, out, true, V(k), std::sqrt(var / 2.0)});
+            used = true;
+          }
+      }
+      if (used) t.outputs.push_back(dofs.equation(m.response_at[r]));
+    }
+    if (t.outputs.empty())
+      throw std::invalid_argument(m.source + ": no response harmonic with a known noise to "
+                                             "compare (output error)");
+    t.balance = std::make_unique<frf::HarmonicBalance>(H, model, dofs, forces, t.outputs,
+                                                       m.frequency_hz, o.balance);
+    // The first Newton guess: the measured joint deformations, so that the harmonic balance
+    // finds the periodic solution on the measured branch (a hardening joint has several).
+    t.Y = Eigen::MatrixXcd::Zero(o.balance.harmonics + 1, static_cast<Eigen::Index>(model.size()));
+    for (std::size_t d = 0; d < set2.size(); ++d) {
+      const int r = m.response_index(dofs.node_dof(set2[d]));
+      if (r < 0) continue;
+      for (int k = 1; k <= std::min(m.harmonics, o.balance.harmonics); ++k)
+        t.Y.row(k) += m.X(k, r) * B.row(static_cast<Eigen::Index>(d)).cast<Complex>();
+    }
+    tests.push_back(std::move(t));
+  }
+  const Eigen::Index n_data = [&] {
+    Eigen::Index n = 0;
+    for (const Entry& e : entries)
+      n += e.k == 0 ? 1 : 2;
+    return n;
+  }();
+  const Eigen::Index n_theta = np + nuisances, n_res = n_data + nuisances;
+
+  // θ → joints and forces; the residual r(θ) (data, then the nuisances' measurements).
+  Eigen::VectorXd theta(n_theta), step(n_theta);
+  std::vector<bool> dissipative(static_cast<std::size_t>(np));
+  for (Eigen::Index q = 0; q < np; ++q) {
+    const Param& p = params[static_cast<std::size_t>(q)];
+    theta(q) = model[p.joint].values[p.term];
+    dissipative[static_cast<std::size_t>(q)] =
+        joints::term_info(model[p.joint].terms[p.term]).nature == joints::Nature::dissipative;
+    double scale = std::abs(theta(q));
+    for (const auto& je : start.joints)
+      if (je.name == model[p.joint].name)
+        for (const auto& te : je.terms)
+          if (te.term == model[p.joint].terms[p.term] && std::isfinite(te.std))
+            scale = std::max(scale, te.std);
+    step(q) = 1e-6 * std::max(scale, 1e-300);
+    if (dissipative[static_cast<std::size_t>(q)]) theta(q) = std::max(theta(q), 0.0);
+  }
+  {
+    Eigen::Index at = np;
+    for (const Test& t : tests)
+      for (Eigen::Index c = 0; c < t.F1_measured.size(); ++c) {
+        theta(at) = t.F1_measured(c).real();
+        theta(at + 1) = t.F1_measured(c).imag();
+        step(at) = step(at + 1) = 1e-6 * std::max(std::abs(t.F1_measured(c)), 1e-300);
+        at += 2;
+      }
+  }
+  const auto joints_at = [&](const Eigen::VectorXd& th) {
+    std::vector<joints::Joint> js = model;
+    for (Eigen::Index q = 0; q < np; ++q)
+      js[params[static_cast<std::size_t>(q)].joint]
+          .values[params[static_cast<std::size_t>(q)].term] = th(q);
+    return js;
+  };
+  // The simulated outputs of test i at θ (nullopt when the harmonic balance fails).
+  const auto simulate =
+      [&](std::size_t i, const Eigen::VectorXd& th,
+          const std::vector<joints::Joint>& js) -> std::optional<Eigen::MatrixXcd> {
+    const Test& t = tests[i];
+    Eigen::Index at = np;
+    for (std::size_t k = 0; k < i; ++k)
+      at += 2 * tests[k].F1_measured.size();
+    Eigen::MatrixXcd F = t.F;
+    for (Eigen::Index c = 0; c < F.cols(); ++c)
+      F(1, c) = Complex(th(at + 2 * c), th(at + 2 * c + 1));
+    const frf::HarmonicBalanceResult r = t.balance->solve(js, F, t.Y.size() > 0 ? &t.Y : nullptr);
+    if (!r.converged) return std::nullopt;
+    t.Y = r.Y;
+    return r.X;
+  };
+  const auto simulated = [&](const Entry& e, const std::vector<Eigen::MatrixXcd>& X) {
+    const Complex x = X[static_cast<std::size_t>(e.test)](e.k, e.out);
+    if (!e.velocity) return x;
+    const double omega =
+        2.0 * std::numbers::pi * measurements[static_cast<std::size_t>(e.test)].frequency_hz;
+    return Complex(0.0, e.k * omega) * x;
+  };
+  const auto residual_of = [&](const std::vector<Eigen::MatrixXcd>& X, const Eigen::VectorXd& th) {
+    Eigen::VectorXd r(n_res);
+    Eigen::Index n = 0;
+    for (const Entry& e : entries) {
+      const Complex d = simulated(e, X) - e.measured;
+      r(n++) = d.real() / e.sigma;
+      if (e.k != 0) r(n++) = d.imag() / e.sigma;
+    }
+    Eigen::Index at = np;
+    for (const Test& t : tests)
+      for (Eigen::Index c = 0; c < t.F1_measured.size(); ++c) {
+        r(n++) = (th(at) - t.F1_measured(c).real()) / t.F1_sigma(c);
+        r(n++) = (th(at + 1) - t.F1_measured(c).imag()) / t.F1_sigma(c);
+        at += 2;
+      }
+    return r;
+  };
+  const auto evaluate = [&](const Eigen::VectorXd& th, std::vector<Eigen::MatrixXcd>& X) -> bool {
+    const std::vector<joints::Joint> js = joints_at(th);
+    X.resize(tests.size());
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+      auto x = simulate(i, th, js);
+      if (!x) return false;
+      X[i] = std::move(*x);
+    }
+    return true;
+  };
+
+  std::vector<Eigen::MatrixXcd> X;
+  if (!evaluate(theta, X)) {
+    for (std::size_t i = 0; i < tests.size(); ++i)
+      if (!simulate(i, theta, joints_at(theta)))
+        throw std::invalid_argument(measurements[i].source +
+                                    ": output error: the harmonic balance does not converge at "
+                                    "the equation-error estimate");
+  }
+  Eigen::VectorXd r = residual_of(X, theta);
+  double cost = r.squaredNorm();
+
+  // The Jacobian by forward differences: a term moves every test, a force only its own test.
+  Eigen::MatrixXd J(n_res, n_theta);
+  const auto jacobian = [&]() -> bool {
+    J.setZero();
+    for (Eigen::Index q = 0; q < n_theta; ++q) {
+      bool done = false;
+      for (const double h : {step(q), -step(q)}) {
+        Eigen::VectorXd tq = theta;
+        tq(q) += h;
+        if (q < np && dissipative[static_cast<std::size_t>(q)] && tq(q) < 0.0) continue;
+        std::vector<Eigen::MatrixXcd> Xq = X;
+        bool ok = true;
+        if (q < np) {
+          ok = evaluate(tq, Xq);
+        } else {
+          std::size_t i = 0;
+          Eigen::Index at = np;
+          while (at + 2 * tests[i].F1_measured.size() <= q)
+            at += 2 * tests[i].F1_measured.size(), ++i;
+          const auto x = simulate(i, tq, joints_at(tq));
+          ok = x.has_value();
+          if (ok) Xq[i] = *x;
+        }
+        if (!ok) continue;
+        J.col(q) = (residual_of(Xq, tq) - r) / h;
+        done = true;
+        break;
+      }
+      if (!done) return false;
+    }
+    // Leave the warm starts at θ.
+    std::vector<Eigen::MatrixXcd> again;
+    (void)evaluate(theta, again);
+    return true;
+  };
+
+  int iterations = 0;
+  double mu = 1e-3;
+  bool stalled = false;
+  for (; iterations < o.max_iterations; ++iterations) {
+    if (!jacobian()) {
+      stalled = true;
+      break;
+    }
+    // Levenberg–Marquardt on the column-scaled problem.
+    const Eigen::VectorXd scale = J.colwise().norm().cwiseMax(1e-300).transpose();
+    const Eigen::MatrixXd Js = J * scale.cwiseInverse().asDiagonal();
+    const Eigen::MatrixXd A = Js.transpose() * Js;
+    const Eigen::VectorXd g = Js.transpose() * r;
+    bool accepted = false;
+    double gain = 0.0;
+    for (int tries = 0; tries < 12 && !accepted; ++tries) {
+      Eigen::MatrixXd M = A;
+      M.diagonal().array() += mu;
+      Eigen::VectorXd next = theta - scale.cwiseInverse().asDiagonal() * M.ldlt().solve(g);
+      for (Eigen::Index q = 0; q < np; ++q)
+        if (dissipative[static_cast<std::size_t>(q)]) next(q) = std::max(next(q), 0.0);
+      std::vector<Eigen::MatrixXcd> Xn;
+      if (next.allFinite() && evaluate(next, Xn)) {
+        const Eigen::VectorXd rn = residual_of(Xn, next);
+        if (rn.squaredNorm() < cost) {
+          gain = (cost - rn.squaredNorm()) / cost;
+          theta = next, X = std::move(Xn), r = rn, cost = r.squaredNorm();
+          mu = std::max(mu / 10.0, 1e-12);
+          accepted = true;
+          break;
+        }
+      }
+      (void)evaluate(theta, Xn); // the warm starts back at θ
+      mu *= 10.0;
+    }
+    if (!accepted || gain < 1e-10) break;
+  }
+  if (!jacobian()) stalled = true;
+
+  // The result: values, and intervals from (Jᵀ J)⁻¹ widened by χ²/dof above 1.
+  FitResult out = start;
+  const Eigen::Index dof = n_res - n_theta;
+  const double chi2 = dof > 0 ? cost / static_cast<double>(dof) : nan;
+  Eigen::MatrixXd C = Eigen::MatrixXd::Constant(n_theta, n_theta, nan);
+  if (!stalled && dof > 0) { // on the column-scaled Jacobian: the units differ by many decades
+    const Eigen::VectorXd s = J.colwise().norm().cwiseMax(1e-300).transpose().cwiseInverse();
+    const Eigen::MatrixXd Js = J * s.asDiagonal();
+    C = std::max(chi2, 1.0) * s.asDiagonal() *
+        (Js.transpose() * Js).completeOrthogonalDecomposition().pseudoInverse() * s.asDiagonal();
+    const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(Js).singularValues();
+    out.singular_values.assign(sv.data(), sv.data() + sv.size());
+    out.condition_number = sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1) : nan;
+  }
+  const double tq = dof > 0 ? student_t_quantile(0.975, static_cast<double>(dof)) : nan;
+  const std::vector<joints::Joint> identified = joints_at(theta);
+  out.joints.clear();
+  Eigen::Index q = 0;
+  std::vector<std::string> poorly;
+  for (std::size_t j = 0; j < identified.size(); ++j) {
+    JointEstimate je{identified[j].name, {}};
+    for (std::size_t t = 0; t < identified[j].terms.size(); ++t) {
+      TermEstimate te;
+      te.term = identified[j].terms[t];
+      te.value = identified[j].values[t];
+      te.fixed = identified[j].fixed[t];
+      if (te.fixed) {
+        te.std = 0.0;
+        te.ci_low = te.ci_high = te.value;
+      } else {
+        te.std = std::isfinite(C(q, q)) ? std::sqrt(std::max(C(q, q), 0.0)) : nan;
+        te.ci_low = te.value - tq * te.std;
+        te.ci_high = te.value + tq * te.std;
+        te.determined = std::isfinite(te.std) && te.std <= o.poorly_determined * std::abs(te.value);
+        if (!te.determined)
+          poorly.push_back(fmt::format("{} of '{}'", joints::term_name(te.term), je.name));
+        ++q;
+      }
+      je.terms.push_back(te);
+    }
+    out.joints.push_back(std::move(je));
+  }
+  double misfit = 0.0, size = 0.0; // of the displacement values (m)
+  for (const Entry& e : entries)
+    if (!e.velocity) {
+      misfit += std::norm(simulated(e, X) - e.measured);
+      size += std::norm(e.measured);
+    }
+  out.equations = static_cast<int>(n_data);
+  out.unknowns = static_cast<int>(n_theta);
+  const auto n_x =
+      std::count_if(entries.begin(), entries.end(), [](const Entry& e) { return !e.velocity; });
+  out.residual_rms = n_x > 0 ? std::sqrt(misfit / static_cast<double>(n_x)) : nan;
+  out.residual_relative = size > 0.0 ? std::sqrt(misfit / size) : nan;
+  out.chi2_per_dof = chi2;
+  out.interval_method = "output error";
+  out.warnings.push_back(fmt::format(
+      "output error: {} Levenberg–Marquardt iteration(s) from the equation-error estimate, "
+      "χ²/dof {:.3g} over {} values (harmonics {} of the displacement, and of the velocity where "
+      "it was measured, each weighted by its noise; the force fundamentals estimated with "
+      "theirs){}",
+      iterations, chi2, n_data, fmt::join(o.harmonics, ", "),
+      stalled ? "; stopped: the harmonic balance did not converge near the estimate, the "
+                "intervals are unknown"
+              : ""));
+  if (chi2 > 3.0)
+    out.warnings.push_back(fmt::format(
+        "output error: the model misses the data by more than their noise (χ²/dof {:.3g}): the "
+        "intervals are widened by its square root, {:.3g}; a bias of the model (e.g. a missing "
+        "term, or a simulation unlike the rig) is not in them",
+        chi2, std::sqrt(chi2)));
+  for (const std::string& p : poorly)
+    out.warnings.push_back(fmt::format(
+        "{} is poorly determined by output error (standard deviation above {} % of its value)", p,
+        100.0 * o.poorly_determined));
+  return out;
+}
+
+FitResult output_error(const frf::Substructure& sub, const std::vector<joints::Joint>& joints,
+                       const std::vector<Measurement>& tests, const FitOptions& fit_options,
+                       const OutputErrorOptions& o) {
+  const FitResult start = fit(sub, joints, tests, fit_options);
+  if (start.status != FitStatus::ok) return start;
+  std::vector<int> equations = joint_dof_set(joints, sub.dofs());
+  double f_max = 0.0;
+  for (const Measurement& m : tests) {
+    f_max = std::max(f_max, m.frequency_hz);
+    for (const auto* list : {&m.force_at, &m.response_at})
+      for (const fem::NodeDof& at : *list)
+        if (sub.dofs().state(at) == fem::DofMap::State::free) {
+          const int e = sub.dofs().equation(at);
+          if (std::find(equations.begin(), equations.end(), e) == equations.end())
+            equations.push_back(e);
+        }
+  }
+  std::vector<std::string> notes;
+  const frf::ModalSynthesis H =
+      sub.synthesis(equations, frf::synthesis_band_hz(f_max, o.balance.harmonics), &notes);
+  FitResult out = output_error(H, sub.dofs(), joints, tests, start, o);
+  for (const std::string& note : notes) // those of the fit's own synthesis are there already
+    if (std::find(out.warnings.begin(), out.warnings.end(), note) == out.warnings.end())
+      out.warnings.push_back(note);
+  return out;
+}
+
+} // namespace jointid::identify
