@@ -228,17 +228,27 @@ std::vector<double> cramer_rao(const frf::Substructure& sub, const Study& s,
   return out;
 }
 
-void report(const Study& s, int reps) {
-  const frf::Substructure sub(test::paper_cantilever());
-  identify::SimulationOptions so;
-  so.steps_per_period = 1024;
-  so.samples_per_period = 256;
-  so.periods = 8;
-  const auto clean = identify::simulate_sine_tests(sub, s.truth, {7, fem::Dof::uy}, s.plans, so);
+// A study's substructure, its clean records (time integration, 1024 steps and 256 samples a
+// period, 8 periods) and the names of its parameters.
+struct Prepared {
+  frf::Substructure sub{test::paper_cantilever()};
+  std::vector<identify::SimulatedTest> clean;
   std::vector<std::string> names;
-  for (const auto& j : s.truth)
-    for (Term t : j.terms)
-      names.push_back(std::string(joints::term_name(t)) + " of '" + j.name + "'");
+  explicit Prepared(const Study& s) {
+    identify::SimulationOptions so;
+    so.steps_per_period = 1024;
+    so.samples_per_period = 256;
+    so.periods = 8;
+    clean = identify::simulate_sine_tests(sub, s.truth, {7, fem::Dof::uy}, s.plans, so);
+    for (const auto& j : s.truth)
+      for (Term t : j.terms)
+        names.push_back(std::string(joints::term_name(t)) + " of '" + j.name + "'");
+  }
+};
+
+void report(const Study& s, int reps) {
+  const Prepared p(s);
+  const auto& [sub, clean, names] = p;
   std::printf("\n### %s (%zu tests, %d repetitions)\n", s.name.c_str(), s.plans.size(), reps);
   for (double level : {0.01, 0.05}) {
     identify::FitOptions ols;
@@ -268,16 +278,8 @@ void report(const Study& s, int reps) {
 
 // Output error against the equation-error fit (GLS) and the Cramér–Rao bound.
 void output_error_report(const Study& s, int reps, const std::vector<double>& levels) {
-  const frf::Substructure sub(test::paper_cantilever());
-  identify::SimulationOptions so;
-  so.steps_per_period = 1024;
-  so.samples_per_period = 256;
-  so.periods = 8;
-  const auto clean = identify::simulate_sine_tests(sub, s.truth, {7, fem::Dof::uy}, s.plans, so);
-  std::vector<std::string> names;
-  for (const auto& j : s.truth)
-    for (Term t : j.terms)
-      names.push_back(std::string(joints::term_name(t)) + " of '" + j.name + "'");
+  const Prepared p(s);
+  const auto& [sub, clean, names] = p;
   std::printf("\n### Output error: %s (%zu tests, %d repetitions)\n", s.name.c_str(),
               s.plans.size(), reps);
   for (double level : levels) {

@@ -4,6 +4,7 @@
 #include "frf/measured_frf.hpp"
 #include "frf/receptance.hpp"
 #include "frf/substructure.hpp"
+#include "support/error_of.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,6 +16,7 @@
 
 using namespace jointid;
 using fem::Dof;
+using test::error_of;
 
 namespace {
 
@@ -55,15 +57,6 @@ frf::MeasuredFrf sampled(double f0, double h, int lines, bool with_33 = true) {
   function(0, 1);
   if (with_33) function(0, 0);
   return out;
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 } // namespace

@@ -14,6 +14,7 @@
 #include "io/model_file.hpp"
 #include "io/test_files.hpp"
 #include "io/uff58.hpp"
+#include "support/error_of.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -25,19 +26,11 @@
 using namespace jointid;
 using fem::Dof;
 namespace fs = std::filesystem;
+using test::error_of;
 
 namespace {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 // The cantilever of DESIGN.md (joint at 7:uy) by finite elements, and its FRFs from a force at
 // 7:uy to 7:uy and 4:uy at lines 0, h, 2h, … f_max.

@@ -12,6 +12,7 @@
 #include "io/frf_output.hpp"
 #include "io/model_file.hpp"
 #include "io/test_files.hpp"
+#include "support/error_of.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -23,6 +24,7 @@
 using namespace jointid;
 using fem::Dof;
 namespace fs = std::filesystem;
+using test::error_of;
 
 namespace {
 
@@ -81,15 +83,6 @@ struct TwoBeams {
            b + "\"\nnode_offset = 100\n\n" + link_joint;
   }
 };
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 } // namespace
 
