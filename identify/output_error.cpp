@@ -245,13 +245,17 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     return true;
   };
 
-  std::vector<Eigen::MatrixXcd> X;
-  if (!evaluate(theta, X)) {
-    for (std::size_t i = 0; i < tests.size(); ++i)
-      if (!simulate(i, theta, joints_at(theta)))
+  std::vector<Eigen::MatrixXcd> X(tests.size());
+  {
+    const std::vector<joints::Joint> js = joints_at(theta);
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+      auto x = simulate(i, theta, js);
+      if (!x)
         throw std::invalid_argument(measurements[i].source +
                                     ": output error: the harmonic balance does not converge at "
                                     "the equation-error estimate");
+      X[i] = std::move(*x);
+    }
   }
   Eigen::VectorXd r = residual_of(X, theta);
   double cost = r.squaredNorm();
