@@ -70,7 +70,9 @@ public:
                   const HarmonicBalanceOptions& options = {});
   /// F: harmonics 0, 1, … of the forces (rows beyond K are ignored, missing ones are 0), one
   /// column per force equation. `start` (K+1 × n_joints), if given, is the first Newton guess;
-  /// otherwise the linear response with the joints' linear terms (k, c) is. Throws
+  /// otherwise the steady state with the fundamental alone (K = 1, solved from the linear
+  /// response with the joints' linear terms k, c, scaled) is, or that linear response if the
+  /// fundamental-only problem does not converge. Throws
   /// std::invalid_argument for a negative friction limit fc (a joint that gives energy).
   HarmonicBalanceResult solve(const std::vector<joints::Joint>& joints, const Eigen::MatrixXcd& F,
                               const Eigen::MatrixXcd* start = nullptr) const;
@@ -98,6 +100,7 @@ private:
   std::vector<CMatrix> Hyy_, HyF_, HoB_, HoF_; // per harmonic
   const detail::Tables* tables_ = nullptr;     // AFT sample tables independent of ω (cached)
   Eigen::MatrixXd dv_;                         // ∂ẏ_n/∂z at this ω
+  Eigen::MatrixXd dyv_;                        // ∂y_n/∂z over ∂ẏ_n/∂z
 };
 
 /// One steady state under F0 sin(2π f t) at `force_equation`.

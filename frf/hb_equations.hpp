@@ -7,14 +7,16 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <vector>
 
 namespace jointid::frf::detail {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
 
-// A joint's smooth force g and its derivatives. Coulomb friction is left out when it is
-// handled exactly (`width` = 0), else regularised as fc·tanh(ẏ/width).
+// A joint's smooth force g and its derivatives at one time (the stability check's). Coulomb
+// friction is left out when it is handled exactly (`width` = 0), else regularised as
+// fc·tanh(ẏ/width), as in add_joint_forces() below.
 inline void joint_force(const joints::Joint& j, double y, double v, double width, double& g,
                         double& gy, double& gv) {
   g = gy = gv = 0.0;
@@ -33,6 +35,30 @@ inline void joint_force(const joints::Joint& j, double y, double v, double width
   }
 }
 
+// A joint's smooth force g and its derivatives at the n time samples y, ẏ, added to the
+// columns of g (n × 3: g, ∂g/∂y, ∂g/∂ẏ). Coulomb friction is left out when it is handled
+// exactly (`width` = 0), else regularised as fc·tanh(ẏ/width).
+inline void add_joint_forces(const joints::Joint& j, const double* y, const double* v, int n,
+                             double width, Eigen::MatrixXd& g) {
+  const auto size = static_cast<std::size_t>(n);
+  const std::span<const double> ys(y, size), vs(v, size);
+  const std::span<double> gs(g.col(0).data(), size), gys(g.col(1).data(), size),
+      gvs(g.col(2).data(), size);
+  for (std::size_t t = 0; t < j.terms.size(); ++t) {
+    const double b = j.values[t];
+    if (!joints::is_dry_friction(j.terms[t])) {
+      joints::add_samples(j.terms[t], b, ys, vs, gs, gys, gvs);
+      continue;
+    }
+    if (width == 0.0) continue;
+    for (std::size_t i = 0; i < size; ++i) {
+      const double th = std::tanh(vs[i] / width);
+      gs[i] += b * th;
+      gvs[i] += b * (1.0 - th * th) / width;
+    }
+  }
+}
+
 // A joint with exact dry friction: its limit, its augmentation r (N s/m) and a compliance c
 // (m/N) that puts its residual rows in metres like the others.
 struct Friction {
@@ -42,7 +68,8 @@ struct Friction {
 
 // The equations of one solve. Unknowns z: per joint j, at offset j (2K + 1), Re Y_0, then
 // Re Y_k, Im Y_k for k = 1 … K; then per friction joint f, at offset (nj + f)(2K + 1), its
-// force harmonics Λ packed the same way (N).
+// force harmonics Λ packed the same way (N). residual() works in scratch arrays of its own
+// (sized once): a Newton iteration allocates nothing, and one Equations serves one thread.
 struct Equations {
   int K, nj, Nt;
   const std::vector<CMatrix>& Hyy;
@@ -51,52 +78,74 @@ struct Equations {
   const std::vector<joints::Joint>& joints;
   double width; // 0: friction exact
   std::vector<Friction> friction;
-  // Per sample n: ∂y_n/∂z and ∂ẏ_n/∂z of one joint (Nt × (2K+1)), and the forward transform
-  // from samples to packed harmonics ((2K+1) × Nt).
-  const Eigen::MatrixXd &dy, &dv, &forward;
-  // cos(pθ_n) and sin(pθ_n), p = 0 … 2K, for the harmonics of sample weights (Nt × (2K+1)).
-  const Eigen::MatrixXd &cos2, &sin2;
+  // Per sample n: ∂y_n/∂z and ∂ẏ_n/∂z of one joint (Nt × (2K+1)), both stacked (2Nt × (2K+1),
+  // one product gives y and ẏ), and the forward transform from samples to packed harmonics
+  // ((2K+1) × Nt).
+  const Eigen::MatrixXd &dy, &dv, &dyv, &forward;
+  // cos(pθ_n) beside sin(pθ_n), p = 0 … 2K (Nt × (4K+2)): the harmonics of sample weights.
+  const Eigen::MatrixXd& trig;
   double omega;
 
-  // forward · diag(wy) · dy + forward · diag(wv) · dv, the derivative of the harmonics of a
-  // signal w_y(t) y(t) + w_v(t) ẏ(t) with respect to the packed harmonics of y, from the
-  // harmonics W_p = (1/Nt) Σ w(θ_n) e^{−ipθ_n}, p ≤ 2K, of the weights (product-to-sum: a
-  // product of harmonics j and k has harmonics k ± j). O(Nt K + K²) instead of O(Nt K²).
-  Eigen::MatrixXd product(const Eigen::VectorXd* wy, const Eigen::VectorXd* wv) const {
-    const int M = m();
-    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(M, M);
-    auto add = [&](const Eigen::VectorXd& w, bool rate) {
-      const Eigen::VectorXd re = cos2.transpose() * w / Nt, im = -(sin2.transpose() * w) / Nt;
-      auto Re = [&](int p) { return re(std::abs(p)); };
-      auto Im = [&](int p) { return p < 0 ? -im(-p) : im(p); };
-      // The columns of y's own harmonics: 0, cos jθ, −sin jθ.
-      Eigen::MatrixXd E(M, M);
-      E(0, 0) = Re(0);
-      for (int j = 1; j <= K; ++j)
-        E(0, 2 * j - 1) = Re(j), E(0, 2 * j) = Im(j);
-      for (int k = 1; k <= K; ++k) {
-        E(2 * k - 1, 0) = 2.0 * Re(k);
-        E(2 * k, 0) = 2.0 * Im(k);
-        for (int j = 1; j <= K; ++j) {
-          E(2 * k - 1, 2 * j - 1) = Re(k - j) + Re(k + j);
-          E(2 * k - 1, 2 * j) = Im(k + j) - Im(k - j);
-          E(2 * k, 2 * j - 1) = Im(k + j) + Im(k - j);
-          E(2 * k, 2 * j) = Re(k - j) - Re(k + j);
-        }
-      }
-      if (!rate) {
-        D += E;
-        return;
-      }
-      // ẏ's columns: d/dt cos jθ = jω (−sin jθ), d/dt (−sin jθ) = −jω cos jθ.
+  struct Scratch {
+    Eigen::VectorXd yv, harmonics, lambda, clamped;
+    // At the point of the last residual(): per joint, g, ∂g/∂y, ∂g/∂ẏ at the samples (Nt × 3);
+    // per friction joint, 1 where a sample sticks (Nt). jacobian() reads them.
+    std::vector<Eigen::MatrixXd> g;
+    std::vector<Eigen::VectorXd> stick;
+    Eigen::MatrixXd weights; // (4K+2) × 2: cos and sin sums of the columns ∂g/∂y, ∂g/∂ẏ
+    Eigen::MatrixXd E, D;
+  };
+  mutable Scratch work{};
+
+  Scratch& scratch() const {
+    if (work.yv.size() != 2 * Nt) {
+      work.yv.resize(2 * Nt);
+      work.lambda.resize(Nt), work.clamped.resize(Nt);
+      work.g.assign(static_cast<std::size_t>(nj), Eigen::MatrixXd(Nt, 3));
+      work.stick.assign(friction.size(), Eigen::VectorXd(Nt));
+      work.harmonics.resize(m());
+      work.weights.resize(2 * m(), 2);
+      work.E.resize(m(), m()), work.D.resize(m(), m());
+    }
+    return work;
+  }
+
+  // D += forward · diag(w) · dy (rate = false) or forward · diag(w) · dv (rate = true): the
+  // derivative of the harmonics of a signal w(t) y(t) or w(t) ẏ(t) with respect to the packed
+  // harmonics of y, from the harmonics W_p = (1/Nt) Σ w(θ_n) e^{−ipθ_n}, p ≤ 2K, of the weights
+  // (product-to-sum: a product of harmonics j and k has harmonics k ± j). O(Nt K + K²) instead
+  // of O(Nt K²). `sums` = trigᵀ w, the column of the weight's cosine and sine sums.
+  template <class Sums> void add_product(const Sums& sums, bool rate, Eigen::MatrixXd& D) const {
+    Scratch& s = scratch();
+    const double* cs = sums.data();
+    const double* sn = cs + m();
+    const double scale = 1.0 / Nt;
+    auto Re = [&](int p) { return scale * cs[std::abs(p)]; };
+    auto Im = [&](int p) { return p < 0 ? scale * sn[-p] : -scale * sn[p]; };
+    // The columns of y's own harmonics: 0, cos jθ, −sin jθ.
+    Eigen::MatrixXd& E = s.E;
+    E(0, 0) = Re(0);
+    for (int j = 1; j <= K; ++j)
+      E(0, 2 * j - 1) = Re(j), E(0, 2 * j) = Im(j);
+    for (int k = 1; k <= K; ++k) {
+      E(2 * k - 1, 0) = 2.0 * Re(k);
+      E(2 * k, 0) = 2.0 * Im(k);
       for (int j = 1; j <= K; ++j) {
-        D.col(2 * j - 1) += j * omega * E.col(2 * j);
-        D.col(2 * j) -= j * omega * E.col(2 * j - 1);
+        E(2 * k - 1, 2 * j - 1) = Re(k - j) + Re(k + j);
+        E(2 * k - 1, 2 * j) = Im(k + j) - Im(k - j);
+        E(2 * k, 2 * j - 1) = Im(k + j) + Im(k - j);
+        E(2 * k, 2 * j) = Re(k - j) - Re(k + j);
       }
-    };
-    if (wy) add(*wy, false);
-    if (wv) add(*wv, true);
-    return D;
+    }
+    if (!rate) {
+      D += E;
+      return;
+    }
+    // ẏ's columns: d/dt cos jθ = jω (−sin jθ), d/dt (−sin jθ) = −jω cos jθ.
+    for (int j = 1; j <= K; ++j) {
+      D.col(2 * j - 1) += j * omega * E.col(2 * j);
+      D.col(2 * j) -= j * omega * E.col(2 * j - 1);
+    }
   }
 
   int m() const { return 2 * K + 1; }
@@ -121,23 +170,28 @@ struct Equations {
     }
   }
 
-  // Harmonics of the joints' smooth forces (K+1) × nj and, if asked, their derivatives with
-  // respect to the joint's own unknowns (one (2K+1) × (2K+1) block per joint, packed like z).
-  Eigen::MatrixXcd forces(const Eigen::VectorXd& z, std::vector<Eigen::MatrixXd>* dG) const {
+  // Packed harmonics of joint j's smooth force (m) at z; its samples are kept for jacobian().
+  void smooth_force(const Eigen::VectorXd& z, int j, Eigen::VectorXd& harmonics) const {
+    Scratch& s = scratch();
+    Eigen::MatrixXd& g = s.g[static_cast<std::size_t>(j)];
+    s.yv.noalias() = dyv * z.segment(j * m(), m());
+    g.setZero();
+    add_joint_forces(joints[j], s.yv.data(), s.yv.data() + Nt, Nt, width, g);
+    harmonics.noalias() = forward * g.col(0);
+  }
+
+  // Harmonics of the joints' forces (K+1) × nj: the smooth forces and the exact friction
+  // forces (unknowns).
+  Eigen::MatrixXcd forces(const Eigen::VectorXd& z) const {
     Eigen::MatrixXcd G(K + 1, nj);
-    Eigen::VectorXd g(Nt), gy(Nt), gv(Nt);
+    Eigen::VectorXd Gp(m());
     for (int j = 0; j < nj; ++j) {
-      const Eigen::VectorXd zj = z.segment(j * m(), m());
-      const Eigen::VectorXd y = dy * zj, v = dv * zj;
-      for (int n = 0; n < Nt; ++n)
-        joint_force(joints[j], y(n), v(n), width, g(n), gy(n), gv(n));
-      const Eigen::VectorXd Gp = forward * g;
+      smooth_force(z, j, Gp);
       G(0, j) = Gp(0);
       for (int k = 1; k <= K; ++k)
         G(k, j) = Complex(Gp(2 * k - 1), Gp(2 * k));
-      if (dG) (*dG)[j] = product(&gy, &gv);
     }
-    for (std::size_t f = 0; f < friction.size(); ++f) // exact friction forces, as unknowns
+    for (std::size_t f = 0; f < friction.size(); ++f)
       G.col(friction[f].joint) += unpack(z, 1, nj + static_cast<int>(f)).col(0);
     return G;
   }
@@ -157,45 +211,93 @@ struct Equations {
     }
   }
 
-  // R = [z_Y − pack(H_yf F) + pack(H_yy G(z)); c (Λ − AFT[proj(λ + r ẏ)])] and its
-  // (generalised) Jacobian.
-  Eigen::VectorXd residual(const Eigen::VectorXd& z, double load, Eigen::MatrixXd* J) const {
-    std::vector<Eigen::MatrixXd> dG(J ? nj : 0);
-    const Eigen::MatrixXcd G = forces(z, J ? &dG : nullptr);
-    Eigen::MatrixXcd R(K + 1, nj);
-    for (int k = 0; k <= K; ++k)
-      R.row(k) = -load * HyF_F.row(k) + (Hyy[k] * G.row(k).transpose()).transpose();
-    Eigen::VectorXd r = z;
-    Eigen::VectorXd packed(nj * m());
-    pack(R, packed);
-    r.head(nj * m()) += packed;
-    if (J) {
-      J->setIdentity(size(), size());
-      for (int a = 0; a < nj; ++a)
+  // r = [z_Y − pack(H_yf F) + pack(H_yy G(z)); c (Λ − AFT[proj(λ + r ẏ)])], sized by the caller
+  // (size()), and, if asked, its (generalised) Jacobian there (as jacobian()).
+  void residual(const Eigen::VectorXd& z, double load, Eigen::VectorXd& r,
+                Eigen::MatrixXd* J) const {
+    Scratch& s = scratch();
+    r = z;
+    // Per joint a: its rows get Σ_b H_yy(kω)_ab G_b,k, with G_b the smooth force of joint b
+    // plus its friction unknowns.
+    Eigen::MatrixXcd& G = force_harmonics_;
+    G.resize(K + 1, nj);
+    for (int b = 0; b < nj; ++b) {
+      smooth_force(z, b, s.harmonics);
+      G(0, b) = s.harmonics(0);
+      for (int k = 1; k <= K; ++k)
+        G(k, b) = Complex(s.harmonics(2 * k - 1), s.harmonics(2 * k));
+    }
+    for (std::size_t f = 0; f < friction.size(); ++f) {
+      const int o = (nj + static_cast<int>(f)) * m(), b = friction[f].joint;
+      G(0, b) += z(o);
+      for (int k = 1; k <= K; ++k)
+        G(k, b) += Complex(z(o + 2 * k - 1), z(o + 2 * k));
+    }
+    for (int a = 0; a < nj; ++a) {
+      const int o = a * m();
+      for (int k = 0; k <= K; ++k) {
+        Complex v = -load * HyF_F(k, a);
         for (int b = 0; b < nj; ++b)
-          add_coupling(*J, a, b, b * m(), dG[b]);
-      const Eigen::MatrixXd unit = Eigen::MatrixXd::Identity(m(), m());
-      for (std::size_t f = 0; f < friction.size(); ++f)
-        for (int a = 0; a < nj; ++a)
-          add_coupling(*J, a, friction[f].joint, (nj + static_cast<int>(f)) * m(), unit);
+          v += Hyy[k](a, b) * G(k, b);
+        if (k == 0) {
+          r(o) += v.real();
+        } else {
+          r(o + 2 * k - 1) += v.real();
+          r(o + 2 * k) += v.imag();
+        }
+      }
     }
     for (std::size_t f = 0; f < friction.size(); ++f) {
       const Friction& fr = friction[f];
       const int o = (nj + static_cast<int>(f)) * m(), oy = fr.joint * m();
-      const Eigen::VectorXd lambda = dy * z.segment(o, m()), v = dv * z.segment(oy, m());
-      Eigen::VectorXd p(Nt), stick(Nt);
+      s.lambda.noalias() = dy * z.segment(o, m());
+      s.yv.tail(Nt).noalias() = dv * z.segment(oy, m());
+      Eigen::VectorXd& stick = s.stick[f];
       for (int n = 0; n < Nt; ++n) {
-        const double trial = lambda(n) + fr.r * v(n);
+        const double trial = s.lambda(n) + fr.r * s.yv(Nt + n);
         stick(n) = std::abs(trial) < fr.limit ? 1.0 : 0.0;
-        p(n) = std::clamp(trial, -fr.limit, fr.limit);
+        s.clamped(n) = std::clamp(trial, -fr.limit, fr.limit);
       }
-      r.segment(o, m()) = fr.c * (z.segment(o, m()) - forward * p);
-      if (J) {
-        J->block(o, o, m(), m()) =
-            fr.c * (Eigen::MatrixXd::Identity(m(), m()) - product(&stick, nullptr));
-        J->block(o, oy, m(), m()) = -fr.c * fr.r * product(nullptr, &stick);
-      }
+      s.harmonics.noalias() = forward * s.clamped;
+      r.segment(o, m()) = fr.c * (z.segment(o, m()) - s.harmonics);
     }
+    if (J) jacobian(*J);
+  }
+
+  // The (generalised) Jacobian of the residual at the point of the last residual() call, from
+  // the samples it kept: Newton needs it only where it takes a step from.
+  void jacobian(Eigen::MatrixXd& J) const {
+    Scratch& s = scratch();
+    J.setIdentity(size(), size());
+    for (int b = 0; b < nj; ++b) {
+      const Eigen::MatrixXd& g = s.g[static_cast<std::size_t>(b)];
+      s.weights.noalias() = trig.transpose().lazyProduct(g.rightCols(2)); // small: no packing
+      s.D.setZero();
+      add_product(s.weights.col(0), false, s.D);
+      add_product(s.weights.col(1), true, s.D);
+      for (int a = 0; a < nj; ++a)
+        add_coupling(J, a, b, b * m(), s.D);
+    }
+    for (std::size_t f = 0; f < friction.size(); ++f) {
+      const Friction& fr = friction[f];
+      const int o = (nj + static_cast<int>(f)) * m(), oy = fr.joint * m();
+      for (int a = 0; a < nj; ++a)
+        add_coupling(J, a, fr.joint, o, Eigen::MatrixXd::Identity(m(), m()));
+      // c (I − P_stick) and −c r P'_stick
+      s.weights.col(0).noalias() = trig.transpose() * s.stick[f];
+      s.D.setZero();
+      add_product(s.weights.col(0), false, s.D);
+      J.block(o, o, m(), m()) = fr.c * (Eigen::MatrixXd::Identity(m(), m()) - s.D);
+      s.D.setZero();
+      add_product(s.weights.col(0), true, s.D);
+      J.block(o, oy, m(), m()) = -fr.c * fr.r * s.D;
+    }
+  }
+
+  Eigen::VectorXd residual(const Eigen::VectorXd& z, double load, Eigen::MatrixXd* J) const {
+    Eigen::VectorXd r(size());
+    if (J) J->resize(size(), size());
+    residual(z, load, r, J);
     return r;
   }
 
@@ -207,6 +309,8 @@ struct Equations {
            z.segment((nj + static_cast<int>(f)) * m(), m()).squaredNorm();
     return std::sqrt(s);
   }
+
+  mutable Eigen::MatrixXcd force_harmonics_{};
 };
 
 /// Newton's method (least-norm steps where J is singular, backtracking) on R(z) = 0 at the

@@ -183,21 +183,21 @@ CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows,
                                    std::span<const int> cols) const {
   const int m = static_cast<int>(omega_.size());
   CVector modal(m);
-  for (int r = 0; r < m; ++r)
-    modal(r) = 1.0 / Complex(omega_(r) * omega_(r) - omega * omega, modal_damping_(r) * omega);
+  for (int r = 0; r < m; ++r) { // 1 / (ω_r² − ω² + i d_r ω), without the library's checked division
+    const double a = omega_(r) * omega_(r) - omega * omega, b = modal_damping_(r) * omega;
+    const double d = a * a + b * b;
+    modal(r) = d > 0.0 ? Complex(a / d, -b / d) : 1.0 / Complex(a, b);
+  }
   CMatrix H(rows.size(), cols.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const int pi = position(rows[i]);
     for (std::size_t j = 0; j < cols.size(); ++j) {
       const int pj = position(cols[j]);
       // Σ_r φ_ir φ_jr / d_r (no conjugation: receptance is symmetric, not Hermitian)
-      const Complex h = (phi_.row(pi)
-                             .transpose()
-                             .cwiseProduct(phi_.row(pj).transpose())
-                             .cast<Complex>()
-                             .cwiseProduct(modal))
-                            .sum();
-      H(i, j) = h + residual_(pi, pj);
+      Complex h = residual_(pi, pj);
+      for (int r = 0; r < m; ++r)
+        h += (phi_(pi, r) * phi_(pj, r)) * modal(r);
+      H(i, j) = h;
     }
   }
   // Measured FRFs, in their block: the entries whose row and column are both theirs.

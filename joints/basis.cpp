@@ -85,4 +85,44 @@ double basis_dydot(Term t, double y, double v) {
   return term_info(t).dg_dydot(y, v);
 }
 
+// The table's functions, one loop per term so that the compiler vectorises them; the test
+// (tests/joints/basis_test.cpp) holds them equal to the table's for every term.
+void add_samples(Term t, double b, std::span<const double> y, std::span<const double> v,
+                 std::span<double> g, std::span<double> gy, std::span<double> gv) {
+  const std::size_t n = y.size();
+  if (v.size() != n || g.size() != n || gy.size() != n || gv.size() != n)
+    throw std::invalid_argument("add_samples: the sample arrays differ in length");
+  switch (t) {
+  case Term::k:
+    for (std::size_t i = 0; i < n; ++i)
+      g[i] += b * y[i], gy[i] += b;
+    return;
+  case Term::c:
+    for (std::size_t i = 0; i < n; ++i)
+      g[i] += b * v[i], gv[i] += b;
+    return;
+  case Term::k2:
+    for (std::size_t i = 0; i < n; ++i)
+      g[i] += b * y[i] * y[i], gy[i] += 2.0 * b * y[i];
+    return;
+  case Term::k3:
+    for (std::size_t i = 0; i < n; ++i)
+      g[i] += b * y[i] * y[i] * y[i], gy[i] += 3.0 * b * y[i] * y[i];
+    return;
+  case Term::c2:
+    for (std::size_t i = 0; i < n; ++i)
+      g[i] += b * v[i] * std::abs(v[i]), gv[i] += 2.0 * b * std::abs(v[i]);
+    return;
+  case Term::c3:
+    for (std::size_t i = 0; i < n; ++i)
+      g[i] += b * v[i] * v[i] * v[i], gv[i] += 3.0 * b * v[i] * v[i];
+    return;
+  case Term::fc:
+    for (std::size_t i = 0; i < n; ++i)
+      g[i] += b * (v[i] > 0.0 ? 1.0 : v[i] < 0.0 ? -1.0 : 0.0);
+    return;
+  }
+  throw std::invalid_argument("add_samples: unknown term");
+}
+
 } // namespace jointid::joints

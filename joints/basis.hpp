@@ -68,5 +68,10 @@ double basis_dydot(Term term, double y, double ydot);
 inline bool is_dry_friction(Term term) {
   return term_info(term).set_valued;
 }
+/// Adds b g(y_n, ẏ_n), b ∂g/∂y and b ∂g/∂ẏ to g[n], gy[n], gv[n] at every sample n: the values
+/// of basis(), basis_dy() and basis_dydot() without a call per sample (the harmonic balance
+/// evaluates its joints at all time samples of a period at once). All spans have one length.
+void add_samples(Term term, double b, std::span<const double> y, std::span<const double> ydot,
+                 std::span<double> g, std::span<double> gy, std::span<double> gv);
 
 } // namespace jointid::joints

@@ -79,6 +79,31 @@ TEST(Basis, DerivativesMatchCentralDifferences) {
   EXPECT_EQ(basis_dydot(Term::fc, 0.1, 0.0), 0.0);
 }
 
+TEST(Basis, SamplesAddTheTableValuesAndDerivativesTimesTheCoefficient) {
+  // add_samples() is the vectorised form of basis(), basis_dy() and basis_dydot(): on every pair
+  // of the samples (ẏ = 0 included, where friction and ẏ|ẏ| are special) it must add exactly
+  // b times their values to what the arrays held.
+  std::vector<double> y, v;
+  for (double a : samples)
+    for (double b : samples)
+      y.push_back(a), v.push_back(b);
+  y.push_back(0.5), v.push_back(0.0);
+  const std::size_t n = y.size();
+  for (Term t : all_terms) {
+    const double b = -2.75;
+    std::vector<double> g(n, 1.0), gy(n, 2.0), gv(n, 3.0);
+    add_samples(t, b, y, v, g, gy, gv);
+    for (std::size_t i = 0; i < n; ++i) {
+      EXPECT_DOUBLE_EQ(g[i], 1.0 + b * basis(t, y[i], v[i])) << term_name(t) << " " << i;
+      EXPECT_DOUBLE_EQ(gy[i], 2.0 + b * basis_dy(t, y[i], v[i])) << term_name(t) << " " << i;
+      EXPECT_DOUBLE_EQ(gv[i], 3.0 + b * basis_dydot(t, y[i], v[i])) << term_name(t) << " " << i;
+    }
+  }
+  std::vector<double> g(2), gy(2), gv(3);
+  EXPECT_THROW(add_samples(Term::k, 1.0, std::vector<double>(2), std::vector<double>(2), g, gy, gv),
+               std::invalid_argument);
+}
+
 TEST(Basis, NamesEffectsAndUnitsFollowTheMethodTable) {
   // Name, key words of the effect column, and the unit of b such that b·g is a force (N): g
   // has the units of y^p ẏ^q.
