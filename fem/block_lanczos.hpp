@@ -14,6 +14,8 @@
 /// keeps memory fixed (n × (cap + b) doubles), needs no shifted QR steps on a block
 /// tridiagonal matrix, and its basis stays orthonormal by construction (every new block is
 /// orthogonalised twice against the whole basis, CGS2 in the M-inner product, BLAS-3).
+/// After convergence the wanted vectors take one more power step, φ ← Op φ / θ, read off the
+/// Krylov relation (no solve): it makes ‖Kφ − λMφ‖ as small as Spectra's.
 ///
 /// A multiple eigenvalue whose multiplicity is at most the block size is found like a simple
 /// one (a random start block has a component in every direction of its eigenspace); a larger
@@ -40,7 +42,8 @@ public:
 struct BlockLanczosOptions {
   int nev = 10;       ///< wanted eigenpairs: the nev largest θ (the lowest λ)
   int block_size = 8; ///< right-hand sides per solve (≥ 1)
-  int max_basis = 0;  ///< basis vectors at most, besides the next block; 0: max(2 nev, nev + 3 b)
+  /// basis vectors at most, besides the next block; 0: max(2 nev + 2 b, nev + 4 b)
+  int max_basis = 0;
   int max_dimension = 0; ///< dimension of the space Op works in (M's rank); 0: rows()
   /// A Ritz pair (θ, y) has converged when ‖Op y − θ y‖_M ≤ tolerance · max(ε^⅔, θ) (Spectra's
   /// test). With λ = σ + 1/θ that is ‖(K − σM)⁻¹(K y − λ M y)‖_M ≤ tolerance for θ ≥ ε^⅔: the
@@ -48,7 +51,8 @@ struct BlockLanczosOptions {
   double tolerance = 1e-10;
   int max_restarts = 1000; ///< restarts (basis rebuilds) before giving up
   /// M singular (massless DOFs): M's null space is invisible to the M-inner product, so start
-  /// from Op applied to a random block and purify the eigenvectors (φ ← Op φ / θ) at the end.
+  /// from Op applied to a random block and purify the eigenvectors (φ ← Op φ / θ) at the end,
+  /// a solve each. (Without it that step is taken from the Krylov relation, without a solve.)
   bool purify = false;
   std::uint64_t seed = 20261201; ///< of the random start block
 };

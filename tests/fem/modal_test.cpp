@@ -150,7 +150,8 @@ TEST(Modal, SparseEngineEqualsDenseEngine) {
   EXPECT_GE(st.factor.factor_nonzeros, s.dofs.num_equations()); // at least the diagonal
   EXPECT_NE(st.factor.ordering.find("on groups"), std::string::npos) << st.factor.ordering;
   // Block Lanczos (the default): 20 equations, 6 modes, so blocks of 7 (the block is cut to
-  // (20 − 6)/2 for so small a space) and the whole space in 3 solves, exact.
+  // (20 − 6)/2 for so small a space) and the whole space in 3 solves (7, 7, and 6 columns
+  // that remain), exact.
   EXPECT_EQ(st.method, "block Lanczos");
   EXPECT_EQ(st.block_size, 7);
   EXPECT_EQ(st.ncv, 20);
@@ -480,6 +481,7 @@ TEST(Modal, BlockLanczosFindsEveryCopyOfTheDoubleModesOfASymmetricLattice) {
     EXPECT_LE((KPhi - (s.M * m.phi) * lambda.asDiagonal()).norm(), 1e-8 * KPhi.norm());
     ASSERT_TRUE(m.sparse.has_value());
     EXPECT_EQ(m.sparse->block_size, block);
+    // Blocks of `block` columns (no direction lost on the way).
     EXPECT_EQ(m.sparse->right_hand_sides, static_cast<long long>(block) * m.sparse->solves);
   }
 }
