@@ -1,6 +1,7 @@
 #include "fem/block_lanczos.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <cblas.h>
 
 #include <algorithm>
 #include <cmath>
@@ -65,6 +66,37 @@ MatrixXd svqb(const ShiftInvertPencil& P, MatrixXd& Z, MatrixXd& MZ, double floo
   return R;
 }
 
+// The products with the basis, n × m by m × b for n up to 10⁶, are the largest dense work
+// outside the solves: they go to the system BLAS (the one CHOLMOD uses; OpenBLAS here, on
+// every core with the machine's kernels), where Eigen's own product would use one core.
+
+// C = V(:, 0:m)ᵀ Z.
+MatrixXd basis_transpose_times(const MatrixXd& V, Index m, const MatrixXd& Z) {
+  MatrixXd C(m, Z.cols());
+  if (m == 0 || Z.cols() == 0) return C.setZero();
+  cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, static_cast<int>(m),
+              static_cast<int>(Z.cols()), static_cast<int>(V.rows()), 1.0, V.data(),
+              static_cast<int>(V.rows()), Z.data(), static_cast<int>(Z.rows()), 0.0, C.data(),
+              static_cast<int>(m));
+  return C;
+}
+
+// Z ← Z + alpha V(:, 0:m) C.
+void add_basis_times(MatrixXd& Z, double alpha, const MatrixXd& V, Index m, const MatrixXd& C) {
+  if (m == 0 || Z.cols() == 0) return;
+  cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, static_cast<int>(Z.rows()),
+              static_cast<int>(Z.cols()), static_cast<int>(m), alpha, V.data(),
+              static_cast<int>(V.rows()), C.data(), static_cast<int>(C.rows()), 1.0, Z.data(),
+              static_cast<int>(Z.rows()));
+}
+
+// V(:, 0:m) S for an m × k matrix S.
+MatrixXd basis_times(const MatrixXd& V, Index m, const MatrixXd& S) {
+  MatrixXd Y = MatrixXd::Zero(V.rows(), S.cols());
+  add_basis_times(Y, 1.0, V, m, S);
+  return Y;
+}
+
 // Makes Z M-orthonormal and M-orthogonal to the first m columns of V: two passes of block
 // classical Gram–Schmidt, then SVQB, repeated while the result is not orthogonal to V to
 // rounding (a block that nearly lies in span(V) loses digits in the first round). Directions
@@ -77,19 +109,28 @@ Projection orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m
   P.mass(Z, MZ);
   const double scale = std::sqrt(std::max(0.0, Z.cwiseProduct(MZ).colwise().sum().maxCoeff()));
   const double floor = relative_floor * scale;
+  // Whether the second pass still removed much (more than half of a column's M-norm², by
+  // Pythagoras): only then can the result be off orthogonal by more than rounding ("twice is
+  // enough", Kahan–Parlett) and is checked.
+  bool check = false;
   if (m > 0) {
     for (int pass = 0; pass < 2; ++pass) {
       if (pass > 0) P.mass(Z, MZ);
-      const MatrixXd c = V.leftCols(m).transpose() * MZ;
-      Z.noalias() -= V.leftCols(m) * c;
+      const MatrixXd c = basis_transpose_times(V, m, MZ);
+      if (pass > 0) {
+        const Eigen::RowVectorXd before = Z.cwiseProduct(MZ).colwise().sum();
+        const Eigen::RowVectorXd removed = c.colwise().squaredNorm();
+        check = (removed.array() > 0.5 * before.array()).any();
+      }
+      add_basis_times(Z, -1.0, V, m, c);
       p.C += c;
     }
   }
   p.R = svqb(P, Z, MZ, floor);
-  for (int round = 0; round < 2 && m > 0 && Z.cols() > 0; ++round) {
-    const MatrixXd e = V.leftCols(m).transpose() * MZ; // cosines: Z and V are M-orthonormal
+  for (int round = 0; round < 2 && check && Z.cols() > 0; ++round) {
+    const MatrixXd e = basis_transpose_times(V, m, MZ); // cosines: Z, V are M-orthonormal
     if (e.cwiseAbs().maxCoeff() <= 8.0 * eps * std::sqrt(static_cast<double>(m))) break;
-    Z.noalias() -= V.leftCols(m) * e; // Z_in = V (C + e R) + Z' R
+    add_basis_times(Z, -1.0, V, m, e); // Z_in = V (C + e R) + Z' R
     p.C += e * p.R;
     p.R = svqb(P, Z, MZ, 0.0) * p.R;
   }
@@ -100,11 +141,14 @@ Projection orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m
 // no second n × k matrix is needed.
 void multiply_in_place(MatrixXd& V, Index m, const MatrixXd& S) {
   const Index n = V.rows(), k = S.cols();
-  constexpr Index slab = 2048;
+  constexpr Index slab = 16384;
   MatrixXd rows(std::min(slab, n), k);
   for (Index r = 0; r < n; r += slab) {
     const Index h = std::min(slab, n - r);
-    rows.topRows(h).noalias() = V.block(r, 0, h, m) * S;
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, static_cast<int>(h),
+                static_cast<int>(k), static_cast<int>(m), 1.0, V.data() + r,
+                static_cast<int>(n), S.data(), static_cast<int>(S.rows()), 0.0, rows.data(),
+                static_cast<int>(rows.rows()));
     V.block(r, 0, h, k) = rows.topRows(h);
   }
 }
@@ -288,14 +332,14 @@ private:
   void refine(BlockLanczosResult& out) {
     const VectorXd inverse = out.theta.cwiseInverse();
     if (o_.purify) {
-      MatrixXd phi = V_.leftCols(m_) * S_.leftCols(nev_), MPhi;
+      MatrixXd phi = basis_times(V_, m_, S_.leftCols(nev_)), MPhi;
       V_.resize(0, 0); // the basis is no longer needed: free it before the solve
       P_.mass(phi, MPhi);
       out.vectors.resize(n_, nev_);
       solve(MPhi, out.vectors);
       out.vectors = (out.vectors * inverse.asDiagonal()).eval();
     } else {
-      out.vectors = V_.leftCols(m_) * S_.leftCols(nev_);
+      out.vectors = basis_times(V_, m_, S_.leftCols(nev_));
       if (q_ > 0)
         out.vectors.noalias() +=
             V_.middleCols(m_, q_) * (R_ * S_.block(c0_, 0, m_ - c0_, nev_) * inverse.asDiagonal());

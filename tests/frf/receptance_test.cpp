@@ -246,8 +246,8 @@ TEST(Receptance, ModesThatDidNotConvergeAreRefused) {
     FAIL() << "modes that did not converge accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(
-        std::string(e.what()).rfind("modal synthesis: the modal analysis failed (shift-invert "
-                                    "Lanczos (Spectra) did not converge to 10 modes in 1 "
+        std::string(e.what()).rfind("modal synthesis: the modal analysis failed (block "
+                                    "shift-invert Lanczos did not converge to 10 modes in 1 "
                                     "restarts",
                                     0),
         0u)
