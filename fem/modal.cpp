@@ -182,26 +182,38 @@ public:
   BlockPencil(const ShiftInvert& op, const SparseMatrix& M) : op_(op), M_(M) {}
   Eigen::Index rows() const override { return M_.rows(); }
   void solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override { op_.solve_block(B, X); }
-  // Y = M X, the columns shared among the cores for a large model (Eigen's sparse product
-  // runs on one and reads M once per column): three of these per block, against one solve.
+  // Y = M X, reading M once for the whole block (Eigen's product reads it once per column) and
+  // rows shared among the cores: M is symmetric, so row i of M X is column i of M times X,
+  // gathered from rows of X held row-major. Three of these per block, against one solve.
   void mass(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const override {
-    Y.resize(X.rows(), X.cols());
-    const auto threads = static_cast<Eigen::Index>(std::max(1u, std::thread::hardware_concurrency()));
-    const Eigen::Index parts = M_.rows() < 20000 ? 1 : std::min(threads, X.cols());
-    if (parts <= 1) {
+    const Eigen::Index n = M_.rows(), b = X.cols();
+    if (n < 1000 || b < 2 || !M_.isCompressed()) {
       Y.noalias() = M_ * X;
       return;
     }
-    auto columns = [&](Eigen::Index part) {
-      const Eigen::Index first = X.cols() * part / parts, last = X.cols() * (part + 1) / parts;
-      Y.middleCols(first, last - first).noalias() = M_ * X.middleCols(first, last - first);
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    const RowMajor Xr = X;
+    RowMajor Yr(n, b);
+    const auto* outer = M_.outerIndexPtr();
+    const auto* inner = M_.innerIndexPtr();
+    const double* value = M_.valuePtr();
+    auto rows = [&](Eigen::Index first, Eigen::Index last) {
+      for (Eigen::Index i = first; i < last; ++i) {
+        auto y = Yr.row(i);
+        y.setZero();
+        for (auto k = outer[i]; k < outer[i + 1]; ++k)
+          y.noalias() += value[k] * Xr.row(inner[k]);
+      }
     };
+    const auto threads =
+        static_cast<Eigen::Index>(std::max(1u, std::thread::hardware_concurrency()));
     std::vector<std::thread> pool;
-    for (Eigen::Index part = 1; part < parts; ++part)
-      pool.emplace_back(columns, part);
-    columns(0);
+    for (Eigen::Index t = 1; t < threads; ++t)
+      pool.emplace_back(rows, n * t / threads, n * (t + 1) / threads);
+    rows(0, n / threads);
     for (auto& t : pool)
       t.join();
+    Y = Yr;
   }
 
 private:
