@@ -145,10 +145,9 @@ void multiply_in_place(MatrixXd& V, Index m, const MatrixXd& S) {
   MatrixXd rows(std::min(slab, n), k);
   for (Index r = 0; r < n; r += slab) {
     const Index h = std::min(slab, n - r);
-    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, static_cast<int>(h),
-                static_cast<int>(k), static_cast<int>(m), 1.0, V.data() + r,
-                static_cast<int>(n), S.data(), static_cast<int>(S.rows()), 0.0, rows.data(),
-                static_cast<int>(rows.rows()));
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, static_cast<int>(h), static_cast<int>(k),
+                static_cast<int>(m), 1.0, V.data() + r, static_cast<int>(n), S.data(),
+                static_cast<int>(S.rows()), 0.0, rows.data(), static_cast<int>(rows.rows()));
     V.block(r, 0, h, k) = rows.topRows(h);
   }
 }
