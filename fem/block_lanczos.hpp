@@ -4,9 +4,13 @@
 /// product, so its Krylov basis is kept M-orthonormal and its projection is symmetric.
 ///
 /// Why blocks: on a large model every application of Op is a solve with the factor of K − σM,
-/// and that solve is bound by the memory bandwidth of reading the factor (20 GiB at 10⁶ DOFs);
-/// CHOLMOD solves b right-hand sides in one pass over the factor for little more than the time
-/// of one, so a block of b columns per pass cuts the passes the iteration needs.
+/// and a single-vector solve is bound by the memory bandwidth of reading the factor (20 GiB at
+/// 10⁶ DOFs, 1.2 s a pass). CHOLMOD solves b right-hand sides in one pass over the factor, with
+/// BLAS-3 instead of BLAS-2, so the iteration needs 3× fewer passes (8 columns: 21–22 instead
+/// of Spectra's 64–75 on the 10⁴ and 10⁵ lattices). What a pass of b columns costs depends on
+/// how fast the BLAS-3 kernels are: on the 10⁵ lattice 8 columns cost 2.2–4.3× one
+/// (docs/benchmarks.md); it can come near 1× only where the pass stays bandwidth-bound (a
+/// factor far larger than the caches and kernels that keep up; not measured here).
 ///
 /// Why thick restart (Wu & Simon's, the symmetric form of Stewart's Krylov–Schur): when the
 /// basis reaches its cap the iteration keeps the wanted Ritz vectors and the residual block
@@ -15,7 +19,8 @@
 /// tridiagonal matrix, and its basis stays orthonormal by construction (every new block is
 /// orthogonalised twice against the whole basis, CGS2 in the M-inner product, BLAS-3).
 /// After convergence the wanted vectors take one more power step, φ ← Op φ / θ, read off the
-/// Krylov relation (no solve): it makes ‖Kφ − λMφ‖ as small as Spectra's.
+/// Krylov relation (no solve): it brings ‖KΦ − MΦΛ‖/‖KΦ‖ from ~1e-8 to ~1e-11 on the 10⁴
+/// lattice (Spectra's: 1e-9 … 1e-12).
 ///
 /// A multiple eigenvalue whose multiplicity is at most the block size is found like a simple
 /// one (a random start block has a component in every direction of its eigenspace); a larger
