@@ -6,11 +6,17 @@
 //   bench_modal_scale SIZE [--export DIR] [--engine sparse|dense] [--modes N]
 //                          [--ordering default|amd|metis|nesdis]
 //                          [--tolerance T] [--analyze-only] [--shift-hz F]
+//                          [--method block|spectra] [--block-size B] [--basis N]
+//                          [--solve-widths B1,B2,...]
 //
 // SIZE is 1e4, 1e5, 1e6 or NXxNYxNZ (grid nodes per axis). Both engines are the library's
 // fem::modal_analysis; the sparse engine's stages (ordering, factorisation, Lanczos) are timed
-// by the library and printed under "sparse". `--analyze-only` stops after the symbolic
-// analysis of K − σM and prints the predicted factor (size, flops, ordering).
+// by the library and printed under "sparse". `--method` picks the sparse engine's iteration
+// (block Lanczos, the default, or Spectra's), `--block-size` and `--basis` its block and
+// basis cap. `--analyze-only` stops after the symbolic analysis of K − σM and prints the
+// predicted factor (size, flops, ordering). `--solve-widths` factorises K − σM (ordering on
+// the nodes, as the engine does) and times block solves of each width instead of the modes
+// (best of 3 per width), to see what a pass over the factor costs per right-hand side.
 #include "bench/lattice.hpp"
 #include "bench/matrix_market.hpp"
 #include "fem/assembly.hpp"
@@ -21,6 +27,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -30,6 +37,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 using namespace jointid;
 using json = nlohmann::json;
@@ -86,6 +94,10 @@ struct Options {
   double shift_hz = 1.0; // the library's default
   bool analyze_only = false;
   bool node_ordering = false;
+  std::string method = "block";
+  int block_size = 8; // the library's default
+  int basis = 0;      // automatic
+  std::vector<int> solve_widths;
 };
 
 [[noreturn]] void usage_error(const std::string& why) {
@@ -93,7 +105,8 @@ struct Options {
       why + "\nusage: bench_modal_scale SIZE [--export DIR] [--engine sparse|dense] "
             "[--modes N] [--ordering default|amd|metis|nesdis] "
             "[--tolerance T] [--analyze-only] "
-            "[--shift-hz F]   (SIZE: 1e4, 1e5, 1e6 or "
+            "[--shift-hz F] [--method block|spectra] [--block-size B] [--basis N] "
+            "[--solve-widths B1,B2,...]   (SIZE: 1e4, 1e5, 1e6 or "
             "NXxNYxNZ)");
 }
 
@@ -132,7 +145,18 @@ Options parse(int argc, char** argv) {
       o.node_ordering = true;
     else if (a == "--shift-hz")
       o.shift_hz = std::stod(value());
-    else if (!a.empty() && a[0] == '-')
+    else if (a == "--method")
+      o.method = value();
+    else if (a == "--block-size")
+      o.block_size = std::stoi(value());
+    else if (a == "--basis")
+      o.basis = std::stoi(value());
+    else if (a == "--solve-widths") {
+      std::istringstream list(value());
+      std::string item;
+      while (std::getline(list, item, ','))
+        o.solve_widths.push_back(std::stoi(item));
+    } else if (!a.empty() && a[0] == '-')
       usage_error("unknown option " + a);
     else if (!have_size) {
       o.size = a;
@@ -152,6 +176,10 @@ Options parse(int argc, char** argv) {
   if (o.engine != "sparse" && o.engine != "dense")
     usage_error("--engine must be sparse or dense, not " + o.engine);
   ordering(o.ordering); // checks the name
+  if (o.method != "block" && o.method != "spectra")
+    usage_error("--method must be block or spectra, not " + o.method);
+  for (int b : o.solve_widths)
+    if (b < 1) usage_error("--solve-widths: every width must be >= 1");
   return o;
 }
 
@@ -229,8 +257,39 @@ int run(const Options& o) {
     std::cout << r.dump() << std::endl;
     return 0;
   }
+  if (!o.solve_widths.empty()) {
+    // The factor the engine would use, then block solves of each width on random blocks.
+    fem::CholeskyOptions co;
+    co.ordering = ordering(o.ordering);
+    fem::SparseCholesky llt(co);
+    const fem::SparseMatrix A = K - sigma * M;
+    r["analysis"] = analysis_json(llt.analyze(A, system.dofs.equation_nodes()));
+    auto stage = std::chrono::steady_clock::now();
+    llt.factorize(A);
+    r["factorize_s"] = seconds_since(stage);
+    json widths = json::array();
+    for (int b : o.solve_widths) {
+      const Eigen::MatrixXd B = Eigen::MatrixXd::Random(K.rows(), b);
+      Eigen::MatrixXd X(K.rows(), b);
+      double best = 1e300;
+      for (int rep = 0; rep < 3; ++rep) {
+        stage = std::chrono::steady_clock::now();
+        llt.solve(B.data(), X.data(), b);
+        best = std::min(best, seconds_since(stage));
+      }
+      widths.push_back({{"width", b}, {"solve_s", best}, {"per_column_s", best / b}});
+    }
+    r["block_solves"] = widths;
+    r["peak_rss_modal_mib"] = proc_status_mib("VmHWM");
+    std::cout << r.dump() << std::endl;
+    return 0;
+  }
   fem::ModalOptions mo;
   mo.num_modes = o.modes;
+  mo.sparse_method =
+      o.method == "spectra" ? fem::SparseMethod::spectra : fem::SparseMethod::block_lanczos;
+  mo.block_size = o.block_size;
+  mo.basis_vectors = o.basis;
   mo.engine = o.engine == "dense" ? fem::ModalEngine::dense : fem::ModalEngine::sparse;
   mo.tolerance = o.tolerance;
   mo.shift_hz = o.shift_hz;
@@ -246,9 +305,12 @@ int run(const Options& o) {
     j["analyze_s"] = st.analyze_s;
     j["factorize_s"] = st.factorize_s;
     j["cholmod_peak_mib"] = st.cholesky_peak_bytes / (1024.0 * 1024.0);
+    j["method"] = st.method;
+    j["block_size"] = st.block_size;
     j["ncv"] = st.ncv;
     j["restarts"] = st.restarts;
     j["solves"] = st.solves;
+    j["right_hand_sides"] = st.right_hand_sides;
     j["solve_s"] = st.solve_s;
     j["lanczos_s"] = st.lanczos_s;
     r["sparse"] = j;

@@ -1,5 +1,7 @@
 #include "fem/modal.hpp"
 
+#include "fem/block_lanczos.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Spectra/MatOp/SparseSymMatProd.h>
@@ -12,6 +14,7 @@
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -151,6 +154,16 @@ public:
     const auto start = std::chrono::steady_clock::now();
     llt_.solve(x_in, y_out);
     ++stats_.solves;
+    ++stats_.right_hand_sides;
+    stats_.solve_s += seconds_since(start);
+  }
+  /// X = (K − σM)⁻¹ B for a block: one pass over the factor.
+  void solve_block(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) const {
+    const auto start = std::chrono::steady_clock::now();
+    X.resize(B.rows(), B.cols());
+    llt_.solve(B.data(), X.data(), B.cols());
+    ++stats_.solves;
+    stats_.right_hand_sides += B.cols();
     stats_.solve_s += seconds_since(start);
   }
 
@@ -163,23 +176,122 @@ private:
   bool factorized_ = false;
 };
 
-// The nev lowest modes with the factorisation held by `op`.
-Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
-                         SparseModalStats& stats, int nev) {
-  const int n = s.dofs.num_equations();
-  const double sigma = -std::pow(two_pi * o.shift_hz, 2);
-  Spectra::SparseSymMatProd<double> bop(s.M);
-  // With massless DOFs the Krylov space of (K − σM)⁻¹M has at most as many dimensions as M
-  // has massive DOFs (its rank); a larger basis breaks down into M's null space.
+// The factor of K − σM and M, as the block Lanczos iteration sees them.
+class BlockPencil final : public ShiftInvertPencil {
+public:
+  BlockPencil(const ShiftInvert& op, const SparseMatrix& M) : op_(op), M_(M) {}
+  Eigen::Index rows() const override { return M_.rows(); }
+  void solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override { op_.solve_block(B, X); }
+  // Y = M X, reading M once for the whole block (Eigen's product reads it once per column) and
+  // rows shared among the cores: M is symmetric, so row i of M X is column i of M times X,
+  // gathered from rows of X held row-major. Three of these per block, against one solve.
+  void mass(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const override {
+    const Eigen::Index n = M_.rows(), b = X.cols();
+    if (n < 1000 || b < 2 || !M_.isCompressed()) {
+      Y.noalias() = M_ * X;
+      return;
+    }
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    const RowMajor Xr = X;
+    RowMajor Yr(n, b);
+    const auto* outer = M_.outerIndexPtr();
+    const auto* inner = M_.innerIndexPtr();
+    const double* value = M_.valuePtr();
+    auto rows = [&](Eigen::Index first, Eigen::Index last) {
+      for (Eigen::Index i = first; i < last; ++i) {
+        auto y = Yr.row(i);
+        y.setZero();
+        for (auto k = outer[i]; k < outer[i + 1]; ++k)
+          y.noalias() += value[k] * Xr.row(inner[k]);
+      }
+    };
+    const auto threads =
+        static_cast<Eigen::Index>(std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (Eigen::Index t = 1; t < threads; ++t)
+      pool.emplace_back(rows, n * t / threads, n * (t + 1) / threads);
+    rows(0, n / threads);
+    for (auto& t : pool)
+      t.join();
+    Y = Yr;
+  }
+
+private:
+  const ShiftInvert& op_;
+  const SparseMatrix& M_;
+};
+
+// With massless DOFs the Krylov space of (K − σM)⁻¹M has at most as many dimensions as M
+// has massive DOFs (its rank); a larger basis breaks down into M's null space.
+int checked_massive_dofs(const Assembled& s, int nev) {
   const int massive = massive_dofs(s);
   if (nev >= massive)
     throw std::invalid_argument("the sparse engine finds fewer modes than DOFs with mass (" +
                                 std::to_string(massive) +
                                 "); ask for fewer modes or use the dense engine");
-  const int ncv = std::min(massive, std::max(2 * nev + 1, nev + 20));
-  stats.ncv = ncv;
+  return massive;
+}
+
+void reset_iteration_stats(SparseModalStats& stats) {
   stats.solves = 0;
+  stats.right_hand_sides = 0;
   stats.solve_s = 0.0;
+}
+
+// The nev lowest modes by thick-restart block Lanczos on the factorisation held by `op`.
+Modes block_lanczos_modes(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
+                          SparseModalStats& stats, int nev) {
+  const int n = s.dofs.num_equations();
+  const double sigma = -std::pow(two_pi * o.shift_hz, 2);
+  const int massive = checked_massive_dofs(s, nev);
+  reset_iteration_stats(stats);
+  BlockLanczosOptions bo;
+  bo.nev = nev;
+  bo.block_size = o.block_size;
+  bo.max_basis = o.basis_vectors;
+  bo.max_dimension = massive;
+  bo.tolerance = o.tolerance;
+  bo.max_restarts = o.max_iterations;
+  bo.purify = massive < n; // see fem/block_lanczos.hpp
+  op.set_shift(sigma);     // factorises K − σM unless a previous pass did
+  BlockPencil pencil(op, s.M);
+  const auto start = std::chrono::steady_clock::now();
+  BlockLanczosResult r = block_lanczos(pencil, bo);
+  stats.lanczos_s = seconds_since(start);
+  stats.method = "block Lanczos";
+  stats.block_size = r.block_size;
+  stats.ncv = r.max_basis;
+  stats.restarts = r.restarts;
+  Modes out;
+  out.sparse = stats;
+  if (!r.converged) {
+    out.status = ModalStatus::not_converging;
+    std::ostringstream reason;
+    reason << "block shift-invert Lanczos did not converge to " << nev << " modes in "
+           << o.max_iterations << " restarts (tolerance " << o.tolerance << "; "
+           << r.converged_count << " of " << nev << " converged)";
+    out.reason = reason.str();
+    return out;
+  }
+  // θ descending is λ = σ + 1/θ ascending.
+  out.omega = r.theta.unaryExpr([sigma](double theta) { return to_omega(sigma + 1.0 / theta); });
+  out.phi = std::move(r.vectors);
+  return out;
+}
+
+// The nev lowest modes by Spectra's shift-invert Lanczos on the factorisation held by `op`.
+Modes spectra_modes(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
+                    SparseModalStats& stats, int nev) {
+  const int n = s.dofs.num_equations();
+  const double sigma = -std::pow(two_pi * o.shift_hz, 2);
+  Spectra::SparseSymMatProd<double> bop(s.M);
+  const int massive = checked_massive_dofs(s, nev);
+  const int ncv =
+      std::min(massive, o.basis_vectors > 0 ? o.basis_vectors : std::max(2 * nev + 1, nev + 20));
+  stats.method = "Spectra";
+  stats.block_size = 1;
+  stats.ncv = ncv;
+  reset_iteration_stats(stats);
   Spectra::SymGEigsShiftSolver<ShiftInvert, Spectra::SparseSymMatProd<double>,
                                Spectra::GEigsMode::ShiftInvert>
       solver(op, bop, nev, ncv, sigma);
@@ -222,6 +334,13 @@ Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert&
     }
   }
   return out;
+}
+
+// The nev lowest modes with the factorisation held by `op`, by the method asked for.
+Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
+                         SparseModalStats& stats, int nev) {
+  if (o.sparse_method == SparseMethod::spectra) return spectra_modes(s, o, op, stats, nev);
+  return block_lanczos_modes(s, o, op, stats, nev);
 }
 
 Modes sparse_modes(const Assembled& s, const ModalOptions& o) {

@@ -416,23 +416,43 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
 }
 
 void SparseCholesky::solve(const double* b, double* x) const {
+  solve(b, x, 1);
+}
+
+void SparseCholesky::solve(const double* b, double* x, std::int64_t columns) const {
   const Impl& m = *impl_;
   if (!m.factorized) throw std::logic_error("sparse Cholesky: solve before factorize");
+  if (columns < 0)
+    throw std::invalid_argument("sparse Cholesky: solve with " + std::to_string(columns) +
+                                " right-hand sides");
+  if (columns == 0) return;
   const auto n = static_cast<std::size_t>(m.analysis.rows);
+  const auto count = n * static_cast<std::size_t>(columns);
   cholmod_dense rhs{};
   rhs.nrow = n;
-  rhs.ncol = 1;
-  rhs.nzmax = n;
+  rhs.ncol = static_cast<std::size_t>(columns);
+  rhs.nzmax = count;
   rhs.d = n;
   rhs.x = const_cast<double*>(b); // read only
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
+  // The workspace (x, y, e) is kept between calls and resized by CHOLMOD when the number of
+  // columns changes.
   if (!cholmod_l_solve2(CHOLMOD_A, m.factor, &rhs, nullptr, &m.x, nullptr, &m.y, &m.e, &m.common)) {
     m.check("solve");
     throw std::runtime_error("sparse Cholesky solve failed");
   }
   const auto* result = static_cast<const double*>(m.x->x);
-  std::copy(result, result + n, x);
+  std::copy(result, result + count, x);
+}
+
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& B) const {
+  if (B.rows() != rows())
+    throw std::invalid_argument("sparse Cholesky: solve with a " + std::to_string(B.rows()) +
+                                "-row block for a matrix of " + std::to_string(rows()) + " rows");
+  Eigen::MatrixXd X(B.rows(), B.cols());
+  solve(B.data(), X.data(), B.cols());
+  return X;
 }
 
 std::int64_t SparseCholesky::rows() const {

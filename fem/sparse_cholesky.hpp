@@ -8,6 +8,7 @@
 /// and predicts the factor's size; `factorize` refuses, with a clear error, a factor that
 /// would not fit in the memory the machine has available (rather than being killed by the
 /// kernel half-way through), and reports a matrix that is not positive definite.
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 
 #include <cstdint>
@@ -82,6 +83,16 @@ public:
 
   /// x = A⁻¹ b for vectors of length rows(); b and x may not overlap.
   void solve(const double* b, double* x) const;
+
+  /// X = A⁻¹ B for `columns` right-hand sides at once: B and X are column-major
+  /// rows() × columns blocks (leading dimension rows()) that may not overlap. One CHOLMOD
+  /// solve for the whole block, so the factor is read once per block instead of once per
+  /// column: a large factor's solve is bound by memory bandwidth, and several columns cost
+  /// little more than one.
+  void solve(const double* b, double* x, std::int64_t columns) const;
+
+  /// X = A⁻¹ B for an n × k block B (k ≥ 0), by the block solve above.
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& B) const;
 
   std::int64_t rows() const;
   const CholeskyAnalysis& analysis() const;

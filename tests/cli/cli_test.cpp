@@ -520,8 +520,9 @@ TEST_F(CliTest, ModesThatDoNotConvergeSayWhyAndWriteNothing) {
                "1", "--tolerance", "1e-300", "--pictures", "0", "-o", out.string()},
               dir());
   EXPECT_EQ(failed.status, 1) << failed.err;
-  EXPECT_EQ(failed.err, "jointid: modal analysis failed: shift-invert Lanczos (Spectra) "
-                        "did not converge to 6 modes in 1 restarts (tolerance 1e-300)\n");
+  EXPECT_EQ(failed.err, "jointid: modal analysis failed: block shift-invert Lanczos did not "
+                        "converge to 6 modes in 1 restarts (tolerance 1e-300; 0 of 6 "
+                        "converged)\n");
   EXPECT_FALSE(fs::exists(out / "modes.json"));
   const Outcome converged = jointid({"modes", portal.string(), "--engine", "sparse", "--count", "6",
                                      "--pictures", "0", "-o", out.string()},

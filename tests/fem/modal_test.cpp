@@ -2,15 +2,18 @@
 // second engine.
 #include "fem/modal.hpp"
 
+#include "bench/lattice.hpp"
 #include "support/beam_models.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 using namespace jointid;
 using fem::ModalEngine;
@@ -146,8 +149,25 @@ TEST(Modal, SparseEngineEqualsDenseEngine) {
   EXPECT_EQ(st.factor.rows, s.dofs.num_equations());
   EXPECT_GE(st.factor.factor_nonzeros, s.dofs.num_equations()); // at least the diagonal
   EXPECT_NE(st.factor.ordering.find("on groups"), std::string::npos) << st.factor.ordering;
-  EXPECT_GE(st.solves, 6);
-  EXPECT_GE(st.ncv, 13);
+  // Block Lanczos (the default): 20 equations, 6 modes, so blocks of 7 (the block is cut to
+  // (20 − 6)/2 for so small a space) and the whole space in 3 solves (7, 7, and 6 columns
+  // that remain), exact.
+  EXPECT_EQ(st.method, "block Lanczos");
+  EXPECT_EQ(st.block_size, 7);
+  EXPECT_EQ(st.ncv, 20);
+  EXPECT_EQ(st.solves, 3);
+  EXPECT_EQ(st.right_hand_sides, 20);
+  // Spectra, one right-hand side per solve, still reachable and the same modes.
+  o.sparse_method = fem::SparseMethod::spectra;
+  const fem::Modes spectra = fem::modal_analysis(s, o);
+  ASSERT_EQ(spectra.status, fem::ModalStatus::success);
+  for (int r = 0; r < 6; ++r)
+    EXPECT_NEAR(spectra.omega(r), dense.omega(r), 1e-9 * dense.omega(r)) << "mode " << r;
+  ASSERT_TRUE(spectra.sparse.has_value());
+  EXPECT_EQ(spectra.sparse->method, "Spectra");
+  EXPECT_GE(spectra.sparse->solves, 6);
+  EXPECT_EQ(spectra.sparse->right_hand_sides, spectra.sparse->solves);
+  EXPECT_GE(spectra.sparse->ncv, 13);
 }
 
 TEST(Modal, SimplySupportedBeamFrequencies) {
@@ -400,4 +420,151 @@ TEST(Modal, OscillatorFrequency) {
   const fem::Modes m = modes_of(test::oscillator(2.5, 1000.0), 1);
   EXPECT_NEAR(m.omega(0), 20.0, 1e-13 * 20.0);
   EXPECT_NEAR(std::abs(m.phi(0, 0)), 1.0 / std::sqrt(2.5), 1e-14);
+}
+
+namespace {
+
+// Modes of `s` by the sparse engine with the given iteration and block size.
+fem::Modes sparse_modes(const fem::Assembled& s, int count, fem::SparseMethod method,
+                        int block_size = 8) {
+  fem::ModalOptions o;
+  o.num_modes = count;
+  o.engine = ModalEngine::sparse;
+  o.sparse_method = method;
+  o.block_size = block_size;
+  return fem::modal_analysis(s, o);
+}
+
+// Indices r with ω_r² and ω_{r+1}² equal to `relative` (a multiple eigenvalue).
+std::vector<int> multiple_pairs(const fem::Modes& m, double relative) {
+  std::vector<int> pairs;
+  for (int r = 0; r + 1 < m.num_modes(); ++r)
+    if (std::abs(std::pow(m.omega(r + 1), 2) / std::pow(m.omega(r), 2) - 1.0) < relative)
+      pairs.push_back(r);
+  return pairs;
+}
+
+} // namespace
+
+TEST(Modal, BlockLanczosFindsEveryCopyOfTheDoubleModesOfASymmetricLattice) {
+  // The 7 × 7 × 5 frame lattice of the benchmarks (1176 equations, base fixed) is symmetric
+  // under x ↔ y, so many of its modes are double (the two sways, ...). Reference: the dense
+  // engine, whose eigenvalues err by ~eps·λ_max absolutely (λ_max/λ_1 ≈ 10⁸ here; measured
+  // 4e-12 relative at worst); the shift-invert ones relatively, to the convergence test.
+  // A copy missed shifts the rest of the list by one mode, an error of several % — as
+  // Spectra's single-vector Lanczos does here: it returns one copy of the double mode 16–17,
+  // so its modes 17–20 are 1.5–4 % off in frequency.
+  const fem::Assembled s = fem::assemble(bench::frame_lattice(7, 7, 5, 1.0));
+  ASSERT_EQ(s.dofs.num_equations(), 1176);
+  fem::ModalOptions o;
+  o.num_modes = 0;
+  o.engine = ModalEngine::dense;
+  const fem::Modes dense = fem::modal_analysis(s, o);
+  const double lambda_max = std::pow(dense.omega(dense.num_modes() - 1), 2);
+  const std::vector<int> doubles = multiple_pairs(dense, 1e-8);
+  ASSERT_GE(std::count_if(doubles.begin(), doubles.end(), [](int r) { return r < 19; }), 5);
+  for (int block : {2, 3, 8}) {
+    const fem::Modes m = sparse_modes(s, 20, fem::SparseMethod::block_lanczos, block);
+    ASSERT_EQ(m.status, fem::ModalStatus::success) << m.reason;
+    ASSERT_EQ(m.num_modes(), 20);
+    for (int r = 0; r < 20; ++r) {
+      const double lambda = dense.omega(r) * dense.omega(r);
+      EXPECT_NEAR(m.omega(r) * m.omega(r), lambda, 1e-10 * lambda + 100.0 * eps * lambda_max)
+          << "block " << block << ", mode " << r + 1;
+    }
+    // ΦᵀMΦ = I and the eigen-equation, ‖KΦ − MΦΛ‖_F / ‖KΦ‖_F: the convergence test bounds
+    // ‖(K − σM)⁻¹(Kφ − λMφ)‖_M by 1e-10, which leaves ‖Kφ − λMφ‖/‖Kφ‖ at 1e-13 … 1e-9
+    // (measured on such lattices); 1e-8 fails for any wrong pair by orders of magnitude.
+    const Eigen::MatrixXd gram = m.phi.transpose() * (s.M * m.phi);
+    EXPECT_LE((gram - Eigen::MatrixXd::Identity(20, 20)).cwiseAbs().maxCoeff(), 1e-12);
+    const Eigen::MatrixXd KPhi = s.K * m.phi;
+    const Eigen::VectorXd lambda = m.omega.array().square();
+    EXPECT_LE((KPhi - (s.M * m.phi) * lambda.asDiagonal()).norm(), 1e-8 * KPhi.norm());
+    ASSERT_TRUE(m.sparse.has_value());
+    EXPECT_EQ(m.sparse->block_size, block);
+    // Blocks of `block` columns (no direction lost on the way).
+    EXPECT_EQ(m.sparse->right_hand_sides, static_cast<long long>(block) * m.sparse->solves);
+  }
+}
+
+TEST(Modal, BlockLanczosEqualsSpectraToRoundingWithFewerSolves) {
+  // 8 × 8 × 6 lattice (1920 equations), 20 modes: both iterations are shift-invert on the
+  // same factor with the same convergence test (1e-10), so their eigenvalues agree far below
+  // it (θ errs by about the residual squared). Compared: the 16 lowest (Spectra returns one
+  // copy of the double mode 16–17, as in the test above, and differs from mode 17 on).
+  const fem::Assembled s = fem::assemble(bench::frame_lattice(8, 8, 6, 1.0));
+  ASSERT_EQ(s.dofs.num_equations(), 1920);
+  const fem::Modes spectra = sparse_modes(s, 20, fem::SparseMethod::spectra);
+  const fem::Modes block = sparse_modes(s, 20, fem::SparseMethod::block_lanczos);
+  ASSERT_EQ(spectra.status, fem::ModalStatus::success) << spectra.reason;
+  ASSERT_EQ(block.status, fem::ModalStatus::success) << block.reason;
+  for (int r = 0; r < 16; ++r)
+    EXPECT_NEAR(block.omega(r) * block.omega(r), spectra.omega(r) * spectra.omega(r),
+                1e-10 * spectra.omega(r) * spectra.omega(r))
+        << "mode " << r + 1;
+  ASSERT_TRUE(block.sparse.has_value() && spectra.sparse.has_value());
+  EXPECT_LT(block.sparse->solves, spectra.sparse->solves);
+}
+
+TEST(Modal, FreeSpaceFrameHasSixRigidModesWithTheBlockEngine) {
+  // A 4 × 4 × 3 lattice with no support: 6 rigid-body modes (3 translations, 3 rotations),
+  // numerically ω² at rounding level, a sextuple eigenvalue that a block of 8 spans from the
+  // start (σ < 0 keeps K − σM positive definite). Mode 7 on is elastic, as the dense engine.
+  fem::Model model = bench::frame_lattice(4, 4, 3, 1.0);
+  model.supports.clear();
+  const fem::Assembled s = fem::assemble(model);
+  ASSERT_EQ(s.dofs.num_equations(), 288);
+  fem::ModalOptions o;
+  o.num_modes = 0;
+  o.engine = ModalEngine::dense;
+  const fem::Modes all = fem::modal_analysis(s, o);
+  const double lambda_max = std::pow(all.omega(all.num_modes() - 1), 2);
+  const double rigid_bound = std::sqrt(100 * eps * lambda_max);
+  ASSERT_GT(all.omega(6), 1e3 * rigid_bound); // the bound separates rigid from elastic
+  const fem::Modes m = sparse_modes(s, 10, fem::SparseMethod::block_lanczos);
+  ASSERT_EQ(m.status, fem::ModalStatus::success) << m.reason;
+  for (int r = 0; r < 6; ++r)
+    EXPECT_LE(m.omega(r), rigid_bound) << "rigid mode " << r + 1;
+  for (int r = 6; r < 10; ++r)
+    EXPECT_NEAR(m.omega(r), all.omega(r), 1e-8 * all.omega(r)) << "mode " << r + 1;
+  // The rigid shapes: M-orthonormal, no strain energy to rounding, and spanning the 6 rigid
+  // motions (a translation along x is in their span).
+  const Eigen::MatrixXd R = m.phi.leftCols(6);
+  const Eigen::MatrixXd M(s.M);
+  EXPECT_LE((R.transpose() * M * R - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff(), 1e-10);
+  Eigen::VectorXd ux = Eigen::VectorXd::Zero(s.dofs.num_equations());
+  for (int e = 0; e < s.dofs.num_equations(); ++e)
+    if (s.dofs.node_dof(e).dof == fem::Dof::ux) ux(e) = 1.0;
+  const Eigen::VectorXd in_span = R * (R.transpose() * (M * ux));
+  EXPECT_LE((in_span - ux).norm(), 1e-6 * ux.norm());
+}
+
+TEST(Modal, BothSparseIterationsReportNonConvergenceNamingThemselves) {
+  // One restart at tolerance 0 (met only by an exact residual): 10 modes of a 400-equation
+  // cantilever do not converge; the reason names the iteration, the count and the limits.
+  const fem::Assembled s = fem::assemble(test::cantilever(200, {}));
+  fem::ModalOptions o;
+  o.num_modes = 10;
+  o.engine = ModalEngine::sparse;
+  o.max_iterations = 1;
+  o.tolerance = 0.0;
+  const fem::Modes block = fem::modal_analysis(s, o);
+  EXPECT_EQ(block.status, fem::ModalStatus::not_converging);
+  EXPECT_EQ(block.reason.rfind("block shift-invert Lanczos did not converge to 10 modes in 1 "
+                               "restarts (tolerance 0; ",
+                               0),
+            0u)
+      << block.reason;
+  EXPECT_EQ(block.num_modes(), 0);
+  ASSERT_TRUE(block.sparse.has_value());
+  EXPECT_EQ(block.sparse->restarts, 1);
+  o.sparse_method = fem::SparseMethod::spectra;
+  const fem::Modes spectra = fem::modal_analysis(s, o);
+  EXPECT_EQ(spectra.status, fem::ModalStatus::not_converging);
+  EXPECT_NE(spectra.reason.find("(Spectra)"), std::string::npos) << spectra.reason;
+  // The defaults converge: the failure is the limits'.
+  o.max_iterations = fem::ModalOptions{}.max_iterations;
+  o.tolerance = fem::ModalOptions{}.tolerance;
+  o.sparse_method = fem::SparseMethod::block_lanczos;
+  EXPECT_EQ(fem::modal_analysis(s, o).status, fem::ModalStatus::success);
 }

@@ -99,6 +99,44 @@ TEST(SparseCholesky, SolvesLikeEigensLdltForEveryOrderingWithAndWithoutGroups) {
     }
 }
 
+TEST(SparseCholesky, ABlockSolveEqualsColumnByColumnSolves) {
+  // Seven right-hand sides in one CHOLMOD call (the supernodal solve then works on the block
+  // with BLAS-3) against seven single solves: the same solutions to rounding, each with its
+  // own residual; then widths 1 and 7 again, in either order, on the workspace kept between
+  // calls. A block solve that mixed up columns, solved only the first or read the leading
+  // dimension wrongly fails by O(1).
+  const GridMatrix g = grid_matrix(6, 5, 5, 6, 4);
+  const Eigen::Index n = g.A.rows();
+  std::mt19937 rng(9);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd B(n, 7);
+  for (Eigen::Index j = 0; j < B.cols(); ++j)
+    for (Eigen::Index i = 0; i < n; ++i)
+      B(i, j) = normal(rng);
+  SparseCholesky llt;
+  llt.analyze(g.A, g.groups);
+  llt.factorize(g.A);
+  Eigen::MatrixXd single(n, 7);
+  for (Eigen::Index j = 0; j < 7; ++j)
+    llt.solve(B.col(j).data(), single.col(j).data());
+  Eigen::MatrixXd block(n, 7);
+  llt.solve(B.data(), block.data(), 7);
+  for (Eigen::Index j = 0; j < 7; ++j) {
+    EXPECT_LT((block.col(j) - single.col(j)).norm(), 1e-13 * single.col(j).norm()) << j;
+    EXPECT_LT(relative_residual(g.A, block.col(j), B.col(j)), 1e-13) << j;
+  }
+  EXPECT_LT((llt.solve(B) - single).norm(), 1e-13 * single.norm()); // the Eigen overload
+  Eigen::VectorXd x(n);
+  llt.solve(B.col(3).data(), x.data());
+  EXPECT_LT((x - single.col(3)).norm(), 1e-13 * x.norm());
+  EXPECT_LT((llt.solve(B.rightCols(2)) - single.rightCols(2)).norm(), 1e-13 * single.norm());
+  EXPECT_EQ(llt.solve(Eigen::MatrixXd(n, 0)).cols(), 0);
+  EXPECT_THROW(llt.solve(Eigen::MatrixXd::Ones(n + 1, 2)), std::invalid_argument);
+  EXPECT_THROW(llt.solve(B.data(), block.data(), -1), std::invalid_argument);
+  SparseCholesky unfactorized;
+  EXPECT_THROW(unfactorized.solve(B.data(), block.data(), 7), std::logic_error);
+}
+
 TEST(SparseCholesky, AutomaticKeepsTheCandidateNeedingLeastMemory) {
   // `automatic` with groups: METIS and NESDIS on the groups, CHOLMOD's default on the
   // equations; the smallest predicted factor is kept.

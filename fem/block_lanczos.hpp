@@ -1,0 +1,83 @@
+#pragma once
+/// Thick-restart block Lanczos for the lowest modes of K φ = λ M φ by shift-invert: the largest
+/// eigenvalues θ = 1/(λ − σ) of Op = (K − σM)⁻¹ M, which is self-adjoint in the M-inner
+/// product, so its Krylov basis is kept M-orthonormal and its projection is symmetric.
+///
+/// Why blocks: on a large model every application of Op is a solve with the factor of K − σM,
+/// and a single-vector solve is bound by the memory bandwidth of reading the factor (20 GiB at
+/// 10⁶ DOFs, 1.2 s a pass). CHOLMOD solves b right-hand sides in one pass over the factor, with
+/// BLAS-3 instead of BLAS-2, so the iteration needs 3× fewer passes (8 columns: 21–22 instead
+/// of Spectra's 64–75 on the 10⁴ and 10⁵ lattices). What a pass of b columns costs depends on
+/// how fast the BLAS-3 kernels are: on the 10⁵ lattice 8 columns cost 2.2–4.3× one
+/// (docs/benchmarks.md); it can come near 1× only where the pass stays bandwidth-bound (a
+/// factor far larger than the caches and kernels that keep up; not measured here).
+///
+/// Why thick restart (Wu & Simon's, the symmetric form of Stewart's Krylov–Schur): when the
+/// basis reaches its cap the iteration keeps the wanted Ritz vectors and the residual block
+/// and goes on from there. That is as good as an implicit restart for a symmetric operator,
+/// keeps memory fixed (n × (cap + b) doubles), needs no shifted QR steps on a block
+/// tridiagonal matrix, and its basis stays orthonormal by construction (every new block is
+/// orthogonalised twice against the whole basis, CGS2 in the M-inner product, BLAS-3).
+/// After convergence the wanted vectors take one more power step, φ ← Op φ / θ, read off the
+/// Krylov relation (no solve): it brings ‖KΦ − MΦΛ‖/‖KΦ‖ from ~1e-8 to ~1e-11 on the 10⁴
+/// lattice (Spectra's: 1e-9 … 1e-12).
+///
+/// A multiple eigenvalue whose multiplicity is at most the block size is found like a simple
+/// one (a random start block has a component in every direction of its eigenspace); a larger
+/// multiplicity only through rounding, as in single-vector Lanczos, so keep the block at least
+/// as large as the multiplicities expected (6 rigid-body modes of a free 3D body).
+#include <Eigen/Core>
+
+#include <cstdint>
+
+namespace jointid::fem {
+
+/// What the iteration needs of the pencil: solves with the factor of K − σM, a block at a
+/// time, and products with M. Both K − σM and M are symmetric, K − σM positive definite.
+class ShiftInvertPencil {
+public:
+  virtual ~ShiftInvertPencil() = default;
+  virtual Eigen::Index rows() const = 0;
+  /// X = (K − σM)⁻¹ B for an n × b block B.
+  virtual void solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) = 0;
+  /// Y = M X for an n × b block X.
+  virtual void mass(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const = 0;
+};
+
+struct BlockLanczosOptions {
+  int nev = 10;       ///< wanted eigenpairs: the nev largest θ (the lowest λ)
+  int block_size = 8; ///< right-hand sides per solve (≥ 1)
+  /// basis vectors at most, besides the next block; 0: max(2 nev + 2 b, nev + 4 b)
+  int max_basis = 0;
+  int max_dimension = 0; ///< dimension of the space Op works in (M's rank); 0: rows()
+  /// A Ritz pair (θ, y) has converged when ‖Op y − θ y‖_M ≤ tolerance · max(ε^⅔, θ) (Spectra's
+  /// test). With λ = σ + 1/θ that is ‖(K − σM)⁻¹(K y − λ M y)‖_M ≤ tolerance for θ ≥ ε^⅔: the
+  /// residual of K φ = λ M φ relative to the pencil, measured without an extra solve.
+  double tolerance = 1e-10;
+  int max_restarts = 1000; ///< restarts (basis rebuilds) before giving up
+  /// M singular (massless DOFs): M's null space is invisible to the M-inner product, so start
+  /// from Op applied to a random block and purify the eigenvectors (φ ← Op φ / θ) at the end,
+  /// a solve each. (Without it that step is taken from the Krylov relation, without a solve.)
+  bool purify = false;
+  std::uint64_t seed = 20261201; ///< of the random start block
+};
+
+struct BlockLanczosResult {
+  bool converged = false;
+  int converged_count = 0; ///< wanted pairs that met the tolerance at the last check
+  Eigen::VectorXd theta;   ///< the nev largest eigenvalues of Op, descending
+  Eigen::MatrixXd vectors; ///< n × nev, M-orthonormal (θ's eigenvectors, in its order)
+  int block_size = 0;      ///< block size used (reduced for a small space)
+  int max_basis = 0;       ///< basis cap used
+  int restarts = 0;
+  long long solves = 0;           ///< calls of ShiftInvertPencil::solve (passes over the factor)
+  long long right_hand_sides = 0; ///< columns solved in all
+  double max_residual = 0.0; ///< max over the wanted pairs of ‖Op y − θ y‖_M / θ, last check
+};
+
+/// The nev largest eigenpairs of Op = (K − σM)⁻¹ M. Throws std::invalid_argument for bad
+/// options (nev ≥ the dimension of the space, block size < 1, negative tolerance or restarts).
+/// Not converging within max_restarts is a result (converged = false), not an exception.
+BlockLanczosResult block_lanczos(ShiftInvertPencil& pencil, const BlockLanczosOptions& options);
+
+} // namespace jointid::fem
