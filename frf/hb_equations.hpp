@@ -94,6 +94,7 @@ struct Equations {
     std::vector<Eigen::VectorXd> stick;
     Eigen::MatrixXd weights; // (4K+2) × 2: cos and sin sums of the columns ∂g/∂y, ∂g/∂ẏ
     Eigen::MatrixXd E, D;
+    Eigen::MatrixXcd G; // (K+1) × nj: the joint forces' harmonics
   };
   mutable Scratch work{};
 
@@ -180,19 +181,27 @@ struct Equations {
     harmonics.noalias() = forward * g.col(0);
   }
 
-  // Harmonics of the joints' forces (K+1) × nj: the smooth forces and the exact friction
-  // forces (unknowns).
-  Eigen::MatrixXcd forces(const Eigen::VectorXd& z) const {
-    Eigen::MatrixXcd G(K + 1, nj);
-    Eigen::VectorXd Gp(m());
+  // Harmonics of the joints' forces (K+1) × nj at z, into G: the smooth forces (their samples
+  // kept for jacobian()) and the exact friction forces (unknowns).
+  void force_harmonics(const Eigen::VectorXd& z, Eigen::MatrixXcd& G) const {
+    Scratch& s = scratch();
+    G.resize(K + 1, nj);
     for (int j = 0; j < nj; ++j) {
-      smooth_force(z, j, Gp);
-      G(0, j) = Gp(0);
+      smooth_force(z, j, s.harmonics);
+      G(0, j) = s.harmonics(0);
       for (int k = 1; k <= K; ++k)
-        G(k, j) = Complex(Gp(2 * k - 1), Gp(2 * k));
+        G(k, j) = Complex(s.harmonics(2 * k - 1), s.harmonics(2 * k));
     }
-    for (std::size_t f = 0; f < friction.size(); ++f)
-      G.col(friction[f].joint) += unpack(z, 1, nj + static_cast<int>(f)).col(0);
+    for (std::size_t f = 0; f < friction.size(); ++f) {
+      const int o = (nj + static_cast<int>(f)) * m(), j = friction[f].joint;
+      G(0, j) += z(o);
+      for (int k = 1; k <= K; ++k)
+        G(k, j) += Complex(z(o + 2 * k - 1), z(o + 2 * k));
+    }
+  }
+  Eigen::MatrixXcd forces(const Eigen::VectorXd& z) const {
+    Eigen::MatrixXcd G;
+    force_harmonics(z, G);
     return G;
   }
 
@@ -219,20 +228,8 @@ struct Equations {
     r = z;
     // Per joint a: its rows get Σ_b H_yy(kω)_ab G_b,k, with G_b the smooth force of joint b
     // plus its friction unknowns.
-    Eigen::MatrixXcd& G = force_harmonics_;
-    G.resize(K + 1, nj);
-    for (int b = 0; b < nj; ++b) {
-      smooth_force(z, b, s.harmonics);
-      G(0, b) = s.harmonics(0);
-      for (int k = 1; k <= K; ++k)
-        G(k, b) = Complex(s.harmonics(2 * k - 1), s.harmonics(2 * k));
-    }
-    for (std::size_t f = 0; f < friction.size(); ++f) {
-      const int o = (nj + static_cast<int>(f)) * m(), b = friction[f].joint;
-      G(0, b) += z(o);
-      for (int k = 1; k <= K; ++k)
-        G(k, b) += Complex(z(o + 2 * k - 1), z(o + 2 * k));
-    }
+    Eigen::MatrixXcd& G = s.G;
+    force_harmonics(z, G);
     for (int a = 0; a < nj; ++a) {
       const int o = a * m();
       for (int k = 0; k <= K; ++k) {
@@ -309,8 +306,6 @@ struct Equations {
            z.segment((nj + static_cast<int>(f)) * m(), m()).squaredNorm();
     return std::sqrt(s);
   }
-
-  mutable Eigen::MatrixXcd force_harmonics_{};
 };
 
 /// Newton's method (least-norm steps where J is singular, backtracking) on R(z) = 0 at the
