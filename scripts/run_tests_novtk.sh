@@ -6,9 +6,8 @@
 #   --sanitize: the same build under AddressSanitizer (with LeakSanitizer) and
 #     UndefinedBehaviorSanitizer, in ./build-novtk-sanitize (scripts/sanitizer_env.sh); any
 #     finding fails its test. The two example studies and the Monte Carlo coverage tests are left
-#     to the uninstrumented builds (instrumented they run for over 16 min each). Meant to replace
-#     the plain build in CI (one build for both checks); not there yet (docs/errors.md,
-#     "Sanitizers").
+#     to the uninstrumented builds (instrumented they run for over 16 min each). This is what CI
+#     runs (.ci/run: one build for both checks; docs/errors.md, "Sanitizers").
 # Other arguments go to cmake.
 set -euo pipefail
 cd "$(dirname "$0")/.."

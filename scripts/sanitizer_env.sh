@@ -9,7 +9,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # -O2 rather than -O1: Eigen's expression templates are 10-30x slower when not inlined (the
 # discovery tests took 150-600 s each at -O1); ASan and UBSan see the same accesses either way.
 # Eigen's own index assertions are off (EIGEN_NO_DEBUG): ASan checks the accesses themselves;
-# jointid's assertions stay on.
+# jointid's assertions stay on. -g1: line tables only, all a report's stack trace needs.
 sanitize_cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo
-  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g -DEIGEN_NO_DEBUG"
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DEIGEN_NO_DEBUG"
   -DJOINTID_SANITIZE=address,undefined)
