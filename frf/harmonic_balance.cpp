@@ -18,7 +18,7 @@ namespace jointid::frf {
 // in a cache: the continuation builds a HarmonicBalance at every frequency it visits, and
 // computing (and allocating) these each time was most of its cost.
 struct detail::Tables {
-  Eigen::MatrixXd cos, sin, dy, dv_unit, forward, trig;
+  Eigen::MatrixXd cos, sin, dy, dv_unit, forward, forward_t, trig;
 };
 
 namespace {
@@ -49,6 +49,7 @@ const detail::Tables& aft_tables(int Nt, int K) {
         t->forward(2 * k - 1, n) = 2.0 * c / Nt, t->forward(2 * k, n) = -2.0 * s / Nt;
       }
     }
+    t->forward_t = t->forward.transpose();
     t->trig.resize(Nt, 2 * m);
     t->trig << t->cos, t->sin;
     slot = std::move(t);
@@ -65,9 +66,18 @@ using detail::two_pi;
 bool detail::newton(const Equations& P, Eigen::VectorXd& z, double load,
                     const HarmonicBalanceOptions& o, int& iterations, double& res_norm) {
   const int n = P.size();
-  Eigen::MatrixXd J(n, n);
-  Eigen::VectorXd r(n), step(n), zt(n), rt(n);
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu(n);
+  // Work arrays kept per thread (newton does not call itself): sizing them is free from the
+  // second call on, and a sweep solves thousands of points of the same size.
+  struct Work {
+    Eigen::MatrixXd J;
+    Eigen::VectorXd r, step, zt, rt;
+    SmallLU<double> lu;
+  };
+  thread_local Work work;
+  Eigen::MatrixXd& J = work.J;
+  Eigen::VectorXd &r = work.r, &step = work.step, &zt = work.zt, &rt = work.rt;
+  SmallLU<double>& lu = work.lu;
+  J.resize(n, n), r.resize(n), step.resize(n), zt.resize(n), rt.resize(n);
   P.residual(z, load, r, &J);
   for (int it = 0; it < o.max_iterations; ++it) {
     ++iterations;
@@ -78,9 +88,12 @@ bool detail::newton(const Equations& P, Eigen::VectorXd& z, double load,
     // (a fraction of full pivoting's cost at these sizes) shows it in its pivots: J = I + …
     // is of order 1, so a pivot at rounding level is a singular direction.
     lu.compute(J);
-    const double pivot = lu.matrixLU().diagonal().cwiseAbs().minCoeff();
-    if (pivot > 1e-13 * std::max(1.0, J.cwiseAbs().maxCoeff())) step.noalias() = lu.solve(-r);
-    if (!(pivot > 1e-13 * std::max(1.0, J.cwiseAbs().maxCoeff())) || !step.allFinite()) {
+    const bool regular = lu.min_pivot > 1e-13 * std::max(1.0, J.lpNorm<Eigen::Infinity>());
+    if (regular) {
+      step = -r;
+      lu.solve_in_place(step);
+    }
+    if (!regular || !step.allFinite()) {
       Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(J);
       cod.setThreshold(1e-13);
       step = cod.solve(-r);
@@ -150,9 +163,19 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   dv_ = omega_ * tables_->dv_unit;
   dyv_.resize(2 * Nt_, 2 * K_ + 1);
   dyv_ << tables_->dy, dv_;
+  if (K_ > 1) { // the first guess's fundamental-only problem
+    coarse_tables_ = &aft_tables(coarse_samples, 1);
+    dv1_ = omega_ * coarse_tables_->dv_unit;
+    dyv1_.resize(2 * coarse_samples, 3);
+    dyv1_ << coarse_tables_->dy, dv1_;
+  }
   // Joint DOFs (node and node_b) and the B matrix restricted to them.
   const std::vector<int> jdofs = joints::joint_dof_set(joints, dofs);
-  const Eigen::MatrixXcd B = joints::joint_coordinates_on(joints, dofs, jdofs).cast<Complex>();
+  const Eigen::MatrixXd B_real = joints::joint_coordinates_on(joints, dofs, jdofs);
+  const Eigen::MatrixXcd B = B_real.cast<Complex>();
+  // Grounded joints, each on a DOF of its own, in order (the common case): B = I and the
+  // blocks are the receptance's own.
+  const bool identity = B_real.rows() == B_real.cols() && B_real.isIdentity(0.0);
   // One receptance per harmonic, rows (joint DOFs, outputs) × columns (joint DOFs, forces),
   // cut into the four blocks.
   std::vector<int> rows = jdofs, cols = jdofs;
@@ -160,12 +183,20 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   cols.insert(cols.end(), force_equations.begin(), force_equations.end());
   const auto nd = static_cast<Eigen::Index>(jdofs.size());
   const auto no = static_cast<Eigen::Index>(outputs.size()), nf = static_cast<Eigen::Index>(nf_);
+  for (auto* blocks : {&Hyy_, &HyF_, &HoB_, &HoF_})
+    blocks->reserve(static_cast<std::size_t>(K_ + 1));
   for (int k = 0; k <= K_; ++k) {
     const CMatrix R = H.receptance(k * omega_, rows, cols);
-    Hyy_.push_back(B.transpose() * R.topLeftCorner(nd, nd) * B);
-    HyF_.push_back(B.transpose() * R.topRightCorner(nd, nf));
-    HoB_.push_back(R.bottomLeftCorner(no, nd) * B);
-    HoF_.push_back(R.bottomRightCorner(no, nf));
+    if (identity) {
+      Hyy_.emplace_back(R.topLeftCorner(nd, nd));
+      HyF_.emplace_back(R.topRightCorner(nd, nf));
+      HoB_.emplace_back(R.bottomLeftCorner(no, nd));
+    } else {
+      Hyy_.emplace_back(B.transpose() * R.topLeftCorner(nd, nd) * B);
+      HyF_.emplace_back(B.transpose() * R.topRightCorner(nd, nf));
+      HoB_.emplace_back(R.bottomLeftCorner(no, nd) * B);
+    }
+    HoF_.emplace_back(R.bottomRightCorner(no, nf));
   }
 }
 
@@ -188,7 +219,12 @@ HarmonicBalance::equations(const std::vector<joints::Joint>& joints,
   Fk.row(0) = Fk.row(0).real().cast<Complex>().eval(); // a mean force is real
   CMatrix HyF_F(K_ + 1, nj_);
   for (int k = 0; k <= K_; ++k)
-    HyF_F.row(k) = (HyF_[k] * Fk.row(k).transpose()).transpose();
+    for (int j = 0; j < nj_; ++j) {
+      Complex h = 0.0;
+      for (int f = 0; f < nf_; ++f)
+        h += HyF_[k](j, f) * Fk(k, f);
+      HyF_F(k, j) = h;
+    }
   const bool exact = options_.exact_friction;
   std::vector<Friction> friction;
   for (int j = 0; j < nj_; ++j) {
@@ -204,10 +240,10 @@ HarmonicBalance::equations(const std::vector<joints::Joint>& joints,
     const double c = std::max(std::abs(Hyy_[1](j, j)), 1e-300);
     friction.push_back({j, limit, 1.0 / (omega_ * c), c});
   }
-  return std::make_unique<Equations>(Equations{K_, nj_, Nt_, Hyy_, std::move(HyF_F), std::move(Fk),
-                                               joints, exact ? 0.0 : options_.friction_width,
-                                               std::move(friction), tables_->dy, dv_, dyv_,
-                                               tables_->forward, tables_->trig, omega_});
+  return std::make_unique<Equations>(
+      Equations{K_, nj_, Nt_, Hyy_, std::move(HyF_F), std::move(Fk), joints,
+                exact ? 0.0 : options_.friction_width, std::move(friction), tables_->dy, dv_, dyv_,
+                tables_->forward, tables_->forward_t, tables_->trig, omega_});
 }
 
 namespace {
@@ -225,8 +261,11 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
     P.pack(*start, z);
   } else {
     Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K + 1, nj);
+    CMatrix D(nj, nj);
+    CVector y(nj);
+    detail::SmallLU<Complex> lu;
     for (int k = 0; k <= K; ++k) {
-      CMatrix D = CMatrix::Identity(nj, nj);
+      D.setIdentity();
       for (int j = 0; j < nj; ++j) {
         Complex lin = 0.0;
         for (std::size_t t = 0; t < joints[j].terms.size(); ++t) {
@@ -238,7 +277,10 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
         }
         D.col(j) += P.Hyy[k].col(j) * lin;
       }
-      Y.row(k) = D.partialPivLu().solve(P.HyF_F.row(k).transpose()).transpose();
+      lu.compute(D);
+      y = P.HyF_F.row(k).transpose();
+      lu.solve_in_place(y);
+      Y.row(k) = y.transpose();
     }
     Y.row(0) = Y.row(0).real().cast<Complex>().eval();
     P.pack(Y, z);
@@ -284,45 +326,45 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
   // 80 N), so the full problem needs 3–4 Newton iterations instead of 11. Its iterations are
   // cheap (3 unknowns a joint, 16 samples; to 1e-6). If it fails, the linear response is the
   // guess.
-  constexpr int coarse_samples = 16;
-  const detail::Tables& t1 = aft_tables(coarse_samples, 1);
-  const std::vector<CMatrix> H1(Hyy_.begin(), Hyy_.begin() + 2);
-  const Eigen::MatrixXd dv1 = omega_ * t1.dv_unit;
-  Eigen::MatrixXd dyv1(2 * coarse_samples, 3);
-  dyv1 << t1.dy, dv1;
+  // (Hyy_ serves as is: the equations read its harmonics 0 and 1 only.)
+  const detail::Tables& t1 = *coarse_tables_;
   const Equations P1{1,
                      nj_,
                      coarse_samples,
-                     H1,
+                     Hyy_,
                      P.HyF_F.topRows(2),
                      P.Fk.topRows(2),
                      P.joints,
                      P.width,
                      P.friction,
                      t1.dy,
-                     dv1,
-                     dyv1,
+                     dv1_,
+                     dyv1_,
                      t1.forward,
+                     t1.forward_t,
                      t1.trig,
                      omega_};
   Eigen::VectorXd z1 = start_from(P1, nullptr);
   // The linear response can be far off in amplitude (a stiffening joint near resonance: 9×);
-  // Newton then creeps (by 2/3 a step for a cubic). Scale it first by the power of 2 that
-  // leaves the least residual: a few cheap evaluations instead of those steps.
-  if (P1.friction.empty()) {
-    Eigen::VectorXd r(P1.size()), zs(P1.size());
+  // Newton then creeps (by 2/3 a step for a cubic; by 1/2 with friction, 10 steps on the
+  // paper's cantilever). Scale the displacements first by the power of 2 that leaves the least
+  // residual: a few cheap evaluations instead of those steps. The friction forces of the slip
+  // law, fc sign(ẏ), do not change with the scale.
+  {
+    const int nd = nj_ * P1.m();
+    Eigen::VectorXd r(P1.size()), zs = z1;
     P1.residual(z1, 1.0, r, nullptr);
     double best = r.norm(), scale = 1.0;
     for (const double step : {0.5, 2.0}) {
       for (double s = step; s >= 1.0 / 1024 && s <= 8.0; s *= step) {
-        zs = s * z1;
+        zs.head(nd) = s * z1.head(nd);
         P1.residual(zs, 1.0, r, nullptr);
         if (!(r.norm() < best)) break;
         best = r.norm(), scale = s;
       }
       if (scale != 1.0) break;
     }
-    z1 *= scale;
+    z1.head(nd) *= scale;
   }
   int iterations = 0;
   double residual = 0.0;
@@ -340,10 +382,17 @@ HarmonicBalanceResult HarmonicBalance::result(const detail::Equations& P,
   out.frequency_hz = frequency_hz_;
   out.Y = P.unpack(z, nj_);
   out.G = P.forces(z);
-  out.X.resize(K_ + 1, HoB_.empty() ? 0 : HoB_[0].rows());
+  const Eigen::Index no = HoB_.empty() ? 0 : HoB_[0].rows();
+  out.X.resize(K_ + 1, no);
   for (int k = 0; k <= K_; ++k)
-    out.X.row(k) =
-        (HoF_[k] * P.Fk.row(k).transpose() - HoB_[k] * out.G.row(k).transpose()).transpose();
+    for (Eigen::Index o = 0; o < no; ++o) { // H_of F − H_oy G, without temporaries
+      Complex x = 0.0;
+      for (int f = 0; f < nf_; ++f)
+        x += HoF_[k](o, f) * P.Fk(k, f);
+      for (int j = 0; j < nj_; ++j)
+        x -= HoB_[k](o, j) * out.G(k, j);
+      out.X(k, o) = x;
+    }
   return out;
 }
 

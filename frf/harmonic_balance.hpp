@@ -101,6 +101,10 @@ private:
   const detail::Tables* tables_ = nullptr;     // AFT sample tables independent of ω (cached)
   Eigen::MatrixXd dv_;                         // ∂ẏ_n/∂z at this ω
   Eigen::MatrixXd dyv_;                        // ∂y_n/∂z over ∂ẏ_n/∂z
+  // The same for the first guess's problem with the fundamental alone (K = 1), when K > 1.
+  static constexpr int coarse_samples = 16;
+  const detail::Tables* coarse_tables_ = nullptr;
+  Eigen::MatrixXd dv1_, dyv1_;
 };
 
 /// One steady state under F0 sin(2π f t) at `force_equation`.

@@ -6,6 +6,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <new>
 #include <numbers>
 #include <span>
 #include <vector>
@@ -39,7 +41,7 @@ inline void joint_force(const joints::Joint& j, double y, double v, double width
 // columns of g (n × 3: g, ∂g/∂y, ∂g/∂ẏ). Coulomb friction is left out when it is handled
 // exactly (`width` = 0), else regularised as fc·tanh(ẏ/width).
 inline void add_joint_forces(const joints::Joint& j, const double* y, const double* v, int n,
-                             double width, Eigen::MatrixXd& g) {
+                             double width, Eigen::Map<Eigen::MatrixXd>& g) {
   const auto size = static_cast<std::size_t>(n);
   const std::span<const double> ys(y, size), vs(v, size);
   const std::span<double> gs(g.col(0).data(), size), gys(g.col(1).data(), size),
@@ -57,6 +59,23 @@ inline void add_joint_forces(const joints::Joint& j, const double* y, const doub
       gvs[i] += b * (1.0 - th * th) / width;
     }
   }
+}
+
+// y = A x and y = Aᵀ x for the small dense tables of one point (A column-major, x and y
+// contiguous, y not aliasing x). Written as inline column updates and dot products: at these
+// sizes (a few hundred entries) Eigen's general matrix-vector kernel costs more in dispatch
+// and blocking than the arithmetic (about 700 instructions a call for a 48 × 11 table).
+inline void multiply(const Eigen::MatrixXd& A, const double* x, double* y) {
+  const Eigen::Index rows = A.rows();
+  Eigen::Map<Eigen::VectorXd> out(y, rows);
+  out.setZero();
+  for (Eigen::Index j = 0; j < A.cols(); ++j)
+    if (x[j] != 0.0) out += x[j] * A.col(j);
+}
+inline void multiply_transposed(const Eigen::MatrixXd& A, const double* x, double* y) {
+  const Eigen::Map<const Eigen::VectorXd> in(x, A.rows());
+  for (Eigen::Index j = 0; j < A.cols(); ++j)
+    y[j] = A.col(j).dot(in);
 }
 
 // A joint with exact dry friction: its limit, its augmentation r (N s/m) and a compliance c
@@ -82,33 +101,62 @@ struct Equations {
   // one product gives y and ẏ), and the forward transform from samples to packed harmonics
   // ((2K+1) × Nt).
   const Eigen::MatrixXd &dy, &dv, &dyv, &forward;
+  const Eigen::MatrixXd& forward_t; // forwardᵀ (Nt × (2K+1)): its rows as contiguous columns
   // cos(pθ_n) beside sin(pθ_n), p = 0 … 2K (Nt × (4K+2)): the harmonics of sample weights.
   const Eigen::MatrixXd& trig;
   double omega;
 
+  // Work arrays of residual() and jacobian(), views into one buffer (one allocation per
+  // Equations: at a harmonic-balance point of a few µs the allocator was a fifth of the time).
+  // A copy starts empty: the views must not point into another object's buffer.
   struct Scratch {
-    Eigen::VectorXd yv, harmonics, lambda, clamped;
+    using Vector = Eigen::Map<Eigen::VectorXd>;
+    using Matrix = Eigen::Map<Eigen::MatrixXd>;
+    std::vector<double> buffer;
+    Vector yv{nullptr, 0}, harmonics{nullptr, 0}, lambda{nullptr, 0}, clamped{nullptr, 0};
     // At the point of the last residual(): per joint, g, ∂g/∂y, ∂g/∂ẏ at the samples (Nt × 3);
     // per friction joint, 1 where a sample sticks (Nt). jacobian() reads them.
-    std::vector<Eigen::MatrixXd> g;
-    std::vector<Eigen::VectorXd> stick;
-    Eigen::MatrixXd weights; // (4K+2) × 2: cos and sin sums of the columns ∂g/∂y, ∂g/∂ẏ
-    Eigen::MatrixXd E, D;
-    Eigen::MatrixXcd G; // (K+1) × nj: the joint forces' harmonics
+    std::vector<Matrix> g;
+    std::vector<Vector> stick;
+    Matrix weights{nullptr, 0, 0}; // (4K+2) × 2: cos and sin sums of the columns ∂g/∂y, ∂g/∂ẏ
+    Matrix E{nullptr, 0, 0}, D{nullptr, 0, 0};
+    Vector w{nullptr, 0}; // the weight's harmonics −2K … 2K, real parts then imaginary
+    Eigen::MatrixXcd G;   // (K+1) × nj: the joint forces' harmonics
+
+    Scratch() = default;
+    Scratch(const Scratch&) : Scratch() {}
+    Scratch& operator=(const Scratch&) { return *this; }
   };
   mutable Scratch work{};
 
   Scratch& scratch() const {
-    if (work.yv.size() != 2 * Nt) {
-      work.yv.resize(2 * Nt);
-      work.lambda.resize(Nt), work.clamped.resize(Nt);
-      work.g.assign(static_cast<std::size_t>(nj), Eigen::MatrixXd(Nt, 3));
-      work.stick.assign(friction.size(), Eigen::VectorXd(Nt));
-      work.harmonics.resize(m());
-      work.weights.resize(2 * m(), 2);
-      work.E.resize(m(), m()), work.D.resize(m(), m());
-    }
-    return work;
+    Scratch& w = work;
+    if (w.yv.size() == 2 * Nt) return w;
+    const Eigen::Index n = Nt, M = m(), nf = static_cast<Eigen::Index>(friction.size());
+    w.buffer.assign(static_cast<std::size_t>(2 * n + M + 2 * n + nj * 3 * n + nf * n + 4 * M +
+                                             2 * M * M + 2 * (2 * M - 1)),
+                    0.0);
+    double* at = w.buffer.data();
+    auto take = [&at](Eigen::Index size) {
+      double* p = at;
+      at += size;
+      return p;
+    };
+    new (&w.yv) Scratch::Vector(take(2 * n), 2 * n);
+    new (&w.harmonics) Scratch::Vector(take(M), M);
+    new (&w.lambda) Scratch::Vector(take(n), n);
+    new (&w.clamped) Scratch::Vector(take(n), n);
+    w.g.clear(), w.stick.clear();
+    for (int j = 0; j < nj; ++j)
+      w.g.emplace_back(take(3 * n), n, 3);
+    for (Eigen::Index f = 0; f < nf; ++f)
+      w.stick.emplace_back(take(n), n);
+    new (&w.weights) Scratch::Matrix(take(4 * M), 2 * M, 2);
+    new (&w.E) Scratch::Matrix(take(M * M), M, M);
+    new (&w.D) Scratch::Matrix(take(M * M), M, M);
+    new (&w.w) Scratch::Vector(take(2 * (2 * M - 1)), 2 * (2 * M - 1));
+    w.G.resize(K + 1, nj);
+    return w;
   }
 
   // D += forward · diag(w) · dy (rate = false) or forward · diag(w) · dv (rate = true): the
@@ -116,15 +164,30 @@ struct Equations {
   // harmonics of y, from the harmonics W_p = (1/Nt) Σ w(θ_n) e^{−ipθ_n}, p ≤ 2K, of the weights
   // (product-to-sum: a product of harmonics j and k has harmonics k ± j). O(Nt K + K²) instead
   // of O(Nt K²). `sums` = trigᵀ w, the column of the weight's cosine and sine sums.
-  template <class Sums> void add_product(const Sums& sums, bool rate, Eigen::MatrixXd& D) const {
+  template <class Sums, class Out> void add_product(const Sums& sums, bool rate, Out& D) const {
+    const auto& E = product_matrix(sums);
+    if (rate)
+      add_rate(E, 1.0, D);
+    else
+      D += E;
+  }
+  // E: the derivative for w(t) y(t) alone (the scratch's E), from the weight's sums.
+  template <class Sums> const Scratch::Matrix& product_matrix(const Sums& sums) const {
     Scratch& s = scratch();
     const double* cs = sums.data();
     const double* sn = cs + m();
     const double scale = 1.0 / Nt;
-    auto Re = [&](int p) { return scale * cs[std::abs(p)]; };
-    auto Im = [&](int p) { return p < 0 ? scale * sn[-p] : -scale * sn[p]; };
+    // W_p = Re + i Im for p = −2K … 2K, tabulated (re[p + 2K], im[p + 2K]).
+    double* re = s.w.data();
+    double* im = re + (4 * K + 1);
+    for (int p = 0; p <= 2 * K; ++p) {
+      re[2 * K + p] = re[2 * K - p] = scale * cs[p];
+      im[2 * K + p] = -scale * sn[p], im[2 * K - p] = scale * sn[p];
+    }
+    auto Re = [&](int p) { return re[2 * K + p]; };
+    auto Im = [&](int p) { return im[2 * K + p]; };
     // The columns of y's own harmonics: 0, cos jθ, −sin jθ.
-    Eigen::MatrixXd& E = s.E;
+    Scratch::Matrix& E = s.E;
     E(0, 0) = Re(0);
     for (int j = 1; j <= K; ++j)
       E(0, 2 * j - 1) = Re(j), E(0, 2 * j) = Im(j);
@@ -138,14 +201,14 @@ struct Equations {
         E(2 * k, 2 * j) = Re(k - j) - Re(k + j);
       }
     }
-    if (!rate) {
-      D += E;
-      return;
-    }
-    // ẏ's columns: d/dt cos jθ = jω (−sin jθ), d/dt (−sin jθ) = −jω cos jθ.
+    return E;
+  }
+  // D += factor · (E for w(t) ẏ(t)): ẏ's columns from y's, d/dt cos jθ = jω (−sin jθ),
+  // d/dt (−sin jθ) = −jω cos jθ; the mean has no rate.
+  template <class Out> void add_rate(const Scratch::Matrix& E, double factor, Out&& D) const {
     for (int j = 1; j <= K; ++j) {
-      D.col(2 * j - 1) += j * omega * E.col(2 * j);
-      D.col(2 * j) -= j * omega * E.col(2 * j - 1);
+      D.col(2 * j - 1) += (factor * j * omega) * E.col(2 * j);
+      D.col(2 * j) -= (factor * j * omega) * E.col(2 * j - 1);
     }
   }
 
@@ -172,13 +235,13 @@ struct Equations {
   }
 
   // Packed harmonics of joint j's smooth force (m) at z; its samples are kept for jacobian().
-  void smooth_force(const Eigen::VectorXd& z, int j, Eigen::VectorXd& harmonics) const {
+  void smooth_force(const Eigen::VectorXd& z, int j, double* harmonics) const {
     Scratch& s = scratch();
-    Eigen::MatrixXd& g = s.g[static_cast<std::size_t>(j)];
-    s.yv.noalias() = dyv * z.segment(j * m(), m());
+    Scratch::Matrix& g = s.g[static_cast<std::size_t>(j)];
+    multiply(dyv, z.data() + j * m(), s.yv.data());
     g.setZero();
     add_joint_forces(joints[j], s.yv.data(), s.yv.data() + Nt, Nt, width, g);
-    harmonics.noalias() = forward * g.col(0);
+    multiply_transposed(forward_t, g.data(), harmonics);
   }
 
   // Harmonics of the joints' forces (K+1) × nj at z, into G: the smooth forces (their samples
@@ -187,7 +250,7 @@ struct Equations {
     Scratch& s = scratch();
     G.resize(K + 1, nj);
     for (int j = 0; j < nj; ++j) {
-      smooth_force(z, j, s.harmonics);
+      smooth_force(z, j, s.harmonics.data());
       G(0, j) = s.harmonics(0);
       for (int k = 1; k <= K; ++k)
         G(k, j) = Complex(s.harmonics(2 * k - 1), s.harmonics(2 * k));
@@ -207,7 +270,8 @@ struct Equations {
 
   // Adds ∂pack(H_yy(kω) G_k)/∂(unknowns of joint b's force) = `d` (packed rows) to the rows of
   // joint a, columns `col`.
-  void add_coupling(Eigen::MatrixXd& J, int a, int b, int col, const Eigen::MatrixXd& d) const {
+  template <class Block>
+  void add_coupling(Eigen::MatrixXd& J, int a, int b, int col, const Block& d) const {
     for (int k = 0; k <= K; ++k) {
       const Complex h = Hyy[k](a, b);
       if (k == 0) { // the mean is real
@@ -217,6 +281,17 @@ struct Equations {
       const auto re = d.row(2 * k - 1), im = d.row(2 * k);
       J.block(a * m() + 2 * k - 1, col, 1, m()) += h.real() * re - h.imag() * im;
       J.block(a * m() + 2 * k, col, 1, m()) += h.imag() * re + h.real() * im;
+    }
+  }
+
+  // The same for d = I (a friction joint's force unknowns enter its harmonics as they are).
+  void add_coupling_identity(Eigen::MatrixXd& J, int a, int b, int col) const {
+    const int r = a * m();
+    J(r, col) += Hyy[0](a, b).real();
+    for (int k = 1; k <= K; ++k) {
+      const Complex h = Hyy[k](a, b);
+      J(r + 2 * k - 1, col + 2 * k - 1) += h.real(), J(r + 2 * k - 1, col + 2 * k) -= h.imag();
+      J(r + 2 * k, col + 2 * k - 1) += h.imag(), J(r + 2 * k, col + 2 * k) += h.real();
     }
   }
 
@@ -247,15 +322,15 @@ struct Equations {
     for (std::size_t f = 0; f < friction.size(); ++f) {
       const Friction& fr = friction[f];
       const int o = (nj + static_cast<int>(f)) * m(), oy = fr.joint * m();
-      s.lambda.noalias() = dy * z.segment(o, m());
-      s.yv.tail(Nt).noalias() = dv * z.segment(oy, m());
-      Eigen::VectorXd& stick = s.stick[f];
+      multiply(dy, z.data() + o, s.lambda.data());
+      multiply(dv, z.data() + oy, s.yv.data() + Nt);
+      Scratch::Vector& stick = s.stick[f];
       for (int n = 0; n < Nt; ++n) {
         const double trial = s.lambda(n) + fr.r * s.yv(Nt + n);
         stick(n) = std::abs(trial) < fr.limit ? 1.0 : 0.0;
         s.clamped(n) = std::clamp(trial, -fr.limit, fr.limit);
       }
-      s.harmonics.noalias() = forward * s.clamped;
+      multiply_transposed(forward_t, s.clamped.data(), s.harmonics.data());
       r.segment(o, m()) = fr.c * (z.segment(o, m()) - s.harmonics);
     }
     if (J) jacobian(*J);
@@ -267,8 +342,9 @@ struct Equations {
     Scratch& s = scratch();
     J.setIdentity(size(), size());
     for (int b = 0; b < nj; ++b) {
-      const Eigen::MatrixXd& g = s.g[static_cast<std::size_t>(b)];
-      s.weights.noalias() = trig.transpose().lazyProduct(g.rightCols(2)); // small: no packing
+      const Scratch::Matrix& g = s.g[static_cast<std::size_t>(b)];
+      multiply_transposed(trig, g.col(1).data(), s.weights.col(0).data());
+      multiply_transposed(trig, g.col(2).data(), s.weights.col(1).data());
       s.D.setZero();
       add_product(s.weights.col(0), false, s.D);
       add_product(s.weights.col(1), true, s.D);
@@ -279,15 +355,14 @@ struct Equations {
       const Friction& fr = friction[f];
       const int o = (nj + static_cast<int>(f)) * m(), oy = fr.joint * m();
       for (int a = 0; a < nj; ++a)
-        add_coupling(J, a, fr.joint, o, Eigen::MatrixXd::Identity(m(), m()));
-      // c (I − P_stick) and −c r P'_stick
-      s.weights.col(0).noalias() = trig.transpose() * s.stick[f];
-      s.D.setZero();
-      add_product(s.weights.col(0), false, s.D);
-      J.block(o, o, m(), m()) = fr.c * (Eigen::MatrixXd::Identity(m(), m()) - s.D);
-      s.D.setZero();
-      add_product(s.weights.col(0), true, s.D);
-      J.block(o, oy, m(), m()) = -fr.c * fr.r * s.D;
+        add_coupling_identity(J, a, fr.joint, o);
+      // c (I − P_stick) and −c r P'_stick, both from the one product matrix of the stick mask
+      multiply_transposed(trig, s.stick[f].data(), s.weights.col(0).data());
+      const Scratch::Matrix& E = product_matrix(s.weights.col(0));
+      J.block(o, o, m(), m()) = -fr.c * E; // the identity is J's own
+      J.block(o, o, m(), m()).diagonal().array() += fr.c;
+      J.block(o, oy, m(), m()).setZero();
+      add_rate(E, -fr.c * fr.r, J.block(o, oy, m(), m()));
     }
   }
 
@@ -305,6 +380,70 @@ struct Equations {
       s += std::pow(friction[f].c, 2) *
            z.segment((nj + static_cast<int>(f)) * m(), m()).squaredNorm();
     return std::sqrt(s);
+  }
+};
+
+/// LU factorisation with partial pivoting of a small dense matrix, in place and without
+/// allocating once sized. At the 10–60 unknowns of a harmonic-balance point Eigen's
+/// PartialPivLU spends most of its time in blocking and dispatch (6 500 instructions for an
+/// 11 × 11 matrix, 45 000 for 30 × 30, against n³/3 multiply-adds); this is the textbook
+/// right-looking elimination, column-major, the trailing update a column at a time.
+template <class Scalar> struct SmallLU {
+  using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  Matrix lu;
+  std::vector<int> pivots; // row k was swapped with row pivots[k]
+  double min_pivot = 0.0;  // least |U_kk|: 0 (or rounding level) where the matrix is singular
+
+  template <class Source> void compute(const Source& A) {
+    lu = A;
+    const Eigen::Index n = lu.rows();
+    pivots.resize(static_cast<std::size_t>(n));
+    min_pivot = n > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+    Scalar* a = lu.data();
+    for (Eigen::Index k = 0; k < n; ++k) {
+      Scalar* ck = a + k * n; // column k
+      Eigen::Index p = k;
+      for (Eigen::Index i = k + 1; i < n; ++i)
+        if (std::abs(ck[i]) > std::abs(ck[p])) p = i;
+      pivots[static_cast<std::size_t>(k)] = static_cast<int>(p);
+      if (p != k)
+        for (Eigen::Index j = 0; j < n; ++j)
+          std::swap(a[j * n + k], a[j * n + p]);
+      const Scalar pivot = ck[k];
+      min_pivot = std::min(min_pivot, static_cast<double>(std::abs(pivot)));
+      if (pivot == Scalar(0)) continue; // singular: the column below is already zero
+      const Scalar inverse = Scalar(1) / pivot;
+      for (Eigen::Index i = k + 1; i < n; ++i)
+        ck[i] *= inverse;
+      for (Eigen::Index j = k + 1; j < n; ++j) {
+        Scalar* cj = a + j * n;
+        const Scalar ukj = cj[k];
+        if (ukj == Scalar(0)) continue;
+        for (Eigen::Index i = k + 1; i < n; ++i)
+          cj[i] -= ck[i] * ukj;
+      }
+    }
+  }
+
+  /// b ← A⁻¹ b; only meaningful where min_pivot > 0.
+  template <class Rhs> void solve_in_place(Rhs& b) const {
+    const Eigen::Index n = lu.rows();
+    const Scalar* a = lu.data();
+    for (Eigen::Index k = 0; k < n; ++k) // P b: the swaps in order (L's rows were swapped too)
+      std::swap(b(k), b(pivots[static_cast<std::size_t>(k)]));
+    for (Eigen::Index k = 0; k < n; ++k) { // L y = P b (unit lower triangle), by columns
+      const Scalar bk = b(k);
+      if (bk == Scalar(0)) continue;
+      for (Eigen::Index i = k + 1; i < n; ++i)
+        b(i) -= a[k * n + i] * bk;
+    }
+    for (Eigen::Index k = n - 1; k >= 0; --k) { // U x = y
+      b(k) /= a[k * n + k];
+      const Scalar bk = b(k);
+      for (Eigen::Index i = 0; i < k; ++i)
+        b(i) -= a[k * n + i] * bk;
+    }
   }
 };
 

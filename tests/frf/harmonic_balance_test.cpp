@@ -1,5 +1,6 @@
 // Harmonic balance against the exact linear solution and against time integration.
 #include "frf/harmonic_balance.hpp"
+#include "frf/hb_equations.hpp" // the small LU of the Newton steps
 
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
@@ -9,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 #include <vector>
 
@@ -421,4 +423,40 @@ TEST(HarmonicBalance, RegularisedFrictionFollowsItsLaw) {
   o.exact_friction = true;
   EXPECT_THROW(frf::harmonic_balance(c.H, negative, c.system.dofs, c.eq(7), 80.0, f, outputs, o),
                std::invalid_argument);
+}
+
+// The Newton steps' small LU (frf/hb_equations.hpp): the solution of a system that needs row
+// exchanges equals Eigen's to rounding, real and complex, and a singular matrix shows in its
+// least pivot (Newton then takes the least-norm step).
+TEST(HarmonicBalance, SmallLUSolvesLikeEigensAndShowsASingularMatrix) {
+  std::srand(7);
+  for (const int n : {1, 3, 11, 30}) {
+    Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n);
+    A(0, 0) = 0.0; // row exchange needed at the first column
+    const Eigen::VectorXd b = Eigen::VectorXd::Random(n);
+    frf::detail::SmallLU<double> lu;
+    lu.compute(A);
+    Eigen::VectorXd x = b;
+    lu.solve_in_place(x);
+    const Eigen::VectorXd reference = A.partialPivLu().solve(b);
+    if (n == 1) { // a 1 × 1 zero: singular, nothing to solve
+      EXPECT_EQ(lu.min_pivot, 0.0);
+      continue;
+    }
+    EXPECT_GT(lu.min_pivot, 0.0);
+    EXPECT_LT((x - reference).norm(), 1e-12 * reference.norm()) << "n = " << n;
+    EXPECT_LT((A * x - b).norm(), 1e-12 * A.norm() * x.norm()) << "n = " << n;
+  }
+  const Eigen::MatrixXcd C = Eigen::MatrixXcd::Random(4, 4);
+  const Eigen::VectorXcd c = Eigen::VectorXcd::Random(4);
+  frf::detail::SmallLU<Complex> clu;
+  clu.compute(C);
+  Eigen::VectorXcd y = c;
+  clu.solve_in_place(y);
+  EXPECT_LT((C * y - c).norm(), 1e-12 * C.norm() * y.norm());
+  // Rank 5 of 6: the least pivot is at rounding level against the matrix's size.
+  const Eigen::MatrixXd U = Eigen::MatrixXd::Random(6, 5), V = Eigen::MatrixXd::Random(5, 6);
+  frf::detail::SmallLU<double> singular;
+  singular.compute(U * V);
+  EXPECT_LT(singular.min_pivot, 1e-13 * (U * V).lpNorm<Eigen::Infinity>());
 }
