@@ -3,55 +3,70 @@
 #include "frf/hb_equations.hpp"
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <mutex>
 #include <numbers>
 #include <stdexcept>
+#include <tuple>
 
 namespace jointid::frf {
 
-// The AFT tables that do not depend on ω, for K harmonics and Nt samples θ_n = 2πn / Nt:
-// cos pθ_n and sin pθ_n for p ≤ 2K (Nt × (2K+1), the Jacobian's products), ∂y_n/∂z (Nt × (2K+1)),
-// ∂ẏ_n/∂z / ω, and the forward transform from samples to packed harmonics ((2K+1) × Nt). Kept
-// in a cache: the continuation builds a HarmonicBalance at every frequency it visits, and
-// computing (and allocating) these each time was most of its cost.
+// The AFT tables that do not depend on ω, for K harmonics and Nt samples θ_n = 2πn / Nt over
+// the period, or, half-wave symmetric, the odd harmonics ≤ K and the Nt / 2 samples of the
+// first half: ∂y_n/∂z and ∂ẏ_n/∂z / ω (each Nt × m, and both stacked), the forward transform
+// from samples to packed harmonics (transposed: Nt × m), and cos pθ_n beside sin pθ_n for the p
+// that the products of two harmonics make (the Jacobian's; p ≤ 2K, the even ones only when
+// symmetric). Kept in a cache: the continuation builds a HarmonicBalance at every frequency it
+// visits, and computing (and allocating) these each time was most of its cost.
 struct detail::Tables {
-  Eigen::MatrixXd cos, sin, dy, dv_unit, forward, forward_t, trig;
+  std::vector<int> harmonics;
+  Eigen::MatrixXd dy, dv_unit, dyv_unit, forward_t, trig;
 };
 
 namespace {
 
-const detail::Tables& aft_tables(int Nt, int K) {
+const detail::Tables& aft_tables(int Nt, int K, bool symmetric) {
   static std::mutex mutex;
-  static std::map<std::pair<int, int>, std::unique_ptr<const detail::Tables>> cache;
+  static std::map<std::tuple<int, int, bool>, std::unique_ptr<const detail::Tables>> cache;
   const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{Nt, K}];
+  auto& slot = cache[{Nt, K, symmetric}];
   if (!slot) {
     auto t = std::make_unique<detail::Tables>();
-    const int P = 2 * K, m = 2 * K + 1;
-    t->cos.resize(Nt, P + 1), t->sin.resize(Nt, P + 1);
-    for (int n = 0; n < Nt; ++n)
-      for (int p = 0; p <= P; ++p) { // the angle reduced exactly, p n mod Nt
-        const double a = 2.0 * std::numbers::pi * (static_cast<long long>(p) * n % Nt) / Nt;
-        t->cos(n, p) = std::cos(a), t->sin(n, p) = std::sin(a);
-      }
-    t->dy.resize(Nt, m), t->dv_unit.resize(Nt, m), t->forward.resize(m, Nt);
-    for (int n = 0; n < Nt; ++n) {
-      t->dy(n, 0) = 1.0;
-      t->dv_unit(n, 0) = 0.0;
-      t->forward(0, n) = 1.0 / Nt;
-      for (int k = 1; k <= K; ++k) {
-        const double c = t->cos(n, k), s = t->sin(n, k);
-        t->dy(n, 2 * k - 1) = c, t->dy(n, 2 * k) = -s;
-        t->dv_unit(n, 2 * k - 1) = -k * s, t->dv_unit(n, 2 * k) = -k * c;
-        t->forward(2 * k - 1, n) = 2.0 * c / Nt, t->forward(2 * k, n) = -2.0 * s / Nt;
+    const int step = symmetric ? 2 : 1;
+    for (int k = symmetric ? 1 : 0; k <= K; k += step)
+      t->harmonics.push_back(k);
+    const int n = symmetric ? Nt / 2 : Nt; // the samples kept (Nt is even when symmetric)
+    const int count = static_cast<int>(t->harmonics.size());
+    const int m = 2 * count - (symmetric ? 0 : 1);
+    // the angle p θ_n reduced exactly, p n mod Nt
+    auto angle = [Nt](long long p, int i) { return 2.0 * std::numbers::pi * (p * i % Nt) / Nt; };
+    t->dy.resize(n, m), t->dv_unit.resize(n, m), t->forward_t.resize(n, m);
+    for (int i = 0; i < n; ++i) {
+      int c = 0;
+      for (const int k : t->harmonics) {
+        if (k == 0) {
+          t->dy(i, 0) = 1.0, t->dv_unit(i, 0) = 0.0, t->forward_t(i, 0) = 1.0 / n;
+          c = 1;
+          continue;
+        }
+        const double co = std::cos(angle(k, i)), si = std::sin(angle(k, i));
+        t->dy(i, c) = co, t->dy(i, c + 1) = -si;
+        t->dv_unit(i, c) = -k * si, t->dv_unit(i, c + 1) = -k * co;
+        t->forward_t(i, c) = 2.0 * co / n, t->forward_t(i, c + 1) = -2.0 * si / n;
+        c += 2;
       }
     }
-    t->forward_t = t->forward.transpose();
-    t->trig.resize(Nt, 2 * m);
-    t->trig << t->cos, t->sin;
+    t->dyv_unit.resize(2 * n, m);
+    t->dyv_unit << t->dy, t->dv_unit;
+    const int np = 2 * t->harmonics.back() / step + 1; // p = 0, step, … 2 max(harmonics)
+    t->trig.resize(n, 2 * np);
+    for (int i = 0; i < n; ++i)
+      for (int q = 0; q < np; ++q)
+        t->trig(i, q) = std::cos(angle(step * q, i)),
+                   t->trig(i, np + q) = std::sin(angle(step * q, i));
     slot = std::move(t);
   }
   return *slot;
@@ -66,14 +81,22 @@ using detail::two_pi;
 bool detail::newton(const Equations& P, Eigen::VectorXd& z, double load,
                     const HarmonicBalanceOptions& o, int& iterations, double& res_norm) {
   const int n = P.size();
-  // Work arrays kept per thread (newton does not call itself): sizing them is free from the
-  // second call on, and a sweep solves thousands of points of the same size.
+  // Work arrays kept per thread and per size (newton does not call itself): sizing them is
+  // free from the second call on. A point solves two sizes (the first guess's fundamental-only
+  // problem, then the full one) and a sweep thousands of points of the same sizes.
   struct Work {
+    int n = -1;
     Eigen::MatrixXd J;
     Eigen::VectorXd r, step, zt, rt;
     SmallLU<double> lu;
   };
-  thread_local Work work;
+  thread_local std::array<Work, 4> works;
+  thread_local std::size_t next = 0;
+  Work* found = nullptr;
+  for (Work& w : works)
+    if (w.n == n) found = &w;
+  if (!found) found = &works[next], next = (next + 1) % works.size(), found->n = n;
+  Work& work = *found;
   Eigen::MatrixXd& J = work.J;
   Eigen::VectorXd &r = work.r, &step = work.step, &zt = work.zt, &rt = work.rt;
   SmallLU<double>& lu = work.lu;
@@ -159,15 +182,11 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   omega_ = two_pi * frequency_hz;
   for (const auto& j : joints)
     layout_.push_back({j.node, j.node_b, j.dof});
-  tables_ = &aft_tables(Nt_, K_);
-  dv_ = omega_ * tables_->dv_unit;
-  dyv_.resize(2 * Nt_, 2 * K_ + 1);
-  dyv_ << tables_->dy, dv_;
+  tables_[0] = &aft_tables(Nt_, K_, false);
+  if (o.half_wave_symmetry) tables_[1] = &aft_tables(Nt_ + Nt_ % 2, K_, true);
   if (K_ > 1) { // the first guess's fundamental-only problem
-    coarse_tables_ = &aft_tables(coarse_samples, 1);
-    dv1_ = omega_ * coarse_tables_->dv_unit;
-    dyv1_.resize(2 * coarse_samples, 3);
-    dyv1_ << coarse_tables_->dy, dv1_;
+    coarse_tables_[0] = &aft_tables(coarse_samples, 1, false);
+    if (o.half_wave_symmetry) coarse_tables_[1] = &aft_tables(coarse_samples, 1, true);
   }
   // Joint DOFs (node and node_b) and the B matrix restricted to them.
   const std::vector<int> jdofs = joints::joint_dof_set(joints, dofs);
@@ -176,33 +195,38 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   // Grounded joints, each on a DOF of its own, in order (the common case): B = I and the
   // blocks are the receptance's own.
   const bool identity = B_real.rows() == B_real.cols() && B_real.isIdentity(0.0);
-  // One receptance per harmonic, rows (joint DOFs, outputs) × columns (joint DOFs, forces),
+  // The receptances at the harmonics, rows (joint DOFs, outputs) × columns (joint DOFs, forces),
   // cut into the four blocks.
   std::vector<int> rows = jdofs, cols = jdofs;
   rows.insert(rows.end(), outputs.begin(), outputs.end());
   cols.insert(cols.end(), force_equations.begin(), force_equations.end());
   const auto nd = static_cast<Eigen::Index>(jdofs.size());
   const auto no = static_cast<Eigen::Index>(outputs.size()), nf = static_cast<Eigen::Index>(nf_);
-  for (auto* blocks : {&Hyy_, &HyF_, &HoB_, &HoF_})
-    blocks->reserve(static_cast<std::size_t>(K_ + 1));
+  const auto nc = static_cast<Eigen::Index>(cols.size());
+  std::vector<double> omegas(static_cast<std::size_t>(K_ + 1));
+  for (int k = 0; k <= K_; ++k)
+    omegas[static_cast<std::size_t>(k)] = k * omega_;
+  const CMatrix R = H.receptances(omegas, rows, cols);
+  Hyy_.resize(nj_, nj_, K_), HyF_.resize(nj_, nf, K_), HoB_.resize(no, nj_, K_);
+  HoF_.resize(no, nf, K_);
   for (int k = 0; k <= K_; ++k) {
-    const CMatrix R = H.receptance(k * omega_, rows, cols);
+    const auto Rk = R.middleCols(k * nc, nc);
     if (identity) {
-      Hyy_.emplace_back(R.topLeftCorner(nd, nd));
-      HyF_.emplace_back(R.topRightCorner(nd, nf));
-      HoB_.emplace_back(R.bottomLeftCorner(no, nd));
+      Hyy_[k] = Rk.topLeftCorner(nd, nd);
+      HyF_[k] = Rk.topRightCorner(nd, nf);
+      HoB_[k] = Rk.bottomLeftCorner(no, nd);
     } else {
-      Hyy_.emplace_back(B.transpose() * R.topLeftCorner(nd, nd) * B);
-      HyF_.emplace_back(B.transpose() * R.topRightCorner(nd, nf));
-      HoB_.emplace_back(R.bottomLeftCorner(no, nd) * B);
+      Hyy_[k] = B.transpose() * Rk.topLeftCorner(nd, nd) * B;
+      HyF_[k] = B.transpose() * Rk.topRightCorner(nd, nf);
+      HoB_[k] = Rk.bottomLeftCorner(no, nd) * B;
     }
-    HoF_.emplace_back(R.bottomRightCorner(no, nf));
+    HoF_[k] = Rk.bottomRightCorner(no, nf);
   }
 }
 
 std::unique_ptr<detail::Equations>
-HarmonicBalance::equations(const std::vector<joints::Joint>& joints,
-                           const Eigen::MatrixXcd& F) const {
+HarmonicBalance::equations(const std::vector<joints::Joint>& joints, const Eigen::MatrixXcd& F,
+                           const Eigen::MatrixXcd* start) const {
   if (static_cast<int>(joints.size()) != nj_)
     throw std::invalid_argument("harmonic balance: the joints differ from the layout");
   for (int j = 0; j < nj_; ++j)
@@ -225,6 +249,22 @@ HarmonicBalance::equations(const std::vector<joints::Joint>& joints,
         h += HyF_[k](j, f) * Fk(k, f);
       HyF_F(k, j) = h;
     }
+  // Half-wave symmetric (odd harmonics only) when every joint force is odd, the force has no
+  // mean or even harmonics, and the start (if any) has none beyond rounding: an asymmetric start
+  // may lead to an asymmetric steady state (a symmetry-breaking bifurcation), which the odd
+  // harmonics cannot hold.
+  bool symmetric = options_.half_wave_symmetry;
+  for (int k = 0; k <= K_ && symmetric; k += 2)
+    symmetric = Fk.row(k).isZero(0.0);
+  if (start && symmetric && start->size() > 0) {
+    const double rounding = 1e-12 * start->cwiseAbs().maxCoeff();
+    for (Eigen::Index k = 0; k < start->rows() && symmetric; k += 2)
+      symmetric = start->row(k).cwiseAbs().maxCoeff() <= rounding;
+  }
+  for (const joints::Joint& j : joints)
+    for (std::size_t t = 0; t < j.terms.size() && symmetric; ++t)
+      symmetric = !joints::term_info(j.terms[t]).even || j.values[t] == 0.0;
+  const detail::Tables& tables = *tables_[symmetric ? 1 : 0];
   const bool exact = options_.exact_friction;
   std::vector<Friction> friction;
   for (int j = 0; j < nj_; ++j) {
@@ -240,10 +280,10 @@ HarmonicBalance::equations(const std::vector<joints::Joint>& joints,
     const double c = std::max(std::abs(Hyy_[1](j, j)), 1e-300);
     friction.push_back({j, limit, 1.0 / (omega_ * c), c});
   }
-  return std::make_unique<Equations>(
-      Equations{K_, nj_, Nt_, Hyy_, std::move(HyF_F), std::move(Fk), joints,
-                exact ? 0.0 : options_.friction_width, std::move(friction), tables_->dy, dv_, dyv_,
-                tables_->forward, tables_->forward_t, tables_->trig, omega_});
+  return std::make_unique<Equations>(Equations{
+      K_, nj_, static_cast<int>(tables.dy.rows()), tables.harmonics, Hyy_, std::move(HyF_F),
+      std::move(Fk), joints, exact ? 0.0 : options_.friction_width, std::move(friction), tables.dy,
+      tables.dv_unit, tables.dyv_unit, tables.forward_t, tables.trig, omega_});
 }
 
 namespace {
@@ -264,7 +304,7 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
     CMatrix D(nj, nj);
     CVector y(nj);
     detail::SmallLU<Complex> lu;
-    for (int k = 0; k <= K; ++k) {
+    for (const int k : P.harmonics) {
       D.setIdentity();
       for (int j = 0; j < nj; ++j) {
         Complex lin = 0.0;
@@ -294,7 +334,8 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
   // cantilever with fc = 3 N).
   if (!friction.empty()) {
     const Eigen::MatrixXcd Y = P.unpack(z, nj), G = P.forces(z);
-    for (int k = 0; k <= K && start; ++k) {
+    for (std::size_t i = 0; i < P.harmonics.size() && start; ++i) {
+      const int k = P.harmonics[i];
       const CVector need = P.Hyy[k].fullPivLu().solve((P.HyF_F.row(k) - Y.row(k)).transpose()) -
                            G.row(k).transpose();
       for (std::size_t f = 0; f < friction.size(); ++f) {
@@ -303,12 +344,13 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
         P.pack(L, z, nj + static_cast<int>(f));
       }
     }
+    Eigen::VectorXd v(P.Nt), slip(P.Nt); // ẏ / ω and the slip force
     for (std::size_t f = 0; f < friction.size() && !start; ++f) {
-      const Eigen::VectorXd v = P.dv * z.segment(friction[f].joint * m, m);
-      Eigen::VectorXd slip(P.Nt);
+      detail::multiply(P.dv_unit, z.data() + friction[f].joint * m, v.data());
       for (int n = 0; n < P.Nt; ++n)
         slip(n) = v(n) > 0.0 ? friction[f].limit : v(n) < 0.0 ? -friction[f].limit : 0.0;
-      z.segment((nj + static_cast<int>(f)) * m, m) = P.forward * slip;
+      detail::multiply_transposed(P.forward_t, slip.data(),
+                                  z.data() + (nj + static_cast<int>(f)) * m);
     }
   }
   return z;
@@ -324,13 +366,14 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
   // one where the linear response can be off by an order of magnitude (a cubic spring near
   // resonance: 77 mm linear, 8.4 mm at K = 1 and K = 5 on the paper's cantilever at 4 Hz,
   // 80 N), so the full problem needs 3–4 Newton iterations instead of 11. Its iterations are
-  // cheap (3 unknowns a joint, 16 samples; to 1e-6). If it fails, the linear response is the
+  // cheap (3 unknowns a joint, 16 samples; to 1e-3). If it fails, the linear response is the
   // guess.
   // (Hyy_ serves as is: the equations read its harmonics 0 and 1 only.)
-  const detail::Tables& t1 = *coarse_tables_;
+  const detail::Tables& t1 = *coarse_tables_[P.symmetric() ? 1 : 0];
   const Equations P1{1,
                      nj_,
-                     coarse_samples,
+                     static_cast<int>(t1.dy.rows()),
+                     t1.harmonics,
                      Hyy_,
                      P.HyF_F.topRows(2),
                      P.Fk.topRows(2),
@@ -338,9 +381,8 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
                      P.width,
                      P.friction,
                      t1.dy,
-                     dv1_,
-                     dyv1_,
-                     t1.forward,
+                     t1.dv_unit,
+                     t1.dyv_unit,
                      t1.forward_t,
                      t1.trig,
                      omega_};
@@ -369,7 +411,9 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
   int iterations = 0;
   double residual = 0.0;
   HarmonicBalanceOptions coarse = options_;
-  coarse.tolerance = std::max(options_.tolerance, 1e-6); // a start: the full Newton refines it
+  // A start only: it differs from the full solution by the harmonics it omits (per cent), so
+  // resolving it beyond 1e-3 buys the full Newton nothing.
+  coarse.tolerance = std::max(options_.tolerance, 1e-3);
   if (!detail::newton(P1, z1, 1.0, coarse, iterations, residual)) return start_from(P, nullptr);
   Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K_ + 1, nj_);
   Y.topRows(2) = P1.unpack(z1, nj_);
@@ -382,7 +426,7 @@ HarmonicBalanceResult HarmonicBalance::result(const detail::Equations& P,
   out.frequency_hz = frequency_hz_;
   out.Y = P.unpack(z, nj_);
   out.G = P.forces(z);
-  const Eigen::Index no = HoB_.empty() ? 0 : HoB_[0].rows();
+  const Eigen::Index no = HoB_.data.rows();
   out.X.resize(K_ + 1, no);
   for (int k = 0; k <= K_; ++k)
     for (Eigen::Index o = 0; o < no; ++o) { // H_of F − H_oy G, without temporaries
@@ -399,7 +443,7 @@ HarmonicBalanceResult HarmonicBalance::result(const detail::Equations& P,
 HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& joints,
                                              const Eigen::MatrixXcd& F,
                                              const Eigen::MatrixXcd* start) const {
-  const std::unique_ptr<Equations> P = equations(joints, F);
+  const std::unique_ptr<Equations> P = equations(joints, F, start);
   Eigen::VectorXd z = first_guess(*P, start);
   const Eigen::VectorXd z_start = z;
   int iterations = 0;

@@ -17,6 +17,7 @@
 #include "frf/receptance.hpp"
 #include "joints/joint.hpp"
 
+#include <array>
 #include <memory>
 #include <string>
 
@@ -25,6 +26,17 @@ namespace jointid::frf {
 namespace detail {
 struct Equations; // frf/hb_equations.hpp, internal
 struct Tables;    // frf/harmonic_balance.cpp: AFT sample tables, shared by (K, samples)
+
+/// A matrix per harmonic k = 0 … K, side by side in one allocation: [k] is harmonic k's.
+struct HarmonicBlocks {
+  CMatrix data; // rows × cols (K + 1)
+  Eigen::Index cols = 0;
+  void resize(Eigen::Index rows, Eigen::Index columns, int K) {
+    data.resize(rows, columns * (K + 1)), cols = columns;
+  }
+  auto operator[](int k) { return data.middleCols(k * cols, cols); }
+  auto operator[](int k) const { return data.middleCols(k * cols, cols); }
+};
 } // namespace detail
 
 struct HarmonicBalanceOptions {
@@ -35,6 +47,17 @@ struct HarmonicBalanceOptions {
   double tolerance = 1e-12;     ///< on the residual, relative to |Y|
   int max_iterations = 60;
   int continuation_steps = 20; ///< amplitude steps tried when the direct solve fails
+  /// Solve for the odd harmonics only, sampling half the period, where the steady state is
+  /// half-wave symmetric, x(t + T/2) = −x(t): when every joint force is odd, g(−y, −ẏ) =
+  /// −g(y, ẏ) (every term but k2, or k2 = 0), and the force has no mean and no even harmonics.
+  /// The even harmonics are then exactly 0 in the results. From the default start Newton's
+  /// iterates never leave that subspace anyway (they agree to rounding, with Nt even); this
+  /// halves the unknowns and the samples. A start with even harmonics (beyond 1e-12 of its
+  /// largest) is solved with all harmonics: such a system can have asymmetric steady states
+  /// besides the symmetric one (a symmetry-breaking bifurcation; the paper's cantilever with a
+  /// hardening joint at 3 Hz, 100 N has one, stable where the symmetric one is not), and the
+  /// start says which is wanted. Off: all harmonics always.
+  bool half_wave_symmetry = true;
 };
 
 struct HarmonicBalanceResult {
@@ -82,8 +105,11 @@ public:
   /// Low level, for the frequency continuation: the equations R(z) = 0 for these joints and
   /// force (they refer to `joints` and to this object, which must outlive them), the packed
   /// first guess, and the result for a solution z.
+  /// `start`, if given, is the start first_guess() will be given: with even harmonics (beyond
+  /// rounding) the equations hold all harmonics even where the joints and force are odd.
   std::unique_ptr<detail::Equations> equations(const std::vector<joints::Joint>& joints,
-                                               const Eigen::MatrixXcd& F) const;
+                                               const Eigen::MatrixXcd& F,
+                                               const Eigen::MatrixXcd* start = nullptr) const;
   Eigen::VectorXd first_guess(const detail::Equations& equations,
                               const Eigen::MatrixXcd* start) const;
   HarmonicBalanceResult result(const detail::Equations& equations, const Eigen::VectorXd& z) const;
@@ -97,14 +123,13 @@ private:
   HarmonicBalanceOptions options_;
   int K_, nj_, nf_, Nt_;
   double omega_, frequency_hz_;
-  std::vector<CMatrix> Hyy_, HyF_, HoB_, HoF_; // per harmonic
-  const detail::Tables* tables_ = nullptr;     // AFT sample tables independent of ω (cached)
-  Eigen::MatrixXd dv_;                         // ∂ẏ_n/∂z at this ω
-  Eigen::MatrixXd dyv_;                        // ∂y_n/∂z over ∂ẏ_n/∂z
+  detail::HarmonicBlocks Hyy_, HyF_, HoB_, HoF_; // per harmonic
+  // AFT sample tables independent of ω (cached): all harmonics, and the half-wave symmetric
+  // problem's (odd harmonics, half the period) when options.half_wave_symmetry.
+  std::array<const detail::Tables*, 2> tables_{};
   // The same for the first guess's problem with the fundamental alone (K = 1), when K > 1.
   static constexpr int coarse_samples = 16;
-  const detail::Tables* coarse_tables_ = nullptr;
-  Eigen::MatrixXd dv1_, dyv1_;
+  std::array<const detail::Tables*, 2> coarse_tables_{};
 };
 
 /// One steady state under F0 sin(2π f t) at `force_equation`.

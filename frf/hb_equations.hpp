@@ -85,26 +85,41 @@ struct Friction {
   double limit, r, c;
 };
 
-// The equations of one solve. Unknowns z: per joint j, at offset j (2K + 1), Re Y_0, then
-// Re Y_k, Im Y_k for k = 1 … K; then per friction joint f, at offset (nj + f)(2K + 1), its
-// force harmonics Λ packed the same way (N). residual() works in scratch arrays of its own
-// (sized once): a Newton iteration allocates nothing, and one Equations serves one thread.
+// The equations of one solve. The harmonics solved for are `harmonics` (ascending): 0 … K, or,
+// for a half-wave symmetric problem, the odd ones 1, 3, … ≤ K (the even ones are then exactly
+// zero and are not unknowns). Unknowns z: per joint j, at offset j m(), Re Y_0 if the mean is
+// solved for, then Re Y_k, Im Y_k for each other harmonic k; then per friction joint f, at
+// offset (nj + f) m(), its force harmonics Λ packed the same way (N). The time samples are
+// θ_n = 2πn / Nt over the period, or over its first half (n < Nt, Nt the half period's count)
+// for a symmetric problem: y(θ + π) = −y(θ), and the sums over half the period are the period's
+// for the harmonics that occur. residual() works in scratch arrays of its own (sized once): a
+// Newton iteration allocates nothing, and one Equations serves one thread.
 struct Equations {
-  int K, nj, Nt;
-  const std::vector<CMatrix>& Hyy;
-  CMatrix HyF_F; // (K+1) × nj: H_yf(kω) F_k, the joints' response to the force alone
-  CMatrix Fk;    // (K+1) × n_forces: the force harmonics
+  int K, nj, Nt; // K: the results' harmonics 0 … K; Nt: the samples kept
+  const std::vector<int>& harmonics;
+  const HarmonicBlocks& Hyy; // per harmonic 0 … K
+  CMatrix HyF_F;             // (K+1) × nj: H_yf(kω) F_k, the joints' response to the force alone
+  CMatrix Fk;                // (K+1) × n_forces: the force harmonics
   const std::vector<joints::Joint>& joints;
   double width; // 0: friction exact
   std::vector<Friction> friction;
-  // Per sample n: ∂y_n/∂z and ∂ẏ_n/∂z of one joint (Nt × (2K+1)), both stacked (2Nt × (2K+1),
-  // one product gives y and ẏ), and the forward transform from samples to packed harmonics
-  // ((2K+1) × Nt).
-  const Eigen::MatrixXd &dy, &dv, &dyv, &forward;
-  const Eigen::MatrixXd& forward_t; // forwardᵀ (Nt × (2K+1)): its rows as contiguous columns
-  // cos(pθ_n) beside sin(pθ_n), p = 0 … 2K (Nt × (4K+2)): the harmonics of sample weights.
+  // Per sample n: ∂y_n/∂z and ∂ẏ_n/∂z / ω of one joint (Nt × m()), both stacked (2Nt × m(),
+  // one product gives y and ẏ / ω), and the forward transform from samples to packed
+  // harmonics, transposed (Nt × m(): its rows as contiguous columns).
+  const Eigen::MatrixXd &dy, &dv_unit, &dyv_unit, &forward_t;
+  // cos(pθ_n) beside sin(pθ_n) for the p = 0, s, 2s, … 2 max(harmonics) that products of two
+  // harmonics make (s = 1, or 2 when symmetric): the harmonics of sample weights.
   const Eigen::MatrixXd& trig;
   double omega;
+
+  bool symmetric() const { return harmonics.front() != 0; }
+  int count() const { return static_cast<int>(harmonics.size()); }
+  int m() const { return 2 * count() - (symmetric() ? 0 : 1); }
+  int size() const { return (nj + static_cast<int>(friction.size())) * m(); }
+  // Offset in a block of the real part of harmonics[i] (its imaginary part follows); i ≥ 1
+  // when the mean is solved for (the mean, at 0, has no imaginary part).
+  int at(int i) const { return symmetric() ? 2 * i : 2 * i - 1; }
+  int first() const { return symmetric() ? 0 : 1; } // the first index i with an imaginary part
 
   // Work arrays of residual() and jacobian(), views into one buffer (one allocation per
   // Equations: at a harmonic-balance point of a few µs the allocator was a fifth of the time).
@@ -118,7 +133,7 @@ struct Equations {
     // per friction joint, 1 where a sample sticks (Nt). jacobian() reads them.
     std::vector<Matrix> g;
     std::vector<Vector> stick;
-    Matrix weights{nullptr, 0, 0}; // (4K+2) × 2: cos and sin sums of the columns ∂g/∂y, ∂g/∂ẏ
+    Matrix weights{nullptr, 0, 0}; // trig.cols() × 2: cos and sin sums of ∂g/∂y, ∂g/∂ẏ
     Matrix E{nullptr, 0, 0}, D{nullptr, 0, 0};
     Vector w{nullptr, 0}; // the weight's harmonics −2K … 2K, real parts then imaginary
     Eigen::MatrixXcd G;   // (K+1) × nj: the joint forces' harmonics
@@ -133,8 +148,9 @@ struct Equations {
     Scratch& w = work;
     if (w.yv.size() == 2 * Nt) return w;
     const Eigen::Index n = Nt, M = m(), nf = static_cast<Eigen::Index>(friction.size());
-    w.buffer.assign(static_cast<std::size_t>(2 * n + M + 2 * n + nj * 3 * n + nf * n + 4 * M +
-                                             2 * M * M + 2 * (2 * M - 1)),
+    const Eigen::Index nw = 4 * K + 1, nt = trig.cols();
+    w.buffer.assign(static_cast<std::size_t>(2 * n + M + 2 * n + nj * 3 * n + nf * n + 2 * nt +
+                                             2 * M * M + 2 * nw),
                     0.0);
     double* at = w.buffer.data();
     auto take = [&at](Eigen::Index size) {
@@ -151,17 +167,17 @@ struct Equations {
       w.g.emplace_back(take(3 * n), n, 3);
     for (Eigen::Index f = 0; f < nf; ++f)
       w.stick.emplace_back(take(n), n);
-    new (&w.weights) Scratch::Matrix(take(4 * M), 2 * M, 2);
+    new (&w.weights) Scratch::Matrix(take(2 * nt), nt, 2);
     new (&w.E) Scratch::Matrix(take(M * M), M, M);
     new (&w.D) Scratch::Matrix(take(M * M), M, M);
-    new (&w.w) Scratch::Vector(take(2 * (2 * M - 1)), 2 * (2 * M - 1));
-    w.G.resize(K + 1, nj);
+    new (&w.w) Scratch::Vector(take(2 * nw), 2 * nw);
+    w.G.setZero(K + 1, nj);
     return w;
   }
 
   // D += forward · diag(w) · dy (rate = false) or forward · diag(w) · dv (rate = true): the
   // derivative of the harmonics of a signal w(t) y(t) or w(t) ẏ(t) with respect to the packed
-  // harmonics of y, from the harmonics W_p = (1/Nt) Σ w(θ_n) e^{−ipθ_n}, p ≤ 2K, of the weights
+  // harmonics of y, from the harmonics W_p = (1/Nt) Σ w(θ_n) e^{−ipθ_n} of the weights
   // (product-to-sum: a product of harmonics j and k has harmonics k ± j). O(Nt K + K²) instead
   // of O(Nt K²). `sums` = trigᵀ w, the column of the weight's cosine and sine sums.
   template <class Sums, class Out> void add_product(const Sums& sums, bool rate, Out& D) const {
@@ -171,34 +187,45 @@ struct Equations {
     else
       D += E;
   }
-  // E: the derivative for w(t) y(t) alone (the scratch's E), from the weight's sums.
+  // E: the derivative for w(t) y(t) alone (the scratch's E), from the weight's sums. When
+  // symmetric, the weight (∂g/∂y, ∂g/∂ẏ of an odd force, a stick mask) has even harmonics
+  // only, and so k ± j is for odd k and j.
   template <class Sums> const Scratch::Matrix& product_matrix(const Sums& sums) const {
     Scratch& s = scratch();
+    const Eigen::Index np = trig.cols() / 2; // the p tabulated
+    const int step = symmetric() ? 2 : 1;
     const double* cs = sums.data();
-    const double* sn = cs + m();
+    const double* sn = cs + np;
     const double scale = 1.0 / Nt;
-    // W_p = Re + i Im for p = −2K … 2K, tabulated (re[p + 2K], im[p + 2K]).
+    // W_p = Re + i Im for p = −2K … 2K (the multiples of step), tabulated (re[p + 2K], im[…]).
     double* re = s.w.data();
     double* im = re + (4 * K + 1);
-    for (int p = 0; p <= 2 * K; ++p) {
-      re[2 * K + p] = re[2 * K - p] = scale * cs[p];
-      im[2 * K + p] = -scale * sn[p], im[2 * K - p] = scale * sn[p];
+    for (Eigen::Index q = 0; q < np; ++q) {
+      const Eigen::Index p = step * q;
+      re[2 * K + p] = re[2 * K - p] = scale * cs[q];
+      im[2 * K + p] = -scale * sn[q], im[2 * K - p] = scale * sn[q];
     }
     auto Re = [&](int p) { return re[2 * K + p]; };
     auto Im = [&](int p) { return im[2 * K + p]; };
     // The columns of y's own harmonics: 0, cos jθ, −sin jθ.
     Scratch::Matrix& E = s.E;
-    E(0, 0) = Re(0);
-    for (int j = 1; j <= K; ++j)
-      E(0, 2 * j - 1) = Re(j), E(0, 2 * j) = Im(j);
-    for (int k = 1; k <= K; ++k) {
-      E(2 * k - 1, 0) = 2.0 * Re(k);
-      E(2 * k, 0) = 2.0 * Im(k);
-      for (int j = 1; j <= K; ++j) {
-        E(2 * k - 1, 2 * j - 1) = Re(k - j) + Re(k + j);
-        E(2 * k - 1, 2 * j) = Im(k + j) - Im(k - j);
-        E(2 * k, 2 * j - 1) = Im(k + j) + Im(k - j);
-        E(2 * k, 2 * j) = Re(k - j) - Re(k + j);
+    const int i0 = first(), n = count();
+    if (i0 == 1) { // the mean's row and column
+      E(0, 0) = Re(0);
+      for (int b = 1; b < n; ++b) {
+        const int j = harmonics[b];
+        E(0, at(b)) = Re(j), E(0, at(b) + 1) = Im(j);
+        E(at(b), 0) = 2.0 * Re(j), E(at(b) + 1, 0) = 2.0 * Im(j);
+      }
+    }
+    for (int a = i0; a < n; ++a) {
+      const int k = harmonics[a], r = at(a);
+      for (int b = i0; b < n; ++b) {
+        const int j = harmonics[b], c = at(b);
+        E(r, c) = Re(k - j) + Re(k + j);
+        E(r, c + 1) = Im(k + j) - Im(k - j);
+        E(r + 1, c) = Im(k + j) + Im(k - j);
+        E(r + 1, c + 1) = Re(k - j) - Re(k + j);
       }
     }
     return E;
@@ -206,60 +233,68 @@ struct Equations {
   // D += factor · (E for w(t) ẏ(t)): ẏ's columns from y's, d/dt cos jθ = jω (−sin jθ),
   // d/dt (−sin jθ) = −jω cos jθ; the mean has no rate.
   template <class Out> void add_rate(const Scratch::Matrix& E, double factor, Out&& D) const {
-    for (int j = 1; j <= K; ++j) {
-      D.col(2 * j - 1) += (factor * j * omega) * E.col(2 * j);
-      D.col(2 * j) -= (factor * j * omega) * E.col(2 * j - 1);
+    for (int b = first(); b < count(); ++b) {
+      const double f = factor * harmonics[b] * omega;
+      const int c = at(b);
+      D.col(c) += f * E.col(c + 1);
+      D.col(c + 1) -= f * E.col(c);
     }
   }
 
-  int m() const { return 2 * K + 1; }
-  int size() const { return (nj + static_cast<int>(friction.size())) * m(); }
-
-  Eigen::MatrixXcd unpack(const Eigen::VectorXd& z, int blocks, int first = 0) const {
-    Eigen::MatrixXcd Y(K + 1, blocks);
+  Eigen::MatrixXcd unpack(const Eigen::VectorXd& z, int blocks, int offset = 0) const {
+    Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K + 1, blocks);
     for (int j = 0; j < blocks; ++j) {
-      const int o = (first + j) * m();
-      Y(0, j) = z(o);
-      for (int k = 1; k <= K; ++k)
-        Y(k, j) = Complex(z(o + 2 * k - 1), z(o + 2 * k));
+      const int o = (offset + j) * m();
+      if (!symmetric()) Y(0, j) = z(o);
+      for (int i = first(); i < count(); ++i)
+        Y(harmonics[i], j) = Complex(z(o + at(i)), z(o + at(i) + 1));
     }
     return Y;
   }
-  void pack(const Eigen::MatrixXcd& Y, Eigen::VectorXd& z, int first = 0) const {
+  void pack(const Eigen::MatrixXcd& Y, Eigen::VectorXd& z, int offset = 0) const {
     for (int j = 0; j < Y.cols(); ++j) {
-      const int o = (first + j) * m();
-      z(o) = Y(0, j).real();
-      for (int k = 1; k <= K; ++k)
-        z(o + 2 * k - 1) = Y(k, j).real(), z(o + 2 * k) = Y(k, j).imag();
+      const int o = (offset + j) * m();
+      if (!symmetric()) z(o) = Y(0, j).real();
+      for (int i = first(); i < count(); ++i) {
+        const Complex y = Y(harmonics[i], j);
+        z(o + at(i)) = y.real(), z(o + at(i) + 1) = y.imag();
+      }
     }
   }
 
+  // y and ẏ at the samples (2 Nt: y, then ẏ) from the packed harmonics `x` of one block.
+  void samples(const double* x, double* yv) const {
+    multiply(dyv_unit, x, yv);
+    for (int n = Nt; n < 2 * Nt; ++n)
+      yv[n] *= omega;
+  }
+
   // Packed harmonics of joint j's smooth force (m) at z; its samples are kept for jacobian().
-  void smooth_force(const Eigen::VectorXd& z, int j, double* harmonics) const {
+  void smooth_force(const Eigen::VectorXd& z, int j, double* harmonics_out) const {
     Scratch& s = scratch();
     Scratch::Matrix& g = s.g[static_cast<std::size_t>(j)];
-    multiply(dyv, z.data() + j * m(), s.yv.data());
+    samples(z.data() + j * m(), s.yv.data());
     g.setZero();
     add_joint_forces(joints[j], s.yv.data(), s.yv.data() + Nt, Nt, width, g);
-    multiply_transposed(forward_t, g.data(), harmonics);
+    multiply_transposed(forward_t, g.data(), harmonics_out);
   }
 
   // Harmonics of the joints' forces (K+1) × nj at z, into G: the smooth forces (their samples
   // kept for jacobian()) and the exact friction forces (unknowns).
   void force_harmonics(const Eigen::VectorXd& z, Eigen::MatrixXcd& G) const {
     Scratch& s = scratch();
-    G.resize(K + 1, nj);
+    G.setZero(K + 1, nj);
     for (int j = 0; j < nj; ++j) {
       smooth_force(z, j, s.harmonics.data());
-      G(0, j) = s.harmonics(0);
-      for (int k = 1; k <= K; ++k)
-        G(k, j) = Complex(s.harmonics(2 * k - 1), s.harmonics(2 * k));
+      if (!symmetric()) G(0, j) = s.harmonics(0);
+      for (int i = first(); i < count(); ++i)
+        G(harmonics[i], j) = Complex(s.harmonics(at(i)), s.harmonics(at(i) + 1));
     }
     for (std::size_t f = 0; f < friction.size(); ++f) {
       const int o = (nj + static_cast<int>(f)) * m(), j = friction[f].joint;
-      G(0, j) += z(o);
-      for (int k = 1; k <= K; ++k)
-        G(k, j) += Complex(z(o + 2 * k - 1), z(o + 2 * k));
+      if (!symmetric()) G(0, j) += z(o);
+      for (int i = first(); i < count(); ++i)
+        G(harmonics[i], j) += Complex(z(o + at(i)), z(o + at(i) + 1));
     }
   }
   Eigen::MatrixXcd forces(const Eigen::VectorXd& z) const {
@@ -272,26 +307,26 @@ struct Equations {
   // joint a, columns `col`.
   template <class Block>
   void add_coupling(Eigen::MatrixXd& J, int a, int b, int col, const Block& d) const {
-    for (int k = 0; k <= K; ++k) {
-      const Complex h = Hyy[k](a, b);
-      if (k == 0) { // the mean is real
-        J.block(a * m(), col, 1, m()) += h.real() * d.row(0);
-        continue;
-      }
-      const auto re = d.row(2 * k - 1), im = d.row(2 * k);
-      J.block(a * m() + 2 * k - 1, col, 1, m()) += h.real() * re - h.imag() * im;
-      J.block(a * m() + 2 * k, col, 1, m()) += h.imag() * re + h.real() * im;
+    const int o = a * m();
+    if (!symmetric()) // the mean is real
+      J.block(o, col, 1, m()) += Hyy[0](a, b).real() * d.row(0);
+    for (int i = first(); i < count(); ++i) {
+      const Complex h = Hyy[harmonics[i]](a, b);
+      const auto re = d.row(at(i)), im = d.row(at(i) + 1);
+      J.block(o + at(i), col, 1, m()) += h.real() * re - h.imag() * im;
+      J.block(o + at(i) + 1, col, 1, m()) += h.imag() * re + h.real() * im;
     }
   }
 
   // The same for d = I (a friction joint's force unknowns enter its harmonics as they are).
   void add_coupling_identity(Eigen::MatrixXd& J, int a, int b, int col) const {
     const int r = a * m();
-    J(r, col) += Hyy[0](a, b).real();
-    for (int k = 1; k <= K; ++k) {
-      const Complex h = Hyy[k](a, b);
-      J(r + 2 * k - 1, col + 2 * k - 1) += h.real(), J(r + 2 * k - 1, col + 2 * k) -= h.imag();
-      J(r + 2 * k, col + 2 * k - 1) += h.imag(), J(r + 2 * k, col + 2 * k) += h.real();
+    if (!symmetric()) J(r, col) += Hyy[0](a, b).real();
+    for (int i = first(); i < count(); ++i) {
+      const Complex h = Hyy[harmonics[i]](a, b);
+      const int p = at(i);
+      J(r + p, col + p) += h.real(), J(r + p, col + p + 1) -= h.imag();
+      J(r + p + 1, col + p) += h.imag(), J(r + p + 1, col + p + 1) += h.real();
     }
   }
 
@@ -307,15 +342,16 @@ struct Equations {
     force_harmonics(z, G);
     for (int a = 0; a < nj; ++a) {
       const int o = a * m();
-      for (int k = 0; k <= K; ++k) {
+      for (int i = 0; i < count(); ++i) {
+        const int k = harmonics[i];
         Complex v = -load * HyF_F(k, a);
         for (int b = 0; b < nj; ++b)
           v += Hyy[k](a, b) * G(k, b);
         if (k == 0) {
           r(o) += v.real();
         } else {
-          r(o + 2 * k - 1) += v.real();
-          r(o + 2 * k) += v.imag();
+          r(o + at(i)) += v.real();
+          r(o + at(i) + 1) += v.imag();
         }
       }
     }
@@ -323,10 +359,11 @@ struct Equations {
       const Friction& fr = friction[f];
       const int o = (nj + static_cast<int>(f)) * m(), oy = fr.joint * m();
       multiply(dy, z.data() + o, s.lambda.data());
-      multiply(dv, z.data() + oy, s.yv.data() + Nt);
+      multiply(dv_unit, z.data() + oy, s.yv.data() + Nt);
       Scratch::Vector& stick = s.stick[f];
+      const double rw = fr.r * omega; // r ẏ = r ω (ẏ / ω)
       for (int n = 0; n < Nt; ++n) {
-        const double trial = s.lambda(n) + fr.r * s.yv(Nt + n);
+        const double trial = s.lambda(n) + rw * s.yv(Nt + n);
         stick(n) = std::abs(trial) < fr.limit ? 1.0 : 0.0;
         s.clamped(n) = std::clamp(trial, -fr.limit, fr.limit);
       }

@@ -181,39 +181,63 @@ int ModalSynthesis::position(int equation) const {
 
 CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows,
                                    std::span<const int> cols) const {
+  return receptances(std::span<const double>(&omega, 1), rows, cols);
+}
+
+CMatrix ModalSynthesis::receptances(std::span<const double> omegas, std::span<const int> rows,
+                                    std::span<const int> cols) const {
   const int m = static_cast<int>(omega_.size());
-  CVector modal(m);
-  for (int r = 0; r < m; ++r) { // 1 / (ω_r² − ω² + i d_r ω), without the library's checked division
-    const double a = omega_(r) * omega_(r) - omega * omega, b = modal_damping_(r) * omega;
-    const double d = a * a + b * b;
-    modal(r) = d > 0.0 ? Complex(a / d, -b / d) : 1.0 / Complex(a, b);
-  }
-  CMatrix H(rows.size(), cols.size());
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const int pi = position(rows[i]);
-    for (std::size_t j = 0; j < cols.size(); ++j) {
-      const int pj = position(cols[j]);
-      // Σ_r φ_ir φ_jr / d_r (no conjugation: receptance is symmetric, not Hermitian)
-      Complex h = residual_(pi, pj);
-      for (int r = 0; r < m; ++r)
-        h += (phi_(pi, r) * phi_(pj, r)) * modal(r);
-      H(i, j) = h;
+  const auto nr = static_cast<Eigen::Index>(rows.size()),
+             nc = static_cast<Eigen::Index>(cols.size());
+  const auto nw = static_cast<Eigen::Index>(omegas.size());
+  CMatrix H(nr, nc * nw);
+  std::vector<int> pr(rows.size()), pc(cols.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    pr[i] = position(rows[i]);
+  for (std::size_t j = 0; j < cols.size(); ++j)
+    pc[j] = position(cols[j]);
+  // 1 / (ω_r² − ω² + i d_r ω) per mode and frequency (m × nw), without the library's checked
+  // division; then per entry Σ_r φ_ir φ_jr / d_r (no conjugation: receptance is symmetric, not
+  // Hermitian), the products φ_ir φ_jr once for all frequencies.
+  CMatrix modal(m, nw);
+  Eigen::VectorXd product(m);
+  for (Eigen::Index k = 0; k < nw; ++k) {
+    const double omega = omegas[static_cast<std::size_t>(k)];
+    for (int r = 0; r < m; ++r) {
+      const double a = omega_(r) * omega_(r) - omega * omega, b = modal_damping_(r) * omega;
+      const double d = a * a + b * b;
+      modal(r, k) = d > 0.0 ? Complex(a / d, -b / d) : 1.0 / Complex(a, b);
     }
   }
+  for (Eigen::Index i = 0; i < nr; ++i)
+    for (Eigen::Index j = 0; j < nc; ++j) {
+      const int pi = pr[static_cast<std::size_t>(i)], pj = pc[static_cast<std::size_t>(j)];
+      for (int r = 0; r < m; ++r)
+        product(r) = phi_(pi, r) * phi_(pj, r);
+      for (Eigen::Index k = 0; k < nw; ++k) {
+        Complex h = residual_(pi, pj);
+        for (int r = 0; r < m; ++r)
+          h += product(r) * modal(r, k);
+        H(i, k * nc + j) = h;
+      }
+    }
   // Measured FRFs, in their block: the entries whose row and column are both theirs.
   for (const MeasuredBlock& b : measured_) {
     std::vector<int> r_at, c_at, r_local, c_local;
     for (std::size_t i = 0; i < rows.size(); ++i)
-      if (const int l = b.local[static_cast<std::size_t>(position(rows[i]))]; l >= 0)
+      if (const int l = b.local[static_cast<std::size_t>(pr[i])]; l >= 0)
         r_at.push_back(static_cast<int>(i)), r_local.push_back(l);
     for (std::size_t j = 0; j < cols.size(); ++j)
-      if (const int l = b.local[static_cast<std::size_t>(position(cols[j]))]; l >= 0)
+      if (const int l = b.local[static_cast<std::size_t>(pc[j])]; l >= 0)
         c_at.push_back(static_cast<int>(j)), c_local.push_back(l);
     if (r_at.empty() || c_at.empty()) continue;
-    const CMatrix Hm = b.frf->receptance(omega, r_local, c_local);
-    for (std::size_t i = 0; i < r_at.size(); ++i)
-      for (std::size_t j = 0; j < c_at.size(); ++j)
-        H(r_at[i], c_at[j]) += Hm(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+    for (Eigen::Index k = 0; k < nw; ++k) {
+      const CMatrix Hm = b.frf->receptance(omegas[static_cast<std::size_t>(k)], r_local, c_local);
+      for (std::size_t i = 0; i < r_at.size(); ++i)
+        for (std::size_t j = 0; j < c_at.size(); ++j)
+          H(r_at[i], k * nc + c_at[j]) +=
+              Hm(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+    }
   }
   return H;
 }

@@ -71,6 +71,11 @@ public:
   }
   /// Rows and columns are equation numbers, each one of `dofs`.
   CMatrix receptance(double omega, std::span<const int> rows, std::span<const int> cols) const;
+  /// The receptances at several frequencies side by side: rows × (|cols| · |omegas|), block k
+  /// (columns k |cols| …) the receptance at omegas[k]. One allocation, the modal products
+  /// φ_ir φ_jr formed once (the harmonic balance's K + 1 harmonics).
+  CMatrix receptances(std::span<const double> omegas, std::span<const int> rows,
+                      std::span<const int> cols) const;
   Blocks blocks(double omega, const Partition& partition) const;
   bool has_residual() const { return has_residual_; }
   int num_modes() const { return static_cast<int>(omega_.size()); }
