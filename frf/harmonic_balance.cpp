@@ -356,6 +356,85 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
   return z;
 }
 
+// The fundamental-only problem's start from the linear response z: its displacements scaled
+// by s ∈ [2⁻¹⁰, 8] and shifted in time by φ/ω (harmonic k times e^{ikφ}), s and φ those that
+// leave the least residual (see first_guess()); z's friction forces are kept.
+void scale_and_shift(const Equations& P, Eigen::VectorXd& z) {
+  constexpr double s_min = 1.0 / 1024, s_max = 8.0;
+  const int nd = P.nj * P.m();
+  Eigen::MatrixXd h;
+  if (P.K == 1 && P.homogeneous_parts(z, h)) {
+    // With u(s) = Σ_p s^p c_p (c0 = h0, c1 = z + h1, c2 = h2, c3 = h3: in h) the residual at s S_φ
+    // z is S_φ u(s) − b (S_φ commutes with H_yy and, the joints being time-invariant, with the
+    // forces), of norm² |u|² + |b|² − 2 u₀·b₀ − 2 Re(e^{−iφ} W(s)), W = Σ_j conj(u_1j) b_1j:
+    // least at φ = arg W, where it is f(s) = |u|² − 2 u₀·b₀ − 2|W| + |b|², polynomials in s
+    // but for the modulus.
+    // b = pack(H_yf F): its mean (non-symmetric) and fundamental, joint by joint.
+    h.col(1) += z.head(nd); // c1
+    std::array<double, 7> a{};
+    std::array<double, 4> beta{};
+    std::array<Complex, 4> W{};
+    const int i1 = P.symmetric() ? 0 : 1; // harmonics[i1] = 1
+    for (int p = 0; p < 4; ++p) {
+      const auto up = static_cast<std::size_t>(p);
+      for (int q = p; q < 4; ++q)
+        a[up + static_cast<std::size_t>(q)] += (p == q ? 1.0 : 2.0) * h.col(p).dot(h.col(q));
+      for (int j = 0; j < P.nj; ++j) {
+        const int o = j * P.m(), r = o + P.at(i1);
+        if (!P.symmetric()) beta[up] += h(o, p) * P.HyF_F(0, j).real();
+        W[up] += std::conj(Complex(h(r, p), h(r + 1, p))) * P.HyF_F(1, j);
+      }
+    }
+    auto polynomial = [](const auto& coefficients, double s) {
+      auto v = coefficients.back() * 0.0;
+      for (auto it = coefficients.rbegin(); it != coefficients.rend(); ++it)
+        v = v * s + *it;
+      return v;
+    };
+    auto f = [&](double s) {
+      return polynomial(a, s) - 2.0 * polynomial(beta, s) -
+             2.0 * std::sqrt(std::norm(polynomial(W, s))); // (std::abs: a libm call)
+    };
+    // The least of a grid of ratio 2, then golden-section search between its neighbours to
+    // 0.1 % of that bracket (a start needs no more).
+    double best = s_min, fbest = f(s_min);
+    const double ratio = 2.0;
+    for (double s = s_min * ratio; s <= s_max * (1.0 + 1e-12); s *= ratio)
+      if (const double v = f(s); v < fbest) best = s, fbest = v;
+    double lo = std::max(s_min, best / ratio), hi = std::min(s_max, best * ratio);
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
+    for (int it = 0; it < 14; ++it) {
+      if (f1 < f2)
+        hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
+      else
+        lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
+    }
+    const double s = 0.5 * (lo + hi);
+    const Complex shift = std::polar(s, std::arg(polynomial(W, s)));
+    for (int j = 0; j < P.nj; ++j) {
+      const int o = j * P.m(), r = o + P.at(i1);
+      if (!P.symmetric()) z(o) *= s;
+      const Complex y = shift * Complex(z(r), z(r + 1));
+      z(r) = y.real(), z(r + 1) = y.imag();
+    }
+    return;
+  }
+  Eigen::VectorXd r(P.size()), zs = z;
+  P.residual(z, 1.0, r, nullptr);
+  double best = r.norm(), scale = 1.0;
+  for (const double step : {0.5, 2.0}) {
+    for (double s = step; s >= s_min && s <= s_max; s *= step) {
+      zs.head(nd) = s * z.head(nd);
+      P.residual(zs, 1.0, r, nullptr);
+      if (!(r.norm() < best)) break;
+      best = r.norm(), scale = s;
+    }
+    if (scale != 1.0) break;
+  }
+  z.head(nd) *= scale;
+}
+
 } // namespace
 
 Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
@@ -389,25 +468,13 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
   Eigen::VectorXd z1 = start_from(P1, nullptr);
   // The linear response can be far off in amplitude (a stiffening joint near resonance: 9×);
   // Newton then creeps (by 2/3 a step for a cubic; by 1/2 with friction, 10 steps on the
-  // paper's cantilever). Scale the displacements first by the power of 2 that leaves the least
-  // residual: a few cheap evaluations instead of those steps. The friction forces of the slip
-  // law, fc sign(ẏ), do not change with the scale.
-  {
-    const int nd = nj_ * P1.m();
-    Eigen::VectorXd r(P1.size()), zs = z1;
-    P1.residual(z1, 1.0, r, nullptr);
-    double best = r.norm(), scale = 1.0;
-    for (const double step : {0.5, 2.0}) {
-      for (double s = step; s >= 1.0 / 1024 && s <= 8.0; s *= step) {
-        zs.head(nd) = s * z1.head(nd);
-        P1.residual(zs, 1.0, r, nullptr);
-        if (!(r.norm() < best)) break;
-        best = r.norm(), scale = s;
-      }
-      if (scale != 1.0) break;
-    }
-    z1.head(nd) *= scale;
-  }
+  // paper's cantilever). Scale the displacements first, by the s that leaves the least
+  // residual. Every term of the library is positively homogeneous, g(s y, s ẏ) = s^d g(y, ẏ),
+  // so without friction unknowns the residual at s z is a cubic polynomial in s with vector
+  // coefficients, from one transform per degree: its least norm over s ∈ [2⁻¹⁰, 8] is found
+  // on the polynomial. With friction (the slip law's forces fc sign(ẏ) do not change with the
+  // scale, but the stick–slip rows do) the powers of 2 are tried instead, a residual each.
+  scale_and_shift(P1, z1);
   int iterations = 0;
   double residual = 0.0;
   HarmonicBalanceOptions coarse = options_;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <new>
@@ -408,6 +409,54 @@ struct Equations {
     if (J) J->resize(size(), size());
     residual(z, load, r, J);
     return r;
+  }
+
+  // The smooth forces' part of the residual's joint rows at z, split by the terms' degree d
+  // (g(s y, s ẏ) = s^d g(y, ẏ) for s > 0, joints::TermInfo::degree): column d of h (size() × 4)
+  // is pack(H_yy G_d(z)),
+  // so that without friction unknowns the residual at s z is
+  //     r(s z) = s z − pack(H_yf F) + Σ_d s^d h_d      (d = 0 … 3, s > 0).
+  // False (h unset) where a force is not of that form (friction unknowns, regularised friction,
+  // a term of another degree) or there are no joints.
+  bool homogeneous_parts(const Eigen::VectorXd& z, Eigen::MatrixXd& h) const {
+    if (!friction.empty() || nj == 0) return false;
+    for (const joints::Joint& j : joints)
+      for (std::size_t t = 0; t < j.terms.size(); ++t) {
+        const int d = joints::term_info(j.terms[t]).degree;
+        if (d < 0 || d > 3 || (width > 0.0 && joints::is_dry_friction(j.terms[t]))) return false;
+      }
+    Scratch& s = scratch();
+    h.setZero(nj * m(), 4);
+    Scratch::Matrix& g = s.g[0];
+    const auto size = static_cast<std::size_t>(Nt);
+    const std::span<const double> ys(s.yv.data(), size), vs(s.yv.data() + Nt, size);
+    const std::span<double> gs(g.col(0).data(), size), gys(g.col(1).data(), size),
+        gvs(g.col(2).data(), size);
+    for (int b = 0; b < nj; ++b) {
+      samples(z.data() + b * m(), s.yv.data());
+      for (int d = 0; d <= 3; ++d) {
+        g.setZero();
+        bool any = false;
+        for (std::size_t t = 0; t < joints[b].terms.size(); ++t)
+          if (joints::term_info(joints[b].terms[t]).degree == d && joints[b].values[t] != 0.0 &&
+              !joints::is_dry_friction(joints[b].terms[t]))
+            joints::add_samples(joints[b].terms[t], joints[b].values[t], ys, vs, gs, gys, gvs),
+                any = true;
+        if (!any) continue;
+        multiply_transposed(forward_t, g.data(), s.harmonics.data());
+        for (int a = 0; a < nj; ++a) // joint a's rows: Σ_b H_yy(kω)_ab G_b,k
+          for (int i = 0; i < count(); ++i) {
+            const int k = harmonics[i];
+            if (k == 0) {
+              h(a * m(), d) += Hyy[0](a, b).real() * s.harmonics(0);
+              continue;
+            }
+            const Complex v = Hyy[k](a, b) * Complex(s.harmonics(at(i)), s.harmonics(at(i) + 1));
+            h(a * m() + at(i), d) += v.real(), h(a * m() + at(i) + 1, d) += v.imag();
+          }
+      }
+    }
+    return true;
   }
 
   // |z| with the force unknowns in metres (through each friction joint's compliance).

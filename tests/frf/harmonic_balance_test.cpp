@@ -590,3 +590,50 @@ TEST(HarmonicBalance, AnAsymmetricStartFindsTheSymmetryBreakingSteadyState) {
   EXPECT_GT(error[0] / error[1], 3.0);
   EXPECT_LT(error[0] / error[1], 5.0);
 }
+
+TEST(HarmonicBalance, ResidualSplitsByTheTermsDegree) {
+  // Every term of the library is positively homogeneous, g(s y, s ẏ) = s^d g(y, ẏ); the first
+  // guess's scaling relies on r(s z) = s z − pack(H_yf F) + Σ_d s^d h_d. Checked against the
+  // residual itself at several s (rounding: 1e-13 of |r|), for every smooth term at once (k2
+  // makes the problem non-symmetric: all harmonics) and for the odd ones (half-wave symmetric).
+  // Friction unknowns or regularised friction have no such split: refused.
+  const PaperCantilever c;
+  const std::vector<int> outputs{c.eq(7)};
+  for (const bool with_even : {true, false}) {
+    SCOPED_TRACE(with_even ? "all terms" : "odd terms");
+    std::vector<Term> terms{Term::k, Term::c, Term::k3, Term::c2, Term::c3};
+    std::vector<double> values{4800.0, 20.0, 1.6e8, 500.0, 3e3};
+    if (with_even) terms.push_back(Term::k2), values.push_back(5e4);
+    const std::vector<joints::Joint> js{make("tip", 7, 0, terms, values),
+                                        make("mid", 4, 5, {Term::k, Term::k3}, {2e5, 1e9})};
+    frf::HarmonicBalanceOptions o;
+    o.harmonics = 5;
+    const frf::HarmonicBalance problem(c.H, js, c.system.dofs, {c.eq(7)}, outputs, 4.0, o);
+    const auto P = problem.equations(js, frf::sine_force(80.0));
+    ASSERT_EQ(P->symmetric(), !with_even);
+    const Eigen::VectorXd z = problem.first_guess(*P, nullptr);
+    Eigen::MatrixXd h;
+    ASSERT_TRUE(P->homogeneous_parts(z, h));
+    Eigen::VectorXd b(P->size());
+    P->pack(P->HyF_F, b);
+    for (const double s : {0.25, 1.0, 3.0}) {
+      const Eigen::VectorXd r = P->residual(s * z, 1.0, nullptr);
+      Eigen::VectorXd split = s * z - b;
+      for (int d = 0; d <= 3; ++d)
+        split += std::pow(s, d) * h.col(d);
+      EXPECT_LE((r - split).norm(), 1e-13 * r.norm()) << "s = " << s;
+    }
+    EXPECT_GT(h.col(3).norm(), 0.01 * z.norm()); // the cubic terms matter at 80 N near resonance
+    EXPECT_EQ(h.col(0).norm(), 0.0);             // no term of degree 0 but friction
+  }
+  const std::vector<joints::Joint> friction{
+      make("tip", 7, 0, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, 3.0})};
+  for (const bool exact : {true, false}) {
+    frf::HarmonicBalanceOptions o;
+    o.exact_friction = exact;
+    const frf::HarmonicBalance problem(c.H, friction, c.system.dofs, {c.eq(7)}, outputs, 4.0, o);
+    const auto P = problem.equations(friction, frf::sine_force(80.0));
+    Eigen::MatrixXd h;
+    EXPECT_FALSE(P->homogeneous_parts(problem.first_guess(*P, nullptr), h));
+  }
+}
