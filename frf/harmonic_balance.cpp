@@ -191,10 +191,10 @@ HarmonicBalance::HarmonicBalance(const ModalSynthesis& H, const std::vector<join
   // Joint DOFs (node and node_b) and the B matrix restricted to them.
   const std::vector<int> jdofs = joints::joint_dof_set(joints, dofs);
   const Eigen::MatrixXd B_real = joints::joint_coordinates_on(joints, dofs, jdofs);
-  const Eigen::MatrixXcd B = B_real.cast<Complex>();
   // Grounded joints, each on a DOF of its own, in order (the common case): B = I and the
   // blocks are the receptance's own.
   const bool identity = B_real.rows() == B_real.cols() && B_real.isIdentity(0.0);
+  const Eigen::MatrixXcd B = identity ? Eigen::MatrixXcd() : B_real.cast<Complex>();
   // The receptances at the harmonics, rows (joint DOFs, outputs) × columns (joint DOFs, forces),
   // cut into the four blocks.
   std::vector<int> rows = jdofs, cols = jdofs;
@@ -301,9 +301,10 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
     P.pack(*start, z);
   } else {
     Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K + 1, nj);
-    CMatrix D(nj, nj);
-    CVector y(nj);
-    detail::SmallLU<Complex> lu;
+    thread_local CMatrix D; // (kept: sized once per thread)
+    thread_local CVector y;
+    thread_local detail::SmallLU<Complex> lu;
+    D.resize(nj, nj), y.resize(nj);
     for (const int k : P.harmonics) {
       D.setIdentity();
       for (int j = 0; j < nj; ++j) {
@@ -358,8 +359,9 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
 
 // The fundamental-only problem's start from the linear response z: its displacements scaled
 // by s ∈ [2⁻¹⁰, 8] and shifted in time by φ/ω (harmonic k times e^{ikφ}), s and φ those that
-// leave the least residual (see first_guess()); z's friction forces are kept.
-void scale_and_shift(const Equations& P, Eigen::VectorXd& z) {
+// leave the least residual (see first_guess()); z's friction forces are kept. True if s and φ
+// were so found; false if only powers of 2 of s were tried (friction, or not K = 1).
+bool scale_and_shift(const Equations& P, Eigen::VectorXd& z) {
   constexpr double s_min = 1.0 / 1024, s_max = 8.0;
   const int nd = P.nj * P.m();
   Eigen::MatrixXd h;
@@ -418,7 +420,7 @@ void scale_and_shift(const Equations& P, Eigen::VectorXd& z) {
       const Complex y = shift * Complex(z(r), z(r + 1));
       z(r) = y.real(), z(r + 1) = y.imag();
     }
-    return;
+    return true;
   }
   Eigen::VectorXd r(P.size()), zs = z;
   P.residual(z, 1.0, r, nullptr);
@@ -433,6 +435,7 @@ void scale_and_shift(const Equations& P, Eigen::VectorXd& z) {
     if (scale != 1.0) break;
   }
   z.head(nd) *= scale;
+  return false;
 }
 
 } // namespace
@@ -466,22 +469,26 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
                      t1.trig,
                      omega_};
   Eigen::VectorXd z1 = start_from(P1, nullptr);
-  // The linear response can be far off in amplitude (a stiffening joint near resonance: 9×);
-  // Newton then creeps (by 2/3 a step for a cubic; by 1/2 with friction, 10 steps on the
-  // paper's cantilever). Scale the displacements first, by the s that leaves the least
-  // residual. Every term of the library is positively homogeneous, g(s y, s ẏ) = s^d g(y, ẏ),
-  // so without friction unknowns the residual at s z is a cubic polynomial in s with vector
-  // coefficients, from one transform per degree: its least norm over s ∈ [2⁻¹⁰, 8] is found
-  // on the polynomial. With friction (the slip law's forces fc sign(ẏ) do not change with the
-  // scale, but the stick–slip rows do) the powers of 2 are tried instead, a residual each.
-  scale_and_shift(P1, z1);
+  // The linear response can be far off in amplitude (a stiffening joint near resonance: 9×)
+  // and phase; Newton then creeps (by 2/3 a step for a cubic; by 1/2 with friction, 10 steps on
+  // the paper's cantilever). So it is first scaled by s and shifted in time by φ/ω, s and φ
+  // those of the least residual. Every term of the library is positively homogeneous,
+  // g(s y, s ẏ) = s^d g(y, ẏ), and time-invariant, so without friction unknowns the residual's
+  // norm over (s, φ) follows from one transform per degree (scale_and_shift()); with friction
+  // (its slip-law forces fc sign(ẏ) do not change with the scale, but the stick–slip rows do)
+  // powers of 2 of s are tried instead, a residual each. With one joint and half-wave symmetry
+  // the fundamental-only problem has two unknowns, its Y1, which s and φ span: their least
+  // residual is its solution (to the search's 0.2 % in s), and its Newton iterations are
+  // skipped (4 Hz, 80 N: 3 Newton iterations of the full problem either way).
+  const bool solved = scale_and_shift(P1, z1) && nj_ == 1 && P1.symmetric();
   int iterations = 0;
   double residual = 0.0;
   HarmonicBalanceOptions coarse = options_;
   // A start only: it differs from the full solution by the harmonics it omits (per cent), so
   // resolving it beyond 1e-3 buys the full Newton nothing.
   coarse.tolerance = std::max(options_.tolerance, 1e-3);
-  if (!detail::newton(P1, z1, 1.0, coarse, iterations, residual)) return start_from(P, nullptr);
+  if (!solved && !detail::newton(P1, z1, 1.0, coarse, iterations, residual))
+    return start_from(P, nullptr);
   Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K_ + 1, nj_);
   Y.topRows(2) = P1.unpack(z1, nj_);
   return start_from(P, &Y);
@@ -512,7 +519,6 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
                                              const Eigen::MatrixXcd* start) const {
   const std::unique_ptr<Equations> P = equations(joints, F, start);
   Eigen::VectorXd z = first_guess(*P, start);
-  const Eigen::VectorXd z_start = z;
   int iterations = 0;
   double residual = 0.0;
   bool converged = detail::newton(*P, z, 1.0, options_, iterations, residual);
@@ -521,7 +527,7 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
     const double direct = residual;
     const int direct_iterations = iterations;
     const int steps = std::max(1, options_.continuation_steps);
-    z = z_start / steps;
+    z = first_guess(*P, start) / steps; // (computed again: the direct solve moved z)
     converged = true;
     int s = 1;
     for (; s <= steps && converged; ++s)

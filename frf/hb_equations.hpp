@@ -136,8 +136,10 @@ struct Equations {
     std::vector<Vector> stick;
     Matrix weights{nullptr, 0, 0}; // trig.cols() × 2: cos and sin sums of ∂g/∂y, ∂g/∂ẏ
     Matrix E{nullptr, 0, 0}, D{nullptr, 0, 0};
-    Vector w{nullptr, 0}; // the weight's harmonics −2K … 2K, real parts then imaginary
-    Eigen::MatrixXcd G;   // (K+1) × nj: the joint forces' harmonics
+    Vector w{nullptr, 0};    // the weight's harmonics −2K … 2K, real parts then imaginary
+    Eigen::MatrixXcd G;      // (K+1) × nj: the joint forces' harmonics at `last`
+    Vector last{nullptr, 0}; // the unknowns of the last residual(), if `has_last`
+    bool has_last = false;
 
     Scratch() = default;
     Scratch(const Scratch&) : Scratch() {}
@@ -151,7 +153,7 @@ struct Equations {
     const Eigen::Index n = Nt, M = m(), nf = static_cast<Eigen::Index>(friction.size());
     const Eigen::Index nw = 4 * K + 1, nt = trig.cols();
     w.buffer.assign(static_cast<std::size_t>(2 * n + M + 2 * n + nj * 3 * n + nf * n + 2 * nt +
-                                             2 * M * M + 2 * nw),
+                                             2 * M * M + 2 * nw + size()),
                     0.0);
     double* at = w.buffer.data();
     auto take = [&at](Eigen::Index size) {
@@ -172,6 +174,8 @@ struct Equations {
     new (&w.E) Scratch::Matrix(take(M * M), M, M);
     new (&w.D) Scratch::Matrix(take(M * M), M, M);
     new (&w.w) Scratch::Vector(take(2 * nw), 2 * nw);
+    new (&w.last) Scratch::Vector(take(size()), size());
+    w.has_last = false;
     w.G.setZero(K + 1, nj);
     return w;
   }
@@ -298,7 +302,10 @@ struct Equations {
         G(harmonics[i], j) += Complex(z(o + at(i)), z(o + at(i) + 1));
     }
   }
+  // The same, returned; the last residual's own when z is its point (the result of a solve).
   Eigen::MatrixXcd forces(const Eigen::VectorXd& z) const {
+    const Scratch& s = scratch();
+    if (s.has_last && z.size() == s.last.size() && (z.array() == s.last.array()).all()) return s.G;
     Eigen::MatrixXcd G;
     force_harmonics(z, G);
     return G;
@@ -341,6 +348,7 @@ struct Equations {
     // plus its friction unknowns.
     Eigen::MatrixXcd& G = s.G;
     force_harmonics(z, G);
+    s.last = z, s.has_last = true;
     for (int a = 0; a < nj; ++a) {
       const int o = a * m();
       for (int i = 0; i < count(); ++i) {

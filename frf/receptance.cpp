@@ -191,11 +191,27 @@ CMatrix ModalSynthesis::receptances(std::span<const double> omegas, std::span<co
              nc = static_cast<Eigen::Index>(cols.size());
   const auto nw = static_cast<Eigen::Index>(omegas.size());
   CMatrix H(nr, nc * nw);
-  std::vector<int> pr(rows.size()), pc(cols.size());
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    pr[i] = position(rows[i]);
-  for (std::size_t j = 0; j < cols.size(); ++j)
-    pc[j] = position(cols[j]);
+  // The rows' and columns' positions among the synthesis's DOFs, and for each the first row
+  // (column) at the same position: a response at the force's DOF, or a joint DOF that is also
+  // a force or response DOF, repeats entries, computed once (one allocation for all four).
+  std::vector<int> index(2 * (rows.size() + cols.size()));
+  int* const pr = index.data();
+  int* const pc = pr + nr;
+  int* const first_row = pc + nc;
+  int* const first_col = first_row + nr;
+  auto positions = [this](std::span<const int> equations, int* at, int* first) {
+    for (std::size_t i = 0; i < equations.size(); ++i) {
+      at[i] = position(equations[i]);
+      first[i] = static_cast<int>(i);
+      for (std::size_t e = 0; e < i; ++e)
+        if (at[e] == at[i]) {
+          first[i] = static_cast<int>(e);
+          break;
+        }
+    }
+  };
+  positions(rows, pr, first_row);
+  positions(cols, pc, first_col);
   // 1 / (ω_r² − ω² + i d_r ω) per mode and frequency (m × nw), without the library's checked
   // division; then per entry Σ_r φ_ir φ_jr / d_r (no conjugation: receptance is symmetric, not
   // Hermitian), the products φ_ir φ_jr once for all frequencies.
@@ -211,7 +227,12 @@ CMatrix ModalSynthesis::receptances(std::span<const double> omegas, std::span<co
   }
   for (Eigen::Index i = 0; i < nr; ++i)
     for (Eigen::Index j = 0; j < nc; ++j) {
-      const int pi = pr[static_cast<std::size_t>(i)], pj = pc[static_cast<std::size_t>(j)];
+      if (const Eigen::Index fi = first_row[i], fj = first_col[j]; fi != i || fj != j) {
+        for (Eigen::Index k = 0; k < nw; ++k) // computed already: fi ≤ i, fj ≤ j
+          H(i, k * nc + j) = H(fi, k * nc + fj);
+        continue;
+      }
+      const int pi = pr[i], pj = pc[j];
       for (int r = 0; r < m; ++r)
         product(r) = phi_(pi, r) * phi_(pj, r);
       for (Eigen::Index k = 0; k < nw; ++k) {
