@@ -1,5 +1,6 @@
 #include "discover/discover.hpp"
 
+#include "fem/minimise.hpp"
 #include "fem/parallel.hpp"
 #include "fem/time_integration.hpp"
 #include "identify/harmonics.hpp"
@@ -1144,15 +1145,8 @@ private:
       const double u = lo + (hi - lo) * i / 6.0, f = trial(u);
       if (f < best_f) best_f = f, best_u = u;
     }
-    const double g = (std::sqrt(5.0) - 1.0) / 2.0, width = (hi - lo) / 6.0;
-    double a = best_u - width, b = best_u + width;
-    double c1 = b - g * (b - a), c2 = a + g * (b - a), f1 = trial(c1), f2 = trial(c2);
-    for (int it = 0; it < 10; ++it) {
-      if (f1 < f2)
-        b = c2, c2 = c1, f2 = f1, c1 = b - g * (b - a), f1 = trial(c1);
-      else
-        a = c1, c1 = c2, f1 = f2, c2 = a + g * (b - a), f2 = trial(c2);
-    }
+    const double width = (hi - lo) / 6.0;
+    fem::golden_section_minimum(trial, best_u - width, best_u + width, 10); // (tried: the best)
     if (tried.empty()) return refused(std::move(c), state, "no damping scale gives a model");
     const double u = std::min_element(tried.begin(), tried.end(), [](const auto& x, const auto& y) {
                        return x.second.criterion < y.second.criterion;

@@ -2,6 +2,8 @@
 
 #include "frf/hb_equations.hpp"
 
+#include "fem/minimise.hpp"
+
 #include <Eigen/Dense>
 #include <array>
 #include <cmath>
@@ -403,16 +405,8 @@ bool scale_and_shift(const Equations& P, Eigen::VectorXd& z) {
     const double ratio = 2.0;
     for (double s = s_min * ratio; s <= s_max * (1.0 + 1e-12); s *= ratio)
       if (const double v = f(s); v < fbest) best = s, fbest = v;
-    double lo = std::max(s_min, best / ratio), hi = std::min(s_max, best * ratio);
-    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
-    for (int it = 0; it < 14; ++it) {
-      if (f1 < f2)
-        hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
-      else
-        lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
-    }
-    const double s = 0.5 * (lo + hi);
+    const double s = fem::golden_section_minimum(f, std::max(s_min, best / ratio),
+                                                 std::min(s_max, best * ratio), 14);
     const Complex shift = std::polar(s, std::arg(polynomial(W, s)));
     for (int j = 0; j < P.nj; ++j) {
       const int o = j * P.m(), r = o + P.at(i1);

@@ -1,5 +1,7 @@
 #include "identify/harmonics.hpp"
 
+#include "fem/minimise.hpp"
+
 #include <Eigen/Dense>
 #include <cmath>
 #include <numbers>
@@ -65,26 +67,16 @@ double estimate_frequency(const Eigen::VectorXd& t, const Eigen::VectorXd& x) {
   // Golden-section refinement around the peak: minimise the residual of a mean + sine fit
   // (zero at the true frequency of a pure sinusoid; the fitted amplitude is not a safe
   // criterion, it can exceed the true one off-frequency on a non-whole number of periods).
-  auto amplitude = [&](double f) {
+  auto misfit = [&](double f) {
     const double w = 2.0 * std::numbers::pi * f;
     const Eigen::VectorXcd X = fit_harmonics(t, x, w, 1);
     double ss = 0.0;
     for (int i = 0; i < n; ++i)
       ss += std::pow(x(i) - X(0).real() - (X(1) * std::polar(1.0, w * t(i))).real(), 2);
-    return -ss;
+    return ss;
   };
-  double a = std::max(best_f - df, 1e-12), b = best_f + df;
-  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
-  double c1 = b - g * (b - a), c2 = a + g * (b - a);
-  double f1 = amplitude(c1), f2 = amplitude(c2);
-  for (int it = 0; it < 80 && (b - a) > 1e-12 * best_f; ++it) {
-    if (f1 > f2) {
-      b = c2, c2 = c1, f2 = f1, c1 = b - g * (b - a), f1 = amplitude(c1);
-    } else {
-      a = c1, c1 = c2, f1 = f2, c2 = a + g * (b - a), f2 = amplitude(c2);
-    }
-  }
-  return 0.5 * (a + b);
+  return fem::golden_section_minimum(misfit, std::max(best_f - df, 1e-12), best_f + df, 80,
+                                     1e-12 * best_f);
 }
 
 int whole_period_samples(const Eigen::VectorXd& t, double frequency_hz) {
