@@ -93,9 +93,9 @@ public:
                   const HarmonicBalanceOptions& options = {});
   /// F: harmonics 0, 1, … of the forces (rows beyond K are ignored, missing ones are 0), one
   /// column per force equation. `start` (K+1 × n_joints), if given, is the first Newton guess;
-  /// otherwise the steady state with the fundamental alone (K = 1, solved from the linear
-  /// response with the joints' linear terms k, c, scaled) is, or that linear response if the
-  /// fundamental-only problem does not converge. Throws
+  /// otherwise the steady state with the fundamental alone (K = 1, from the linear response
+  /// with the joints' linear terms k, c, scaled and shifted in time to the least residual) is,
+  /// or that linear response if the fundamental-only problem does not converge. Throws
   /// std::invalid_argument for a negative friction limit fc (a joint that gives energy).
   HarmonicBalanceResult solve(const std::vector<joints::Joint>& joints, const Eigen::MatrixXcd& F,
                               const Eigen::MatrixXcd* start = nullptr) const;
