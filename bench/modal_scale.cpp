@@ -16,7 +16,9 @@
 // basis cap. `--analyze-only` stops after the symbolic analysis of K − σM and prints the
 // predicted factor (size, flops, ordering). `--solve-widths` factorises K − σM (ordering on
 // the nodes, as the engine does) and times block solves of each width instead of the modes
-// (best of 3 per width), to see what a pass over the factor costs per right-hand side.
+// (best of 3 per width), to see what a pass over the factor costs per right-hand side: the
+// CHOLMOD's solve (`solve_s`, what the engine uses) and our own (`own_solve_s`,
+// fem/supernodal_solve.hpp) on the same factor, and how far their results differ.
 #include "bench/lattice.hpp"
 #include "bench/matrix_market.hpp"
 #include "fem/assembly.hpp"
@@ -270,14 +272,24 @@ int run(const Options& o) {
     json widths = json::array();
     for (int b : o.solve_widths) {
       const Eigen::MatrixXd B = Eigen::MatrixXd::Random(K.rows(), b);
-      Eigen::MatrixXd X(K.rows(), b);
-      double best = 1e300;
-      for (int rep = 0; rep < 3; ++rep) {
-        stage = std::chrono::steady_clock::now();
-        llt.solve(B.data(), X.data(), b);
-        best = std::min(best, seconds_since(stage));
+      // Our own block solve (fem/supernodal_solve.hpp), then CHOLMOD's, on the same factor.
+      Eigen::MatrixXd X[2] = {Eigen::MatrixXd(K.rows(), b), Eigen::MatrixXd(K.rows(), b)};
+      double best[2] = {1e300, 1e300};
+      for (int path = 0; path < 2; ++path) {
+        llt.set_own_solve_columns(path == 0 ? 1 : 0);
+        for (int rep = 0; rep < 3; ++rep) {
+          stage = std::chrono::steady_clock::now();
+          llt.solve(B.data(), X[path].data(), b);
+          best[path] = std::min(best[path], seconds_since(stage));
+        }
       }
-      widths.push_back({{"width", b}, {"solve_s", best}, {"per_column_s", best / b}});
+      llt.set_own_solve_columns(co.own_solve_columns);
+      widths.push_back({{"width", b},
+                        {"own_solve_s", best[0]},
+                        {"solve_s", best[1]},
+                        {"per_column_s", best[1] / b},
+                        {"max_relative_difference",
+                         (X[0] - X[1]).cwiseAbs().maxCoeff() / X[1].cwiseAbs().maxCoeff()}});
     }
     r["block_solves"] = widths;
     r["peak_rss_modal_mib"] = proc_status_mib("VmHWM");

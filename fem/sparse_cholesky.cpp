@@ -1,5 +1,7 @@
 #include "fem/sparse_cholesky.hpp"
 
+#include "fem/supernodal_solve.hpp"
+
 #include <cholmod.h>
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -426,6 +429,26 @@ void SparseCholesky::solve(const double* b, double* x, std::int64_t columns) con
     throw std::invalid_argument("sparse Cholesky: solve with " + std::to_string(columns) +
                                 " right-hand sides");
   if (columns == 0) return;
+  const cholmod_factor& L = *m.factor;
+  const int own_from = m.options.own_solve_columns >= 0   ? m.options.own_solve_columns
+                       : m.analysis.factor_entries >= 5e7 ? 2
+                                                          : 0;
+  if (own_from > 0 && columns >= own_from && L.is_super && L.xtype == CHOLMOD_REAL &&
+      L.dtype == CHOLMOD_DOUBLE) {
+    static_assert(sizeof(Long) == sizeof(std::int64_t));
+    SupernodalFactorView view;
+    view.n = static_cast<std::int64_t>(L.n);
+    view.supernodes = static_cast<std::int64_t>(L.nsuper);
+    view.first_column = static_cast<const std::int64_t*>(L.super);
+    view.row_pointer = static_cast<const std::int64_t*>(L.pi);
+    view.value_pointer = static_cast<const std::int64_t*>(L.px);
+    view.rows = static_cast<const std::int64_t*>(L.s);
+    view.values = static_cast<const double*>(L.x);
+    view.permutation = static_cast<const std::int64_t*>(L.Perm); // null: the identity
+    supernodal_solve(view, b, x, columns,
+                     static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+    return;
+  }
   const auto n = static_cast<std::size_t>(m.analysis.rows);
   const auto count = n * static_cast<std::size_t>(columns);
   cholmod_dense rhs{};
@@ -453,6 +476,10 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& B) const {
   Eigen::MatrixXd X(B.rows(), B.cols());
   solve(B.data(), X.data(), B.cols());
   return X;
+}
+
+void SparseCholesky::set_own_solve_columns(int columns) {
+  impl_->options.own_solve_columns = columns;
 }
 
 std::int64_t SparseCholesky::rows() const {

@@ -36,6 +36,13 @@ struct CholeskyOptions {
   /// (CHOLMOD's zrelax[2], whose own default is 0.05). Those supernodes hold most of a large
   /// factor: 0 saved 10 % of the factor's memory on a 10⁶-DOF frame for ~10 % more time.
   double large_supernode_zeros = 0.0;
+  /// Blocks of at least this many right-hand sides are solved by our own supernodal
+  /// substitution on every core (fem/supernodal_solve.hpp), smaller ones by CHOLMOD's
+  /// `cholmod_l_solve2`; 0: CHOLMOD's always; −1 (the default): ours from 2 columns on for a
+  /// factor of at least 5·10⁷ values, where it was measured faster (8 columns: 2.79 s against
+  /// 3.93 s on the 10⁶-DOF lattice, 3–10 % on the 10⁵ one, slower on the 10⁴ one;
+  /// docs/benchmarks.md, "Own block solve").
+  int own_solve_columns = -1;
 };
 
 /// What the symbolic analysis predicts.
@@ -85,14 +92,17 @@ public:
   void solve(const double* b, double* x) const;
 
   /// X = A⁻¹ B for `columns` right-hand sides at once: B and X are column-major
-  /// rows() × columns blocks (leading dimension rows()) that may not overlap. One CHOLMOD
-  /// solve for the whole block, so the factor is read once per block instead of once per
-  /// column: a large factor's solve is bound by memory bandwidth, and several columns cost
-  /// little more than one.
+  /// rows() × columns blocks (leading dimension rows()) that may not overlap. One pass over
+  /// the factor for the whole block (CHOLMOD's, or ours on every core from
+  /// `own_solve_columns` on), so the factor is read once per block instead of once per column.
   void solve(const double* b, double* x, std::int64_t columns) const;
 
   /// X = A⁻¹ B for an n × k block B (k ≥ 0), by the block solve above.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& B) const;
+
+  /// Changes CholeskyOptions::own_solve_columns of this factorisation (e.g. to time both
+  /// solves on one factor).
+  void set_own_solve_columns(int columns);
 
   std::int64_t rows() const;
   const CholeskyAnalysis& analysis() const;
