@@ -280,43 +280,40 @@ struct Solve {
     }
   }
 
+  // Thread t's part of supernode s: forward (L y = b) or backward (Lᵀ x = y), which changes
+  // only the supernode's own rows.
+  JOINTID_KERNEL void supernode(Long s, int t, bool down) {
+    const Block b = block(s);
+    const Long changed = down ? b.nsrow : b.nscol;
+    if (!shared(b)) {
+      if (t != 0) return;
+      gather(s, b, 0, wp);
+      if (down)
+        forward(b, 0, 1);
+      else
+        backward(b, 0, 1);
+      scatter(s, b, changed, 0, w);
+      return;
+    }
+    wait(); // thread 0's supernodes before this one are done
+    const Long c0 = share(wp, t, threads, 1), c1 = share(wp, t + 1, threads, 1);
+    gather(s, b, c0, c1);
+    wait();
+    if (down)
+      forward(b, t, threads);
+    else
+      backward(b, t, threads);
+    scatter(s, b, changed, c0, c1);
+    wait();
+  }
+
   // Everything thread t does: L y = P b supernode by supernode, then Lᵀ x = y in reverse.
   JOINTID_KERNEL void run(int t) {
-    for (Long s = 0; s < F.supernodes; ++s) {
-      const Block b = block(s);
-      if (!shared(b)) {
-        if (t != 0) continue;
-        gather(s, b, 0, wp);
-        forward(b, 0, 1);
-        scatter(s, b, b.nsrow, 0, w);
-        continue;
-      }
-      wait(); // thread 0's supernodes before this one are done
-      const Long c0 = share(wp, t, threads, 1), c1 = share(wp, t + 1, threads, 1);
-      gather(s, b, c0, c1);
-      wait();
-      forward(b, t, threads);
-      scatter(s, b, b.nsrow, c0, c1);
-      wait();
-    }
+    for (Long s = 0; s < F.supernodes; ++s)
+      supernode(s, t, true);
     wait();
-    for (Long s = F.supernodes - 1; s >= 0; --s) {
-      const Block b = block(s);
-      if (!shared(b)) {
-        if (t != 0) continue;
-        gather(s, b, 0, wp);
-        backward(b, 0, 1);
-        scatter(s, b, b.nscol, 0, w);
-        continue;
-      }
-      wait();
-      const Long c0 = share(wp, t, threads, 1), c1 = share(wp, t + 1, threads, 1);
-      gather(s, b, c0, c1);
-      wait();
-      backward(b, t, threads);
-      scatter(s, b, b.nscol, c0, c1);
-      wait();
-    }
+    for (Long s = F.supernodes - 1; s >= 0; --s)
+      supernode(s, t, false);
     wait();
   }
 };

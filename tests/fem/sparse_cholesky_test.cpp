@@ -68,6 +68,17 @@ GridMatrix grid_matrix(int nx, int ny, int nz, int d, unsigned seed) {
   return g;
 }
 
+// n × columns standard normal values, reproducible from the seed.
+Eigen::MatrixXd random_block(Eigen::Index n, Eigen::Index columns, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd B(n, columns);
+  for (Eigen::Index j = 0; j < B.cols(); ++j)
+    for (Eigen::Index i = 0; i < n; ++i)
+      B(i, j) = normal(rng);
+  return B;
+}
+
 double relative_residual(const Sparse& A, const Eigen::VectorXd& x, const Eigen::VectorXd& b) {
   return (A * x - b).norm() / b.norm();
 }
@@ -107,12 +118,7 @@ TEST(SparseCholesky, ABlockSolveEqualsColumnByColumnSolves) {
   // dimension wrongly fails by O(1).
   const GridMatrix g = grid_matrix(6, 5, 5, 6, 4);
   const Eigen::Index n = g.A.rows();
-  std::mt19937 rng(9);
-  std::normal_distribution<double> normal;
-  Eigen::MatrixXd B(n, 7);
-  for (Eigen::Index j = 0; j < B.cols(); ++j)
-    for (Eigen::Index i = 0; i < n; ++i)
-      B(i, j) = normal(rng);
+  const Eigen::MatrixXd B = random_block(n, 7, 9);
   SparseCholesky llt;
   llt.analyze(g.A, g.groups);
   llt.factorize(g.A);
@@ -142,16 +148,11 @@ TEST(SparseCholesky, OwnBlockSolveEqualsCholmodsForEveryWidth) {
   // of the same factor, column by column. The 12 × 12 × 12 grid of 6 unknowns (10 368) has a
   // top separator of 864 columns, so its panels of 256, the share of rows and columns among
   // the cores, the 8-, 4- and 1-row tiles and the padding of the right-hand sides to a
-  // multiple of 4 are all run. Widths 2-17 (all remainders by 4 and 8); with the natural
-  // ordering too (no permutation), and a block with a zero column.
+  // multiple of 4 are all run. Widths 2-17 (all remainders by 4 and 8), two orderings, a
+  // zero column; then a small grid whose supernodes are all done by one core.
   const GridMatrix g = grid_matrix(12, 12, 12, 6, 11);
   const Eigen::Index n = g.A.rows();
-  std::mt19937 rng(5);
-  std::normal_distribution<double> normal;
-  Eigen::MatrixXd B(n, 17);
-  for (Eigen::Index j = 0; j < B.cols(); ++j)
-    for (Eigen::Index i = 0; i < n; ++i)
-      B(i, j) = normal(rng);
+  Eigen::MatrixXd B = random_block(n, 17, 5);
   B.col(5).setZero();
   for (CholeskyOrdering ordering : {CholeskyOrdering::automatic, CholeskyOrdering::amd}) {
     CholeskyOptions cholmod_only, own;
@@ -179,11 +180,10 @@ TEST(SparseCholesky, OwnBlockSolveEqualsCholmodsForEveryWidth) {
       }
     }
   }
-  // The natural ordering: the factor's rows are the equations (no permutation applied).
   const GridMatrix small = grid_matrix(5, 4, 4, 3, 12);
-  CholeskyOptions natural;
-  natural.ordering = CholeskyOrdering::amd;
-  SparseCholesky llt(natural);
+  CholeskyOptions own;
+  own.own_solve_columns = 2;
+  SparseCholesky llt(own);
   llt.analyze(small.A);
   llt.factorize(small.A);
   const Eigen::MatrixXd Bs = Eigen::MatrixXd::Random(small.A.rows(), 3);
