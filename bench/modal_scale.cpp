@@ -16,7 +16,7 @@
 // basis cap. `--analyze-only` stops after the symbolic analysis of K − σM and prints the
 // predicted factor (size, flops, ordering). `--solve-widths` factorises K − σM (ordering on
 // the nodes, as the engine does) and times block solves of each width instead of the modes
-// (best of 3 per width), to see what a pass over the factor costs per right-hand side: the
+// (best of 3 per width), to see what a pass over the factor costs per right-hand side:
 // CHOLMOD's solve (`solve_s`, what the engine uses) and our own (`own_solve_s`,
 // fem/supernodal_solve.hpp) on the same factor, and how far their results differ.
 #include "bench/lattice.hpp"
