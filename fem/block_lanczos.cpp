@@ -27,6 +27,22 @@ struct Projection {
   MatrixXd R; // kept × q
 };
 
+// Y = Z S for an n × q block Z and a small q × k matrix S, on the system BLAS (every core),
+// into Y's storage when it already has the size: at 10⁶ DOFs a new n × 8 block costs more in
+// page faults than the product.
+void times_small(const MatrixXd& Z, const MatrixXd& S, MatrixXd& Y) {
+  Y.resize(Z.rows(), S.cols());
+  if (Y.size() == 0) return;
+  if (Z.cols() == 0) {
+    Y.setZero();
+    return;
+  }
+  cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, static_cast<int>(Z.rows()),
+              static_cast<int>(S.cols()), static_cast<int>(Z.cols()), 1.0, Z.data(),
+              static_cast<int>(Z.rows()), S.data(), static_cast<int>(S.rows()), 0.0, Y.data(),
+              static_cast<int>(Y.rows()));
+}
+
 // Z ← Z Δ^{-1/2} U D^{-1/2} from the scaled Gram matrix Δ^{-1/2} ZᵀMZ Δ^{-1/2} = U D Uᵀ,
 // Δ = diag(ZᵀMZ) (SVQB, Stathopoulos & Wu 2002): the scaling lets columns of very different
 // M-norms (a block after its projection, some columns nearly converged) be orthonormalised
@@ -34,7 +50,8 @@ struct Projection {
 // cannot tell from the others (D below q ε), is dropped. MZ ← M Z of the result; returns R
 // with Z_in = Z_out R. A second pass when the first was ill-conditioned (its orthonormality
 // error is about ε κ).
-MatrixXd svqb(const ShiftInvertPencil& P, MatrixXd& Z, MatrixXd& MZ, double floor) {
+MatrixXd svqb(const ShiftInvertPencil& P, MatrixXd& Z, MatrixXd& MZ, double floor,
+              MatrixXd& scratch) {
   const Index q0 = Z.cols();
   MatrixXd R = MatrixXd::Identity(q0, q0);
   for (int pass = 0; pass < 2 && Z.cols() > 0; ++pass) {
@@ -55,8 +72,10 @@ MatrixXd svqb(const ShiftInvertPencil& P, MatrixXd& Z, MatrixXd& MZ, double floo
     const MatrixXd U = eig.eigenvectors().rightCols(kept);
     const VectorXd root = d.tail(kept).cwiseSqrt();
     const MatrixXd to_new = scale.asDiagonal() * U * root.cwiseInverse().asDiagonal();
-    Z = (Z * to_new).eval();
-    MZ = (MZ * to_new).eval();
+    times_small(Z, to_new, scratch);
+    Z.swap(scratch);
+    times_small(MZ, to_new, scratch);
+    MZ.swap(scratch);
     // Z_in = Z_out D^{1/2} Uᵀ Δ^{1/2}; Δ^{1/2} is 1/scale (0 for a dropped column).
     const VectorXd unscale = scale.unaryExpr([](double v) { return v > 0.0 ? 1.0 / v : 0.0; });
     R = (root.asDiagonal() * U.transpose() * unscale.asDiagonal() * R).eval();
@@ -103,7 +122,7 @@ MatrixXd basis_times(const MatrixXd& V, Index m, const MatrixXd& S) {
 // that do lie in span(V) (M-norm below `relative_floor` times the largest column's before
 // the projection) are dropped. MZ holds M Z of the result.
 Projection orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m, MatrixXd& Z,
-                          MatrixXd& MZ, double relative_floor) {
+                          MatrixXd& MZ, double relative_floor, MatrixXd& scratch) {
   Projection p;
   p.C = MatrixXd::Zero(m, Z.cols());
   P.mass(Z, MZ);
@@ -126,13 +145,13 @@ Projection orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m
       p.C += c;
     }
   }
-  p.R = svqb(P, Z, MZ, floor);
+  p.R = svqb(P, Z, MZ, floor, scratch);
   for (int round = 0; round < 2 && check && Z.cols() > 0; ++round) {
     const MatrixXd e = basis_transpose_times(V, m, MZ); // cosines: Z, V are M-orthonormal
     if (e.cwiseAbs().maxCoeff() <= 8.0 * eps * std::sqrt(static_cast<double>(m))) break;
     add_basis_times(Z, -1.0, V, m, e); // Z_in = V (C + e R) + Z' R
     p.C += e * p.R;
-    p.R = svqb(P, Z, MZ, 0.0) * p.R;
+    p.R = svqb(P, Z, MZ, 0.0, scratch) * p.R;
   }
   return p;
 }
@@ -174,9 +193,12 @@ public:
     // A space too small for the block (a small model): smaller blocks, so that the basis can
     // hold the wanted vectors and a block beside them.
     b_ = std::min<Index>(o.block_size, std::max<Index>(1, (rank_ - nev_) / 2));
-    // The default cap: room for the wanted vectors, as many others, and 2 blocks (nev 20, b 8:
-    // 56 vectors, 64 with the next block, 512 MB at 10⁶ DOFs).
-    cap_ = o.max_basis > 0 ? o.max_basis : std::max(2 * nev_ + 2 * b_, nev_ + 4 * b_);
+    // The default cap: room for the wanted vectors, as many others, and 6 blocks (nev 20, b 8:
+    // 88 vectors, 96 with the next block, 768 MB at 10⁶ DOFs). Measured on the frame lattices
+    // of 10⁴, 10⁵ and 10⁶ DOFs (20 modes, blocks of 8): a cap of 56 took 21–23 passes over the
+    // factor, 72 took 19, 88 and more 18 (docs/benchmarks.md); the work outside the solves
+    // hardly changed.
+    cap_ = o.max_basis > 0 ? o.max_basis : 2 * nev_ + 6 * b_;
     cap_ = std::min(std::max(cap_, nev_ + b_), rank_);
     b_ = std::min(b_, cap_ - nev_);
   }
@@ -231,7 +253,7 @@ private:
 
   void start() {
     MatrixXd Z = fresh(b_), MZ;
-    orthonormalise(P_, V_, 0, Z, MZ, deflation);
+    orthonormalise(P_, V_, 0, Z, MZ, deflation, scratch_);
     m_ = 0;
     c0_ = 0;
     q_ = Z.cols();
@@ -250,9 +272,11 @@ private:
     }
     const Index j = m_, q = q_;
     m_ += q;
-    MatrixXd W(n_, q), MW;
+    MatrixXd& W = W_;
+    MatrixXd& MW = MW_;
+    W.resize(n_, q);
     solve(MQ_, W); // W = Op Q
-    const Projection p = orthonormalise(P_, V_, m_, W, MW, deflation);
+    const Projection p = orthonormalise(P_, V_, m_, W, MW, deflation, scratch_);
     const MatrixXd D = p.C.bottomRows(q); // Q_jᵀ M Op Q_j
     H_.block(j, j, q, q) = 0.5 * (D + D.transpose());
     Index kept = W.cols();
@@ -265,7 +289,7 @@ private:
     // while the space has room, so the block keeps its size; they enter with R = 0.
     if (kept < q && m_ + q < rank_) {
       MatrixXd Z = fresh(q - kept), MZ;
-      orthonormalise(P_, V_, m_ + kept, Z, MZ, deflation);
+      orthonormalise(P_, V_, m_ + kept, Z, MZ, deflation, scratch_);
       V_.middleCols(m_ + kept, Z.cols()) = Z;
       MQ_.middleCols(kept, Z.cols()) = MZ;
       kept += Z.cols();
@@ -307,9 +331,9 @@ private:
     // lattice, keeping none of the others took twice the solves, keeping all 10–20 % more.
     const Index k = nev_ + (cap_ - q_ - nev_) / 2;
     multiply_in_place(V_, m_, S.leftCols(k));
-    if (k != m_) {
-      const MatrixXd Q = V_.middleCols(m_, q_);
-      V_.middleCols(k, q_) = Q;
+    if (k != m_) { // k < m: the block moves left, through a copy (the ranges may overlap)
+      W_ = V_.middleCols(m_, q_);
+      V_.middleCols(k, q_) = W_;
     }
     R_ = (R_ * S.block(c0_, 0, m_ - c0_, k)).eval();
     H_.setZero();
@@ -360,6 +384,8 @@ private:
   const BlockLanczosOptions& o_;
   Index n_ = 0, rank_ = 0, nev_ = 0, b_ = 0, cap_ = 0;
   MatrixXd V_, H_, R_, MQ_;
+  // Work blocks kept from block to block (n × b each; new ones would cost page faults).
+  MatrixXd W_, MW_, scratch_;
   VectorXd theta_; // Ritz values of the last Rayleigh–Ritz, descending
   MatrixXd S_;     // their eigenvectors in the basis
   Index m_ = 0, c0_ = 0, q_ = 0;

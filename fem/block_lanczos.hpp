@@ -5,12 +5,11 @@
 ///
 /// Why blocks: on a large model every application of Op is a solve with the factor of K − σM,
 /// and a single-vector solve is bound by the memory bandwidth of reading the factor (20 GiB at
-/// 10⁶ DOFs, 1.2 s a pass). CHOLMOD solves b right-hand sides in one pass over the factor, with
-/// BLAS-3 instead of BLAS-2, so the iteration needs 3× fewer passes (8 columns: 21–22 instead
-/// of Spectra's 64–75 on the 10⁴ and 10⁵ lattices). What a pass of b columns costs depends on
-/// how fast the BLAS-3 kernels are: on the 10⁵ lattice 8 columns cost 2.2–4.3× one
-/// (docs/benchmarks.md); it can come near 1× only where the pass stays bandwidth-bound (a
-/// factor far larger than the caches and kernels that keep up; not measured here).
+/// 10⁶ DOFs, 1.0–1.5 s a pass). A block of b right-hand sides is solved in one pass over the
+/// factor (fem/supernodal_solve.hpp on large factors, CHOLMOD's solve on small ones), so the
+/// iteration needs 3–5× fewer passes (8 columns: 18–19 instead of Spectra's 64–86 on the
+/// 10⁴–10⁶ lattices). At 10⁶ DOFs a pass of 8 columns costs about what one column costs
+/// (1.48 s against CHOLMOD's 1.49 s, measured; docs/benchmarks.md, "Own block solve").
 ///
 /// Why thick restart (Wu & Simon's, the symmetric form of Stewart's Krylov–Schur): when the
 /// basis reaches its cap the iteration keeps the wanted Ritz vectors and the residual block
@@ -47,7 +46,7 @@ public:
 struct BlockLanczosOptions {
   int nev = 10;       ///< wanted eigenpairs: the nev largest θ (the lowest λ)
   int block_size = 8; ///< right-hand sides per solve (≥ 1)
-  /// basis vectors at most, besides the next block; 0: max(2 nev + 2 b, nev + 4 b)
+  /// basis vectors at most, besides the next block; 0: 2 nev + 6 b
   int max_basis = 0;
   int max_dimension = 0; ///< dimension of the space Op works in (M's rank); 0: rows()
   /// A Ritz pair (θ, y) has converged when ‖Op y − θ y‖_M ≤ tolerance · max(ε^⅔, θ) (Spectra's

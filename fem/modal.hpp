@@ -39,8 +39,8 @@ struct ModalOptions {
   /// expected (6 rigid-body modes of a free 3D frame): a larger one is found only by rounding.
   int block_size = 8;
   /// sparse: basis vectors at most (memory: rows × (basis + block) doubles); 0: automatic
-  /// (block Lanczos max(2 nev + 2 block_size, nev + 4 block_size), Spectra max(2 nev + 1, nev +
-  /// 20)), capped at the DOFs with mass
+  /// (block Lanczos 2 nev + 6 block_size, Spectra max(2 nev + 1, nev + 20)), capped at the
+  /// DOFs with mass
   int basis_vectors = 0;
   CholeskyOptions cholesky{}; ///< sparse: ordering and memory check of the K − σM factor
 };

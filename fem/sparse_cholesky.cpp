@@ -152,6 +152,9 @@ struct SparseCholesky::Impl {
   mutable cholmod_dense* x = nullptr;
   mutable cholmod_dense* y = nullptr;
   mutable cholmod_dense* e = nullptr;
+  // Our block solve's plan and work space (fem/supernodal_solve.hpp), made at its first use
+  // after a factorisation.
+  mutable std::unique_ptr<SupernodalSolver> own_solver;
 
   explicit Impl(const CholeskyOptions& o) : options(o) {
     cholmod_l_start(&common);
@@ -330,6 +333,7 @@ const CholeskyAnalysis& SparseCholesky::analyze(const Eigen::SparseMatrix<double
   Impl& m = *impl_;
   cholmod_l_free_factor(&m.factor, &m.common);
   m.factorized = false;
+  m.own_solver.reset();
   const SparsePtr lower(m.lower_triangle(A), FreeSparse{&m.common});
   if (!groups.empty() && static_cast<Long>(groups.size()) != static_cast<Long>(A.cols()))
     throw std::invalid_argument("sparse Cholesky: " + std::to_string(groups.size()) +
@@ -386,6 +390,7 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
                                 " x " + std::to_string(A.cols()) + " matrix, analysed " +
                                 std::to_string(m.analysis.rows));
   m.factorized = false;
+  m.own_solver.reset();
   const SparsePtr lower(m.lower_triangle(A), FreeSparse{&m.common});
   if (!(pattern_of(*lower) == m.pattern))
     throw std::invalid_argument("sparse Cholesky: factorize got a matrix whose nonzero pattern "
@@ -431,22 +436,26 @@ void SparseCholesky::solve(const double* b, double* x, std::int64_t columns) con
   if (columns == 0) return;
   const cholmod_factor& L = *m.factor;
   const int own_from = m.options.own_solve_columns >= 0   ? m.options.own_solve_columns
-                       : m.analysis.factor_entries >= 5e7 ? 2
+                       : m.analysis.factor_entries >= 2e6 ? 2
                                                           : 0;
   if (own_from > 0 && columns >= own_from && L.is_super && L.xtype == CHOLMOD_REAL &&
       L.dtype == CHOLMOD_DOUBLE) {
     static_assert(sizeof(Long) == sizeof(std::int64_t));
-    SupernodalFactorView view;
-    view.n = static_cast<std::int64_t>(L.n);
-    view.supernodes = static_cast<std::int64_t>(L.nsuper);
-    view.first_column = static_cast<const std::int64_t*>(L.super);
-    view.row_pointer = static_cast<const std::int64_t*>(L.pi);
-    view.value_pointer = static_cast<const std::int64_t*>(L.px);
-    view.rows = static_cast<const std::int64_t*>(L.s);
-    view.values = static_cast<const double*>(L.x);
-    view.permutation = static_cast<const std::int64_t*>(L.Perm); // null: the identity
-    supernodal_solve(view, b, x, columns,
-                     static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+    if (!m.own_solver) {
+      SupernodalFactorView view;
+      view.n = static_cast<std::int64_t>(L.n);
+      view.supernodes = static_cast<std::int64_t>(L.nsuper);
+      view.first_column = static_cast<const std::int64_t*>(L.super);
+      view.row_pointer = static_cast<const std::int64_t*>(L.pi);
+      view.value_pointer = static_cast<const std::int64_t*>(L.px);
+      view.rows = static_cast<const std::int64_t*>(L.s);
+      view.values = static_cast<const double*>(L.x);
+      view.permutation = static_cast<const std::int64_t*>(L.Perm); // null: the identity
+      const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+      m.own_solver = std::make_unique<SupernodalSolver>(
+          view, m.options.own_solve_threads > 0 ? m.options.own_solve_threads : cores);
+    }
+    m.own_solver->solve(b, x, columns);
     return;
   }
   const auto n = static_cast<std::size_t>(m.analysis.rows);

@@ -39,10 +39,13 @@ struct CholeskyOptions {
   /// Blocks of at least this many right-hand sides are solved by our own supernodal
   /// substitution on every core (fem/supernodal_solve.hpp), smaller ones by CHOLMOD's
   /// `cholmod_l_solve2`; 0: CHOLMOD's always; −1 (the default): ours from 2 columns on for a
-  /// factor of at least 5·10⁷ values, where it was measured faster (8 columns: 2.79 s against
-  /// 3.93 s on the 10⁶-DOF lattice, 3–10 % on the 10⁵ one, slower on the 10⁴ one;
-  /// docs/benchmarks.md, "Own block solve").
+  /// factor of at least 2·10⁶ values, where it was measured faster (8 columns: 1.48 s against
+  /// 3.70 s on the 10⁶-DOF lattice, 63 ms against 167 ms on the 10⁵ one, 4.5 ms against 9.5 ms
+  /// on the 10⁴ one of 2.8·10⁶ values; docs/benchmarks.md, "Own block solve"). On smaller
+  /// factors starting the cores costs more than the solve.
   int own_solve_columns = -1;
+  /// Cores our block solve uses; 0: every core the machine has.
+  int own_solve_threads = 0;
 };
 
 /// What the symbolic analysis predicts.

@@ -4,18 +4,24 @@
 ///
 /// Why not CHOLMOD's own solve: for a block of b columns it calls the BLAS on each supernode
 /// (dtrsm on the diagonal block, dgemm of the rows below by the b columns). With b small (8)
-/// those calls pack their operands, so on the 10⁵ lattice 8 columns cost 3.1× one column,
-/// where reading the factor, which bounds a single-column solve, is the same. Here each
-/// supernode's columns are taken in panels of 256: the panel's triangle with the right-hand
-/// sides shared among the cores, then the rows below it (forward) or the panel's columns
-/// (backward) shared, with register-blocked kernels that read each factor value once and use
-/// it for every right-hand side. Supernodes under 2¹⁶ values are done by one core.
+/// those calls pack their operands, so on the 10⁶-DOF lattice 8 columns cost 3.9× one column,
+/// where reading the factor, which bounds a single-column solve, is the same.
 ///
-/// Measured (docs/benchmarks.md, "Own block solve"), 8 columns: 2.79 s against CHOLMOD's 3.93 s
-/// on the 10⁶-DOF lattice, 3–10 % faster on the 10⁵ one, slower on the 10⁴ one; so it is used
-/// for large factors only (CholeskyOptions::own_solve_columns). Its forward kernel reads 8
-/// rows of each of 256 columns at a time, which streams the factor badly: the next thing to
-/// change.
+/// How it is done here:
+/// - The right-hand sides are held row-major, a row's (up to) 8 values in one cache line, so
+///   that gathering a supernode's rows reads one line per row instead of one per column.
+/// - The elimination tree is cut below its top: the subtrees under the cut are shared among
+///   the cores whole (a core forward-solves its subtrees alone; the updates its subtrees make
+///   to the rows of the top go to a buffer of its own, added up when all are done), the top
+///   supernodes (the large separators) are each shared: their columns in panels of 256, the
+///   panel's triangle with the right-hand sides shared, then the rows below it (forward) or
+///   the panel's columns (backward). The cut is chosen to balance the cores' work (the factor
+///   values each reads) with least work left in the top's small supernodes, which one core does.
+/// - The kernels read the factor column by column, G columns at a time (4 with AVX2, 8 with
+///   AVX-512), each value once for all the right-hand sides, the rows they update held in the
+///   L1 cache: the hardware prefetchers follow such streams.
+///
+/// Measured: docs/benchmarks.md, "Own block solve".
 ///
 /// The layout (CHOLMOD's `cholmod_factor` with `is_super`): supernode s holds columns
 /// first_column[s] … first_column[s + 1] − 1 of L, its row indices are
@@ -23,6 +29,7 @@
 /// and its values a column-major block of those rows by those columns, starting at
 /// values[value_pointer[s]], the diagonal block's upper part not read.
 #include <cstdint>
+#include <memory>
 
 namespace jointid::fem {
 
@@ -38,8 +45,27 @@ struct SupernodalFactorView {
   const std::int64_t* permutation = nullptr;
 };
 
-/// X = A⁻¹ B for `columns` right-hand sides: B and X column-major n × columns (leading dimension
-/// n), which may not overlap. `threads` ≤ 1 runs on the calling thread alone.
+/// A factor's substitution plan (its elimination tree, cut and shared among `threads` cores)
+/// and work space, kept for repeated solves. The factor's arrays must outlive it and keep
+/// their structure (new values in the same structure are fine).
+class SupernodalSolver {
+public:
+  /// `threads` ≤ 1 runs on the calling thread alone.
+  SupernodalSolver(const SupernodalFactorView& factor, int threads);
+  ~SupernodalSolver();
+  SupernodalSolver(const SupernodalSolver&) = delete;
+  SupernodalSolver& operator=(const SupernodalSolver&) = delete;
+
+  /// X = A⁻¹ B for `columns` right-hand sides: B and X column-major n × columns (leading
+  /// dimension n), which may not overlap.
+  void solve(const double* B, double* X, std::int64_t columns);
+
+private:
+  struct Plan;
+  std::unique_ptr<Plan> plan_;
+};
+
+/// One solve with a plan made for it (SupernodalSolver keeps the plan for the next).
 void supernodal_solve(const SupernodalFactorView& factor, const double* B, double* X,
                       std::int64_t columns, int threads);
 

@@ -147,9 +147,9 @@ TEST(SparseCholesky, OwnBlockSolveEqualsCholmodsForEveryWidth) {
   // Our supernodal substitution (fem/supernodal_solve.hpp, every core) against CHOLMOD's solve
   // of the same factor, column by column. The 12 × 12 × 12 grid of 6 unknowns (10 368) has a
   // top separator of 864 columns, so its panels of 256, the share of rows and columns among
-  // the cores, the 8-, 4- and 1-row tiles and the padding of the right-hand sides to a
-  // multiple of 4 are all run. Widths 2-17 (all remainders by 4 and 8), two orderings, a
-  // zero column; then a small grid whose supernodes are all done by one core.
+  // the cores, the subtrees below the cut, the kernels' groups of 8, 4, 2 and 1 columns and the
+  // padding of the right-hand sides to a multiple of 8 are all run. Widths 2-17 (all
+  // remainders by 4 and 8), two orderings, 1-5 cores, a zero column; then a small grid.
   const GridMatrix g = grid_matrix(12, 12, 12, 6, 11);
   const Eigen::Index n = g.A.rows();
   Eigen::MatrixXd B = random_block(n, 17, 5);
@@ -159,25 +159,36 @@ TEST(SparseCholesky, OwnBlockSolveEqualsCholmodsForEveryWidth) {
     cholmod_only.ordering = own.ordering = ordering;
     cholmod_only.own_solve_columns = 0;
     own.own_solve_columns = 2;
-    SparseCholesky reference(cholmod_only), llt(own);
+    SparseCholesky reference(cholmod_only);
     reference.analyze(g.A, g.groups);
     reference.factorize(g.A);
-    llt.analyze(g.A, g.groups);
-    llt.factorize(g.A);
     Eigen::MatrixXd single(n, B.cols());
     for (Eigen::Index j = 0; j < B.cols(); ++j)
       reference.solve(B.col(j).data(), single.col(j).data());
-    for (Eigen::Index width = 2; width <= B.cols(); ++width) {
-      const Eigen::MatrixXd X = llt.solve(B.leftCols(width));
-      for (Eigen::Index j = 0; j < width; ++j) {
-        // The same factor and arithmetic up to the order of the sums: rounding only. The
-        // solution of a zero column is exactly zero.
-        EXPECT_LE((X.col(j) - single.col(j)).norm(), 1e-13 * single.col(j).norm())
-            << "width " << width << " column " << j;
-        if (j != 5) {
-          EXPECT_LT(relative_residual(g.A, X.col(j), B.col(j)), 1e-13) << width << " " << j;
+    // Every core of this machine (0), and 1, 3 and 5 cores: the elimination tree cut and its
+    // subtrees dealt differently, the top's rows and columns shared in other proportions.
+    for (int threads : {0, 1, 3, 5}) {
+      own.own_solve_threads = threads;
+      SparseCholesky llt(own);
+      llt.analyze(g.A, g.groups);
+      llt.factorize(g.A);
+      for (Eigen::Index width = 2; width <= B.cols(); ++width) {
+        if (threads != 0 && width != 2 && width != 8 && width != 13) continue;
+        const Eigen::MatrixXd X = llt.solve(B.leftCols(width));
+        for (Eigen::Index j = 0; j < width; ++j) {
+          // The same factor and arithmetic up to the order of the sums: rounding only. The
+          // solution of a zero column is exactly zero.
+          EXPECT_LE((X.col(j) - single.col(j)).norm(), 1e-13 * single.col(j).norm())
+              << "threads " << threads << " width " << width << " column " << j;
+          if (j != 5) {
+            EXPECT_LT(relative_residual(g.A, X.col(j), B.col(j)), 1e-13) << width << " " << j;
+          }
         }
       }
+      // A second solve with the plan and work space of the first (the top's update buffers
+      // must have been emptied).
+      const Eigen::MatrixXd again = llt.solve(B.leftCols(8));
+      EXPECT_LE((again.col(7) - single.col(7)).norm(), 1e-13 * single.col(7).norm()) << threads;
     }
   }
   const GridMatrix small = grid_matrix(5, 4, 4, 3, 12);
