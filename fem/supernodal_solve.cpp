@@ -1,6 +1,7 @@
 #include "fem/supernodal_solve.hpp"
 
 #include <algorithm>
+#include <array>
 #include <barrier>
 #include <cassert>
 #include <cstring>
@@ -84,15 +85,38 @@ struct Block {
   Long nscol, nsrow, wp;
 };
 
+// The G columns j … j + G − 1 of a supernode's values.
+template <int G> JOINTID_KERNEL std::array<const double*, G> columns(const Block& b, Long j) {
+  std::array<const double*, G> l;
+#pragma GCC unroll 8
+  for (int k = 0; k < G; ++k)
+    l[k] = b.L + (j + k) * b.nsrow;
+  return l;
+}
+
+// Calls kernel(std::integral_constant<int, g>{}, j) for the columns [j0, j1) in groups of g = G,
+// the rest in groups of 4, 2 and 1.
+template <int G, class Kernel>
+JOINTID_KERNEL void column_groups(Long j0, Long j1, Kernel&& kernel) {
+  Long j = j0;
+  for (; j + G <= j1; j += G)
+    kernel(std::integral_constant<int, G>{}, j);
+  if constexpr (G > 4)
+    for (; j + 4 <= j1; j += 4)
+      kernel(std::integral_constant<int, 4>{}, j);
+  if constexpr (G > 2)
+    for (; j + 2 <= j1; j += 2)
+      kernel(std::integral_constant<int, 2>{}, j);
+  for (; j < j1; ++j)
+    kernel(std::integral_constant<int, 1>{}, j);
+}
+
 // Y(r, :) −= Σ_k L(r, j + k) Y(j + k, :) for the G columns j … j + G − 1 and rows r in
 // [r0, r1): the G columns of L are read as G streams, each value once for all right-hand
 // sides; two sums, so that a row's chain of fused multiply-adds is half as long.
 template <int G> JOINTID_KERNEL void subtract_columns(const Block& b, Long j, Long r0, Long r1) {
-  const Long ld = b.nsrow, wp = b.wp;
-  const double* l[G];
-#pragma GCC unroll 8
-  for (int k = 0; k < G; ++k)
-    l[k] = b.L + (j + k) * ld;
+  const Long wp = b.wp;
+  const auto l = columns<G>(b, j);
   for (Long c = 0; c < wp; c += chunk) {
     v8 x[G];
 #pragma GCC unroll 8
@@ -113,11 +137,8 @@ template <int G> JOINTID_KERNEL void subtract_columns(const Block& b, Long j, Lo
 
 // Y(j + k, :) −= Σ_r L(r, j + k) Y(r, :) over rows r in [r0, r1), for the G columns j … j + G − 1.
 template <int G> JOINTID_KERNEL void gather_columns(const Block& b, Long j, Long r0, Long r1) {
-  const Long ld = b.nsrow, wp = b.wp;
-  const double* l[G];
-#pragma GCC unroll 8
-  for (int k = 0; k < G; ++k)
-    l[k] = b.L + (j + k) * ld;
+  const Long wp = b.wp;
+  const auto l = columns<G>(b, j);
   for (Long c = 0; c < wp; c += chunk) {
     v8 s[G];
 #pragma GCC unroll 8
@@ -144,17 +165,10 @@ template <int G>
 JOINTID_KERNEL void update_below(const Block& b, Long p0, Long pb, Long r0, Long r1) {
   for (Long rb = r0; rb < r1; rb += row_block) {
     const Long re = std::min(r1, rb + row_block);
-    Long j = p0;
-    for (; j + G <= p0 + pb; j += G)
-      subtract_columns<G>(b, j, rb, re);
-    if constexpr (G > 4)
-      for (; j + 4 <= p0 + pb; j += 4)
-        subtract_columns<4>(b, j, rb, re);
-    if constexpr (G > 2)
-      for (; j + 2 <= p0 + pb; j += 2)
-        subtract_columns<2>(b, j, rb, re);
-    for (; j < p0 + pb; ++j)
-      subtract_columns<1>(b, j, rb, re);
+    column_groups<G>(
+        p0, p0 + pb, [&](auto g, Long j) __attribute__((always_inline)) {
+          subtract_columns<g()>(b, j, rb, re);
+        });
   }
 }
 
@@ -162,17 +176,10 @@ JOINTID_KERNEL void update_below(const Block& b, Long p0, Long pb, Long r0, Long
 template <int G> JOINTID_KERNEL void update_panel(const Block& b, Long j0, Long j1, Long r0) {
   for (Long rb = r0; rb < b.nsrow; rb += row_block) {
     const Long re = std::min(b.nsrow, rb + row_block);
-    Long j = j0;
-    for (; j + G <= j1; j += G)
-      gather_columns<G>(b, j, rb, re);
-    if constexpr (G > 4)
-      for (; j + 4 <= j1; j += 4)
-        gather_columns<4>(b, j, rb, re);
-    if constexpr (G > 2)
-      for (; j + 2 <= j1; j += 2)
-        gather_columns<2>(b, j, rb, re);
-    for (; j < j1; ++j)
-      gather_columns<1>(b, j, rb, re);
+    column_groups<G>(
+        j0, j1, [&](auto g, Long j) __attribute__((always_inline)) {
+          gather_columns<g()>(b, j, rb, re);
+        });
   }
 }
 
