@@ -44,7 +44,7 @@ struct CholeskyOptions {
   /// on the 10⁴ one of 2.8·10⁶ values; docs/benchmarks.md, "Own block solve"). On smaller
   /// factors starting the cores costs more than the solve.
   int own_solve_columns = -1;
-  /// Cores our block solve uses; 0: every core the machine has.
+  /// Cores our block solve uses; 0 (or less): every core the machine has.
   int own_solve_threads = 0;
 };
 

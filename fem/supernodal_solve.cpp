@@ -656,9 +656,4 @@ void SupernodalSolver::solve(const double* B, double* Xout, Long columns) {
   }
 }
 
-void supernodal_solve(const SupernodalFactorView& factor, const double* B, double* X, Long columns,
-                      int threads) {
-  SupernodalSolver(factor, threads).solve(B, X, columns);
-}
-
 } // namespace jointid::fem

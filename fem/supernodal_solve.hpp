@@ -65,8 +65,4 @@ private:
   std::unique_ptr<Plan> plan_;
 };
 
-/// One solve with a plan made for it (SupernodalSolver keeps the plan for the next).
-void supernodal_solve(const SupernodalFactorView& factor, const double* B, double* X,
-                      std::int64_t columns, int threads);
-
 } // namespace jointid::fem
