@@ -100,11 +100,12 @@ MatrixXd basis_transpose_times(const MatrixXd& V, Index m, const MatrixXd& Z) {
   return C;
 }
 
-// Z ← Z + alpha V(:, 0:m) C.
-void add_basis_times(MatrixXd& Z, double alpha, const MatrixXd& V, Index m, const MatrixXd& C) {
+// Z ← Z + alpha V(:, first:first + m) C.
+void add_basis_times(MatrixXd& Z, double alpha, const MatrixXd& V, Index m, const MatrixXd& C,
+                     Index first = 0) {
   if (m == 0 || Z.cols() == 0) return;
   cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, static_cast<int>(Z.rows()),
-              static_cast<int>(Z.cols()), static_cast<int>(m), alpha, V.data(),
+              static_cast<int>(Z.cols()), static_cast<int>(m), alpha, V.data() + first * V.rows(),
               static_cast<int>(V.rows()), C.data(), static_cast<int>(C.rows()), 1.0, Z.data(),
               static_cast<int>(Z.rows()));
 }
@@ -116,30 +117,35 @@ MatrixXd basis_times(const MatrixXd& V, Index m, const MatrixXd& S) {
   return Y;
 }
 
-// Makes Z M-orthonormal and M-orthogonal to the first m columns of V: two passes of block
-// classical Gram–Schmidt, then SVQB, repeated while the result is not orthogonal to V to
-// rounding (a block that nearly lies in span(V) loses digits in the first round). Directions
-// that do lie in span(V) (M-norm below `relative_floor` times the largest column's before
-// the projection) are dropped. MZ holds M Z of the result.
+// Makes Z M-orthonormal and M-orthogonal to the first m columns of V: `passes` passes of
+// block classical Gram–Schmidt (two for a block never projected before; one after a first
+// projection the caller made, the Lanczos step against the last blocks), then SVQB, repeated
+// while the result is not orthogonal to V to rounding (a block that nearly lies in span(V)
+// loses digits in the first round). Directions that do lie in span(V) (M-norm below
+// `relative_floor` times the largest column's before any projection) are dropped; `removed`
+// holds, per column, the M-norm² a caller's first projection took away (empty: none). MZ holds
+// M Z of the result.
 Projection orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m, MatrixXd& Z,
-                          MatrixXd& MZ, double relative_floor, MatrixXd& scratch) {
+                          MatrixXd& MZ, double relative_floor, MatrixXd& scratch, int passes = 2,
+                          const Eigen::RowVectorXd& removed = {}) {
   Projection p;
   p.C = MatrixXd::Zero(m, Z.cols());
   P.mass(Z, MZ);
-  const double scale = std::sqrt(std::max(0.0, Z.cwiseProduct(MZ).colwise().sum().maxCoeff()));
+  Eigen::RowVectorXd norms2 = Z.cwiseProduct(MZ).colwise().sum();
+  if (removed.size() == norms2.size()) norms2 += removed; // Pythagoras
+  const double scale = std::sqrt(std::max(0.0, norms2.maxCoeff()));
   const double floor = relative_floor * scale;
-  // Whether the second pass still removed much (more than half of a column's M-norm², by
+  // Whether the last pass still removed much (more than half of a column's M-norm², by
   // Pythagoras): only then can the result be off orthogonal by more than rounding ("twice is
   // enough", Kahan–Parlett) and is checked.
   bool check = false;
   if (m > 0) {
-    for (int pass = 0; pass < 2; ++pass) {
+    for (int pass = 0; pass < passes; ++pass) {
       if (pass > 0) P.mass(Z, MZ);
       const MatrixXd c = basis_transpose_times(V, m, MZ);
-      if (pass > 0) {
+      if (pass == passes - 1) {
         const Eigen::RowVectorXd before = Z.cwiseProduct(MZ).colwise().sum();
-        const Eigen::RowVectorXd removed = c.colwise().squaredNorm();
-        check = (removed.array() > 0.5 * before.array()).any();
+        check = (c.colwise().squaredNorm().array() > 0.5 * before.array()).any();
       }
       add_basis_times(Z, -1.0, V, m, c);
       p.C += c;
@@ -276,15 +282,30 @@ private:
     MatrixXd& MW = MW_;
     W.resize(n_, q);
     solve(MQ_, W); // W = Op Q
-    const Projection p = orthonormalise(P_, V_, m_, W, MW, deflation, scratch_);
-    const MatrixXd D = p.C.bottomRows(q); // Q_jᵀ M Op Q_j
+    // The Lanczos step first, against the columns Q couples to: their coefficients are known,
+    // V(c0..j)ᵀ M Op Q = Rᵀ (Op is M-self-adjoint and Op V(c0..j) = V H + Q R), and Qᵀ M Op Q
+    // = (M Q)ᵀ W needs no product with M. In exact arithmetic that leaves W M-orthogonal to
+    // the whole basis; one pass of Gram–Schmidt against the whole basis then takes away what
+    // rounding and the solve's error left (the second pass of CGS2, the first being this one),
+    // with one product with M and two reads of the basis fewer than two full passes.
+    MatrixXd local(m_ - c0_, q);
+    local.topRows(j - c0_) = R_.transpose();
+    local.bottomRows(q) = basis_transpose_times(MQ_, q, W);
+    add_basis_times(W, -1.0, V_, m_ - c0_, local, c0_);
+    const Projection p =
+        orthonormalise(P_, V_, m_, W, MW, deflation, scratch_, 1, local.colwise().squaredNorm());
+    const MatrixXd D = local.bottomRows(q) + p.C.bottomRows(q); // Q_jᵀ M Op Q_j
     H_.block(j, j, q, q) = 0.5 * (D + D.transpose());
     Index kept = W.cols();
     MatrixXd R = MatrixXd::Zero(q, q);
     R.topRows(kept) = p.R;
     V_.middleCols(m_, kept) = W;
-    MQ_.resize(n_, q);
-    MQ_.leftCols(kept) = MW;
+    if (kept == q) {
+      MQ_.swap(MW); // MW's storage is the next block's
+    } else {
+      MQ_.resize(n_, q);
+      MQ_.leftCols(kept) = MW;
+    }
     // A direction lost (Op Q nearly in span(V)): refill the block with fresh directions
     // while the space has room, so the block keeps its size; they enter with R = 0.
     if (kept < q && m_ + q < rank_) {

@@ -16,7 +16,8 @@
 /// and goes on from there. That is as good as an implicit restart for a symmetric operator,
 /// keeps memory fixed (n × (cap + b) doubles), needs no shifted QR steps on a block
 /// tridiagonal matrix, and its basis stays orthonormal by construction (every new block is
-/// orthogonalised twice against the whole basis, CGS2 in the M-inner product, BLAS-3).
+/// orthogonalised twice, CGS2 in the M-inner product, BLAS-3: first by the Lanczos step against
+/// the blocks it couples to, whose coefficients are known, then against the whole basis).
 /// After convergence the wanted vectors take one more power step, φ ← Op φ / θ, read off the
 /// Krylov relation (no solve): it brings ‖KΦ − MΦΛ‖/‖KΦ‖ from ~1e-8 to ~1e-11 on the 10⁴
 /// lattice (Spectra's: 1e-9 … 1e-12).

@@ -187,7 +187,7 @@ public:
   void solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) override { op_.solve_block(B, X); }
   // Y = M X, reading M once for the whole block (Eigen's product reads it once per column) and
   // rows shared among the cores: M is symmetric, so row i of M X is column i of M times X,
-  // gathered from rows of X held row-major (one cache line per row for 8 columns). Three of
+  // gathered from rows of X held row-major (one cache line per row for 8 columns). Two of
   // these per block, against one solve: the row-major copy is kept between calls (a new
   // 64 MB block at 10⁶ DOFs costs more in page faults than the product), and each core
   // writes its rows of Y straight into the column-major result.
