@@ -362,7 +362,13 @@ TEST_P(NoiseLevel, CubicStiffnessIsFoundAndTheGapEndsAtTheNoise) {
   EXPECT_LT(r.noise_gap, 4.0 * fundamental);
 }
 
-INSTANTIATE_TEST_SUITE_P(Discover, NoiseLevel, ::testing::Values(0.005, 0.01, 0.02));
+// Named by the noise in per cent of each channel's RMS: Noise0_5pc, Noise1pc, Noise2pc.
+INSTANTIATE_TEST_SUITE_P(Discover, NoiseLevel, ::testing::Values(0.005, 0.01, 0.02),
+                         [](const auto& info) {
+                           const long tenths = std::lround(info.param * 1000.0);
+                           return "Noise" + std::to_string(tenths / 10) +
+                                  (tenths % 10 ? "_" + std::to_string(tenths % 10) : "") + "pc";
+                         });
 
 TEST(Discover, FromStepSineFundamentalsOfAccelerationOnly) {
   // What many labs keep: the fundamental of force and drive-point acceleration per test. The
