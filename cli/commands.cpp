@@ -2,6 +2,7 @@
 
 #include "cli/engine.hpp"
 
+#include "cli/terminal_progress.hpp"
 #include "discover/discover.hpp"
 #include "fem/excitation.hpp"
 #include "fem/modal.hpp"
@@ -15,19 +16,22 @@
 #include "identify/output_error.hpp"
 #include "identify/random_tests.hpp"
 #include "identify/sine_tests.hpp"
-#include "io/chart.hpp"
-#include "io/discovery_report.hpp"
 #include "io/files.hpp"
 #include "io/frf_output.hpp"
-#include "io/harmonic_fit_figure.hpp"
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
 #include "io/response_curves.hpp"
 #include "io/results_json.hpp"
 #include "io/spectra_comparison.hpp"
-#include "io/terminal_progress.hpp"
-#include "io/vtk_output.hpp"
 #include "joints/joint.hpp"
+#include "report/chart.hpp"
+#include "report/compare_figure.hpp"
+#include "report/discovery_json.hpp"
+#include "report/discovery_report.hpp"
+#include "report/frf_figure.hpp"
+#include "report/harmonic_fit_figure.hpp"
+#include "report/response_figure.hpp"
+#include "report/vtk_output.hpp"
 
 #include <fmt/format.h>
 
@@ -166,9 +170,9 @@ std::pair<double, double> parse_band(const std::string& option, const std::strin
 }
 
 // Progress on a terminal, from MPI rank 0 only.
-struct TerminalProgress : io::TerminalProgress {
+struct TerminalProgress : TerminalProgress {
   explicit TerminalProgress(std::string label)
-      : io::TerminalProgress(std::move(label), output_rank()) {}
+      : TerminalProgress(std::move(label), output_rank()) {}
 };
 
 identify::TransientRoute parse_route(const std::string& text) {
@@ -435,7 +439,7 @@ void simulate(const SimulateOptions& o) {
     std::vector<identify::Record> records;
     for (const auto& t : tests)
       records.push_back(t.record);
-    const io::SteppedSineTable table = io::stepped_sine_table(records);
+    const io::SteppedSineTable table = identify::stepped_sine_table(records);
     outputs.push_back({o.output_dir / "stepped_sine.csv", io::stepped_sine_csv(table, comments)});
   } else {
     for (const auto& t : tests)
@@ -514,7 +518,7 @@ void identify(const IdentifyOptions& o) {
     fmt::print("not determined: {}\n", sentence);
   fmt::print("wrote {}\n", o.output.string());
   // The pictures (each optional; one that cannot be drawn is a warning, the result stands).
-  std::vector<std::pair<fs::path, std::function<io::Figure()>>> pictures;
+  std::vector<std::pair<fs::path, std::function<report::Figure()>>> pictures;
   if (!o.fit_png.empty())
     pictures.push_back({o.fit_png, [&] {
                           std::vector<fem::NodeDof> shown;
@@ -523,19 +527,20 @@ void identify(const IdentifyOptions& o) {
                               if (node != 0 && std::find(shown.begin(), shown.end(),
                                                          fem::NodeDof{node, j.dof}) == shown.end())
                                 shown.push_back({node, j.dof});
-                          return io::harmonic_fit_figure(measured, shown);
+                          return report::harmonic_fit_figure(measured, shown);
                         }});
   if (!o.params_png.empty())
-    pictures.push_back({o.params_png, [&] { return io::parameter_figure(result, file.joints); }});
+    pictures.push_back(
+        {o.params_png, [&] { return report::parameter_figure(result, file.joints); }});
   std::string why;
-  const bool drawable = pictures.empty() || io::can_render_charts(&why);
+  const bool drawable = pictures.empty() || report::can_render_charts(&why);
   for (const auto& [png, figure] : pictures) {
     if (!drawable) {
       warn("no " + png.string() + ": " + why + " (run under xvfb-run -a)");
       continue;
     }
     try {
-      io::write_chart_png(png, figure());
+      report::write_chart_png(png, figure());
       fmt::print("wrote {}\n", png.string());
     } catch (const std::invalid_argument& e) {
       warn("no " + png.string() + ": " + e.what());
@@ -586,13 +591,13 @@ void discover(const DiscoverOptions& o) {
   if (!output_rank()) return;
   make_output_dir(o.output_dir);
   const fs::path json = o.output_dir / "discovery.json";
-  io::write_json(json, io::discovery_json(result));
+  io::write_json(json, report::discovery_json(result));
   std::vector<std::string> warnings = result.warnings;
-  io::ReportContext context{o.model.string(), {}, o.plots};
+  report::ReportContext context{o.model.string(), {}, o.plots};
   for (const auto& p : o.records)
     context.inputs.push_back(p.string());
   const std::vector<fs::path> written =
-      io::write_discovery_report(o.output_dir, result, context, warnings);
+      report::write_discovery_report(o.output_dir, result, context, warnings);
 
   for (std::size_t i = 0; i + 1 < result.diagnosis.findings.size(); ++i)
     fmt::print("{}\n", result.diagnosis.findings[i]);
@@ -692,23 +697,23 @@ void modes(const ModesOptions& o) {
   fmt::print("{:>5} {:>16}\n", "mode", "frequency (Hz)");
   for (int r = 0; r < std::min(count, modes.num_modes()); ++r)
     fmt::print("{:>5} {:>16.8g}\n", r + 1, modes.frequency_hz(r));
-  if (!io::vtk_available()) {
+  if (!report::vtk_available()) {
     fmt::print("wrote {}\n", out.string());
-    warnings.push_back(std::string(io::no_vtk_message) +
+    warnings.push_back(std::string(report::no_vtk_message) +
                        " (modes.json only: no .vtu/.pvd files, no modes.png)");
     for (const auto& w : warnings)
       warn(w);
     return;
   }
-  io::write_modes_vtk(o.output_dir, file.model, system.dofs, modes);
+  report::write_modes_vtk(o.output_dir, file.model, system.dofs, modes);
   fmt::print("wrote {}, {} and {} (ParaView)\n", out.string(),
              (o.output_dir / "modes.vtu").string(), (o.output_dir / "mode_<r>.pvd").string());
   if (o.pictures > 0) {
     const fs::path png = o.output_dir / "modes.png";
     const char* display = std::getenv("DISPLAY");
     if (display && *display) {
-      io::render_modes_png(png, file.model, system.dofs, modes,
-                           std::min(o.pictures, modes.num_modes()));
+      report::render_modes_png(png, file.model, system.dofs, modes,
+                               std::min(o.pictures, modes.num_modes()));
       fmt::print("wrote {}\n", png.string());
     } else {
       warnings.push_back(
@@ -782,9 +787,9 @@ void response(const ResponseOptions& o) {
   fmt::print("wrote {}\n", json.string());
   if (o.plot) {
     std::string why;
-    if (io::can_render_charts(&why)) {
+    if (report::can_render_charts(&why)) {
       const fs::path png = o.output_dir / "response.png";
-      io::write_chart_png(png, io::response_figure(curves, shown));
+      report::write_chart_png(png, report::response_figure(curves, shown));
       fmt::print("wrote {}\n", png.string());
     } else {
       warn("no response.png: " + why + " (run under xvfb-run -a)");
@@ -874,8 +879,8 @@ void frf(const FrfOptions& o) {
   fmt::print("wrote {}\nwrote {}\n", csv.string(), uff.string());
   if (o.plot) {
     std::string why;
-    if (io::can_render_charts(&why)) {
-      io::write_chart_png(png, io::frf_figure(sweep, sub.dofs()));
+    if (report::can_render_charts(&why)) {
+      report::write_chart_png(png, report::frf_figure(sweep, sub.dofs()));
       fmt::print("wrote {}\n", png.string());
     } else {
       warn("no frf.png: " + why + " (run under xvfb-run -a)");
@@ -1119,9 +1124,9 @@ void compare(const CompareOptions& o) {
   fmt::print("wrote {}\n", json.string());
   if (o.plot) {
     std::string why;
-    if (io::can_render_charts(&why)) {
+    if (report::can_render_charts(&why)) {
       const fs::path png = o.output_dir / "compare.png";
-      io::write_chart_png(png, io::compare_figure(result));
+      report::write_chart_png(png, report::compare_figure(result));
       fmt::print("wrote {}\n", png.string());
     } else {
       warn("no compare.png: " + why + " (run under xvfb-run -a)");

@@ -3,7 +3,7 @@
 #include "cli/commands.hpp"
 #include "cli/engine.hpp"
 #include "io/files.hpp"
-#include "io/vtk_output.hpp"
+#include "report/vtk_output.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -31,7 +31,7 @@ std::string one_line(std::string text) {
 // command again under `xvfb-run -a` (a virtual one), once; if that is impossible, carry on and
 // the picture is skipped with a warning.
 void rerun_with_display(char** argv) {
-  if (!jointid::io::vtk_available()) return; // nothing to draw with
+  if (!jointid::report::vtk_available()) return; // nothing to draw with
   const char* display = std::getenv("DISPLAY");
   if ((display && *display) || std::getenv("JOINTID_UNDER_XVFB")) return;
   setenv("JOINTID_UNDER_XVFB", "1", 1);

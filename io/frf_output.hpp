@@ -3,7 +3,6 @@
 /// universal file (dataset 58, function type 4) and a magnitude-and-phase figure.
 #include "fem/dof_map.hpp"
 #include "frf/sweep.hpp"
-#include "io/chart.hpp"
 #include "io/uff58.hpp"
 
 #include <string>
@@ -27,9 +26,5 @@ std::string frf_csv(const frf::FrfSweep& sweep, const fem::DofMap& dofs);
 /// line 1 `<kind> <response>/<drive>`. Throws io::Error when the frequencies are not evenly
 /// spaced (to 1e-9 of the step; dataset 58 would need uneven spacing) or fewer than 2.
 std::vector<Uff58Function> frf_uff58(const frf::FrfSweep& sweep, const fem::DofMap& dofs);
-
-/// Magnitude (log scale) and phase (degrees, -180 … 180) over frequency, one colour per
-/// response DOF: two charts, one above the other.
-Figure frf_figure(const frf::FrfSweep& sweep, const fem::DofMap& dofs);
 
 } // namespace jointid::io

@@ -349,49 +349,6 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
   return table;
 }
 
-SteppedSineTable stepped_sine_table(const std::vector<identify::Record>& records) {
-  SteppedSineTable table;
-  if (records.empty()) return table;
-  for (const auto& c : records.front().channels)
-    table.channels.push_back(c.name());
-  table.values.resize(static_cast<Eigen::Index>(records.size()),
-                      static_cast<Eigen::Index>(table.channels.size()));
-  for (std::size_t i = 0; i < records.size(); ++i) {
-    const identify::Record& r = records[i];
-    std::vector<std::string> names;
-    for (const auto& c : r.channels)
-      names.push_back(c.name());
-    if (names != table.channels)
-      throw Error(fmt::format("{}: its channels differ from those of {}; a stepped-sine table "
-                              "needs the same channels in every test",
-                              r.source, records.front().source));
-    const double f = r.excitation_hz
-                         ? *r.excitation_hz
-                         : identify::estimate_frequency(
-                               r.t, r.all(identify::Quantity::force).empty()
-                                        ? r.channels.front().samples
-                                        : r.all(identify::Quantity::force).front()->samples);
-    const double nyquist = 0.5 / r.dt();
-    if (!(f < nyquist))
-      throw Error(fmt::format("{}: the excitation, {} Hz, is not below the Nyquist frequency of "
-                              "its sampling, {} Hz (step {} s): its fundamental cannot be fitted",
-                              r.source, f, nyquist, r.dt()));
-    const int n = identify::whole_period_samples(r.t, f);
-    if (n == 0) throw Error(fmt::format("{}: shorter than one period of {} Hz", r.source, f));
-    if (n < 3)
-      throw Error(fmt::format("{}: its whole periods of {} Hz hold {} samples; fitting the "
-                              "fundamental needs at least 3 (a longer record or faster sampling)",
-                              r.source, f, n));
-    table.freq_hz.push_back(f);
-    for (std::size_t c = 0; c < r.channels.size(); ++c)
-      table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) =
-          identify::fit_harmonics(Eigen::VectorXd(r.t.head(n)),
-                                  Eigen::VectorXd(r.channels[c].samples.head(n)),
-                                  2.0 * std::numbers::pi * f, 1)(1);
-  }
-  return table;
-}
-
 std::string stepped_sine_csv(const SteppedSineTable& table,
                              const std::vector<std::string>& comments) {
   const auto rows = static_cast<Eigen::Index>(table.freq_hz.size());

@@ -7,6 +7,7 @@
 #include "fem/dof_map.hpp"
 #include "identify/measurement.hpp"
 #include "identify/record.hpp"
+#include "identify/stepped_sine.hpp"
 #include "joints/joint.hpp"
 
 #include <Eigen/Core>
@@ -35,24 +36,10 @@ std::string record_csv(const identify::Record& record,
 void write_record(const std::filesystem::path& path, const identify::Record& record,
                   const std::vector<std::string>& comments = {});
 
-/// Many sine tests reduced to their fundamentals.
-struct SteppedSineTable {
-  std::vector<double> freq_hz;       ///< one per test, Hz
-  std::vector<std::string> channels; ///< "x@7:uy", ...
-  Eigen::MatrixXcd values;           ///< tests × channels, complex peak amplitudes (SI)
-  std::vector<int> lines;            ///< line of each test in the file
-};
+using SteppedSineTable = identify::SteppedSineTable;
 
 /// Reads a stepped-sine table; throws io::Error naming file, line and column as read_record.
 SteppedSineTable read_stepped_sine(const std::filesystem::path& path);
-
-/// The fundamentals of sine-test records as a stepped-sine table: each channel's complex
-/// amplitude at its record's excitation frequency (a least-squares fit over the record's whole
-/// periods), one row per record. The records must have the same channels in the same order;
-/// throws io::Error naming the first that differs, one shorter than a period, one whose
-/// frequency is not below the Nyquist frequency of its sampling, or one whose whole periods hold
-/// fewer than 3 samples.
-SteppedSineTable stepped_sine_table(const std::vector<identify::Record>& records);
 
 /// The CSV text of a stepped-sine table: each comment as `# ...` lines, the header and one row
 /// per test, every number in its shortest form that reads back bit-exactly. Throws io::Error

@@ -2,7 +2,6 @@
 /// Response curves (frf::response_curves) as `jointid response` writes them: the JSON contract
 /// and the figure.
 #include "frf/continuation.hpp"
-#include "io/chart.hpp"
 
 #include <string>
 
@@ -15,10 +14,5 @@ namespace jointid::io {
 /// `points` follow the branch (the frequency may go back at folds); `folds` index `points`;
 /// `stable` is null where not determined. Non-finite numbers are written as null.
 std::string response_json(const frf::ResponseCurves& curves);
-
-/// Amplitude of the fundamental |X_1| at `shown` (one of curves.dofs) over frequency, one
-/// colour per force amplitude: stable stretches solid, unstable dashed, stability not
-/// determined dotted (points), folds marked with black dots.
-Figure response_figure(const frf::ResponseCurves& curves, const fem::NodeDof& shown);
 
 } // namespace jointid::io

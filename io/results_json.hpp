@@ -1,6 +1,5 @@
 #pragma once
 /// JSON results (DESIGN.md's contract): identification results and mode lists.
-#include "discover/discover.hpp"
 #include "fem/modal.hpp"
 #include "identify/design.hpp"
 #include "identify/fit.hpp"
@@ -31,16 +30,6 @@ std::string identify_result_json(const identify::FitResult& result,
 /// count < 0 or larger than the number of modes).
 std::string modes_json(const fem::Modes& modes, int count = -1,
                        const std::vector<std::string>& warnings = {});
-
-/// The discovery result as DESIGN.md's JSON, extended (README: "discovery.json"):
-/// {"tests", "compared_values", "noise_gap", "at_noise_level", "start": {"notes", "gap",
-/// "joints"}, "steps": [{"joint", "term", "effect", "value", "std", "ci95", "gap_before",
-/// "gap_after", "explained", "cv_gap_before", "cv_gap_after", "finding", "ranking": [...]}],
-/// "gap": [g0, g1, ...], "diagnosis": {...}, "final_model": {"joints": [...],
-/// "substructure_damping_scale"}, "stop_reason", "last_ranking", "comparisons": {"start": [...],
-/// "final": [...]}, "warnings"}. The substructure's damping scale appears as joint
-/// "substructure", term "damping_scale". NaN and infinite numbers are written as null.
-std::string discovery_json(const discover::Result& result);
 
 /// An experiment design (README: "design.json"): {"noise", "periods", "harmonics",
 /// "unknowns": [{"joint", "term", "prior", "std", "relative_std", "bias"}], "chosen":

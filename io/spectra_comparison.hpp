@@ -2,7 +2,6 @@
 /// `jointid compare`'s outputs: the JSON of identify::Comparison and its figure (measured vs
 /// predicted response PSD, log y, one chart per channel).
 #include "identify/compare.hpp"
-#include "io/chart.hpp"
 
 #include <string>
 
@@ -17,9 +16,5 @@ std::string compare_json(const identify::Comparison& comparison);
 
 /// The unit of the one-sided PSD of a channel ("x@7:uy"): "m^2/Hz", "(rad/s)^2/Hz" for v@7:rz, …
 std::string psd_unit(const std::string& channel);
-
-/// One chart per channel: measured and predicted PSD over the band (log y), titled with the
-/// channel and its RMS difference in dB. Part of jointid_io_output (the chart writer's library).
-Figure compare_figure(const identify::Comparison& comparison);
 
 } // namespace jointid::io

@@ -20,7 +20,7 @@ cmake --build build-sanitize -j "$(nproc)"
 # LeakSanitizer reports from an "<unknown module>" (the library is gone, so no suppression can
 # name it). These run with leak detection off; ASan's memory errors and UBSan stay on. Every
 # other test runs with leak detection.
-drawing='^(io_vtk_png|io_vtk_demo|CliTest\..*|fem_slepc_np[12])$'
+drawing='^(report_vtk_png|report_vtk_demo|CliTest\..*|fem_slepc_np[12])$'
 ctest --test-dir build-sanitize --output-on-failure --timeout 1800 -j "$(nproc)" \
   -E "$drawing" "$@"
 ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" \

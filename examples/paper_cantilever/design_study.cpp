@@ -5,13 +5,13 @@
 // error of the identification (noise added to the records, identified; RMS over
 // the repetitions, bias included). Records by time integration from rest (Newmark, 2048 steps a
 // period, to the periodic steady state), 8 periods of 256 samples. Prints a Markdown table.
+#include "cli/terminal_progress.hpp"
 #include "frf/substructure.hpp"
 #include "identify/design.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "identify/sine_tests.hpp"
 #include "io/model_file.hpp"
-#include "io/terminal_progress.hpp"
 #include "paper_cases.hpp"
 
 #include <fmt/format.h>
@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
         fo.harmonics = harmonics;
         Eigen::VectorXd square = Eigen::VectorXd::Zero(scale.size());
         int failed = 0;
-        const io::TerminalProgress progress("paper_design_study: " + design.name);
+        const TerminalProgress progress("paper_design_study: " + design.name);
         for (int r = 0; r < reps; ++r) {
           progress.show(static_cast<double>(r) / reps);
           std::vector<identify::SineTest> tests;

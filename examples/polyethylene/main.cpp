@@ -33,10 +33,10 @@
 #include "identify/measurement.hpp"
 #include "identify/random_tests.hpp"
 #include "identify/sine_tests.hpp"
-#include "io/chart.hpp"
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
 #include "io/spectra_comparison.hpp"
+#include "report/chart.hpp"
 
 #include <fmt/format.h>
 
@@ -371,12 +371,12 @@ int main(int argc, char** argv) {
                                                  rb.f1, own.rms_db, ctl.rms_db));
       if (!png.empty()) {
         std::string why;
-        if (!io::can_render_charts(&why)) {
+        if (!report::can_render_charts(&why)) {
           fmt::print("no picture: {}\n", why);
         } else {
-          io::Figure f = io::compare_figure(predictions[rb.use_fit].second);
+          report::Figure f = report::compare_figure(predictions[rb.use_fit].second);
           const std::string file = fmt::format("{}_{:g}-{:g}Hz.png", png, rb.f0, rb.f1);
-          io::write_chart_png(file, f);
+          report::write_chart_png(file, f);
           fmt::print("wrote {}\n", file);
         }
       }

@@ -8,13 +8,13 @@
 //  3. Monte Carlo over the noise (fixed seeds): the coverage of the 95 % intervals and the bias of
 //     every parameter, and a figure of the coverage (needs an X display: run under xvfb-run -a).
 // Usage: three_joints [--reps N] [--noise L] [--png FILE]
+#include "cli/terminal_progress.hpp"
 #include "frf/substructure.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "identify/sine_tests.hpp"
-#include "io/chart.hpp"
 #include "io/model_file.hpp"
-#include "io/terminal_progress.hpp"
+#include "report/chart.hpp"
 
 #include <fmt/format.h>
 
@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
       names.push_back(fmt::format("{} {}", truth[j].name, joints::term_name(truth[j].terms[t])));
   covered.assign(names.size(), 0.0);
   bias = square = stds = covered;
-  const io::TerminalProgress progress("three_joints: Monte Carlo");
+  const TerminalProgress progress("three_joints: Monte Carlo");
   for (int r = 0; r < reps; ++r) {
     progress.show(static_cast<double>(r) / reps);
     const identify::FitResult fit = identify_once(r);
@@ -132,30 +132,31 @@ int main(int argc, char** argv) {
 
   if (!png.empty()) {
     std::string why;
-    if (!io::can_render_charts(&why)) {
+    if (!report::can_render_charts(&why)) {
       fmt::print("no picture: {} (run under xvfb-run -a)\n", why);
       return 0;
     }
-    io::Chart c;
+    report::Chart c;
     c.title = fmt::format("Coverage of the 95 % intervals, {} noisy repetitions ({:g} % noise)",
                           reps, 100.0 * noise);
     c.y_label = "coverage (%)";
     c.x_categories = names;
-    io::Series bars{"coverage", {}, {}, io::Series::Style::bars};
+    report::Series bars{"coverage", {}, {}, report::Series::Style::bars};
     for (double v : covered)
       bars.y.push_back(100.0 * v);
     c.series.push_back(bars);
     const double x0 = 0.5, x1 = static_cast<double>(names.size()) + 0.5;
     c.series.push_back(
-        {"95 % (nominal)", {x0, x1}, {95.0, 95.0}, io::Series::Style::line, {0, 0, 0}});
+        {"95 % (nominal)", {x0, x1}, {95.0, 95.0}, report::Series::Style::line, {0, 0, 0}});
     c.series.push_back(
-        {"90 % and 98 %", {x0, x1}, {90.0, 90.0}, io::Series::Style::dashed, {120, 120, 120}});
-    c.series.push_back({"", {x0, x1}, {98.0, 98.0}, io::Series::Style::dashed, {120, 120, 120}});
-    io::Figure f;
+        {"90 % and 98 %", {x0, x1}, {90.0, 90.0}, report::Series::Style::dashed, {120, 120, 120}});
+    c.series.push_back(
+        {"", {x0, x1}, {98.0, 98.0}, report::Series::Style::dashed, {120, 120, 120}});
+    report::Figure f;
     f.width = 1400;
     f.height = 700;
     f.charts.push_back(c);
-    io::write_chart_png(png, f);
+    report::write_chart_png(png, f);
     fmt::print("wrote {}\n", png);
   }
   return 0;

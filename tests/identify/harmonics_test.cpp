@@ -90,7 +90,7 @@ TEST(WholePeriodSamples, CountsWholePeriods) {
   EXPECT_EQ(whole_period_samples(t, 2.0), 1000);    // 2 whole periods of 0.5 s
   EXPECT_EQ(whole_period_samples(t, 0.5), 0);       // shorter than one period
   // Frequencies far above the sampling's, infinite or NaN no longer overflow the conversion to
-  // int (UBSan; seen while fixing what fuzzing found in io::stepped_sine_table).
+  // int (UBSan; seen while fixing what fuzzing found in identify::stepped_sine_table).
   EXPECT_EQ(whole_period_samples(t, 1e300), 1050);
   EXPECT_EQ(whole_period_samples(t, std::numeric_limits<double>::infinity()), 0);
   EXPECT_EQ(whole_period_samples(t, std::numeric_limits<double>::quiet_NaN()), 0);

@@ -1,6 +1,6 @@
 // Charts written as PNG pictures, read back with VTK's PNG reader and checked pixel by pixel:
 // the picture's size, where the series' colours land, and the errors for bad figures.
-#include "io/chart.hpp"
+#include "report/chart.hpp"
 
 #include "io/test_files.hpp"
 
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace jointid::io {
+namespace jointid::report {
 namespace {
 
 namespace fs = std::filesystem;
@@ -500,4 +500,4 @@ TEST(ChartValidation, WithoutDisplayTheErrorSaysToUseXvfbRun) {
 }
 
 } // namespace
-} // namespace jointid::io
+} // namespace jointid::report

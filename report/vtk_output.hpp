@@ -8,7 +8,7 @@
 
 #include <filesystem>
 
-namespace jointid::io {
+namespace jointid::report {
 
 /// What a build without VTK (-DJOINTID_WITH_VTK=OFF) says when asked for VTK files, pictures or
 /// charts.
@@ -69,4 +69,4 @@ void render_modes_png(const std::filesystem::path& png, const fem::Model& model,
                       const fem::DofMap& dofs, const fem::Modes& modes, int count,
                       const PngOptions& options = {});
 
-} // namespace jointid::io
+} // namespace jointid::report

@@ -1,4 +1,5 @@
 // frf_figure(): part of jointid_io_output, with the other figures (the palette lives there).
+#include "report/frf_figure.hpp"
 #include "io/frf_output.hpp"
 
 #include <fmt/format.h>
@@ -7,7 +8,7 @@
 #include <complex>
 #include <numbers>
 
-namespace jointid::io {
+namespace jointid::report {
 
 Figure frf_figure(const frf::FrfSweep& sweep, const fem::DofMap& dofs) {
   const fem::NodeDof drive = dofs.node_dof(sweep.drive);
@@ -22,7 +23,7 @@ Figure frf_figure(const frf::FrfSweep& sweep, const fem::DofMap& dofs) {
   for (std::size_t c = 0; c < sweep.responses.size(); ++c) {
     const fem::NodeDof at = dofs.node_dof(sweep.responses[c]);
     const std::string unit =
-        frf_unit(sweep.kind, fem::is_rotation(at.dof), fem::is_rotation(drive.dof));
+        io::frf_unit(sweep.kind, fem::is_rotation(at.dof), fem::is_rotation(drive.dof));
     if (units.find(unit) == std::string::npos) units += (units.empty() ? "" : ", ") + unit;
     Series mag, ph;
     mag.label = ph.label = fem::to_string(at);
@@ -56,4 +57,4 @@ Figure frf_figure(const frf::FrfSweep& sweep, const fem::DofMap& dofs) {
   return figure;
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

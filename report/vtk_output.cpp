@@ -1,8 +1,8 @@
-#include "io/vtk_output.hpp"
+#include "report/vtk_output.hpp"
 
 #include "io/files.hpp"
-#include "io/vtk_display.hpp"
-#include "io/vtk_render.hpp"
+#include "report/vtk_display.hpp"
+#include "report/vtk_render.hpp"
 
 #include <vtkActor.h>
 #include <vtkActor2D.h>
@@ -45,7 +45,7 @@
 #include <string>
 #include <vector>
 
-namespace jointid::io {
+namespace jointid::report {
 
 namespace fs = std::filesystem;
 
@@ -222,7 +222,7 @@ public:
     for (int attempt = 0; attempt < 100; ++attempt) {
       path_ = dir_ / (".jointid-vtk-" + std::to_string(random() % 1000000000));
       // Registered before it exists: an interrupt removes it with whatever it holds.
-      registration_ = std::make_unique<InFlight>(path_, InFlight::Kind::directory);
+      registration_ = std::make_unique<io::InFlight>(path_, io::InFlight::Kind::directory);
       if (fs::create_directory(path_, ec)) return;
     }
     registration_.reset();
@@ -240,9 +240,9 @@ public:
   /// Moves staged entries (file or directory names, in this order) into the target directory.
   void commit(const std::vector<std::string>& names) {
     for (const auto& name : names)
-      check_not_an_input(dir_ / name);
+      io::check_not_an_input(dir_ / name);
     // An interrupt waits for the renames: an old directory moved aside is always replaced.
-    const CommitSection section;
+    const io::CommitSection section;
     std::error_code ec;
     for (const auto& name : names) {
       const fs::path target = dir_ / name;
@@ -258,7 +258,7 @@ public:
 private:
   fs::path dir_;
   fs::path path_;
-  std::unique_ptr<InFlight> registration_;
+  std::unique_ptr<io::InFlight> registration_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -659,4 +659,4 @@ void render_modes_png(const fs::path& png, const fem::Model& model, const fem::D
   detail::render_to_png(window, png);
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

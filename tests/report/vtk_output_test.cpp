@@ -1,10 +1,10 @@
 // VTK files and PNG pictures of mode shapes, read back with VTK's own readers and checked
 // against the modal analysis they were written from.
-#include "io/vtk_output.hpp"
+#include "report/vtk_output.hpp"
 
 #include "fem/assembly.hpp"
 #include "io/test_files.hpp"
-#include "io/vtk_models.hpp"
+#include "report/vtk_models.hpp"
 
 #include <gtest/gtest.h>
 
@@ -25,7 +25,7 @@
 #include <set>
 #include <string>
 
-namespace jointid::io {
+namespace jointid::report {
 namespace {
 
 namespace fs = std::filesystem;
@@ -383,4 +383,4 @@ TEST(VtkPng, WithoutDisplayTheErrorSaysToUseXvfbRun) {
 }
 
 } // namespace
-} // namespace jointid::io
+} // namespace jointid::report

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace jointid::io {
+namespace jointid::report {
 
 struct ReportContext {
   std::string model;               ///< the model file, as given
@@ -26,4 +26,4 @@ std::vector<std::filesystem::path> write_discovery_report(const std::filesystem:
                                                           const ReportContext& context,
                                                           std::vector<std::string>& warnings);
 
-} // namespace jointid::io
+} // namespace jointid::report

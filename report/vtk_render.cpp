@@ -1,4 +1,4 @@
-#include "io/vtk_render.hpp"
+#include "report/vtk_render.hpp"
 
 #include "io/files.hpp"
 
@@ -10,7 +10,7 @@
 #include <random>
 #include <stdexcept>
 
-namespace jointid::io::detail {
+namespace jointid::report::detail {
 
 namespace fs = std::filesystem;
 
@@ -38,10 +38,10 @@ void render_to_png(vtkRenderWindow* window, const fs::path& png) {
   capture->Update();
   // A hidden temporary name beside the picture, registered so that an interrupt removes it,
   // then renamed over the picture: an old picture is replaced whole or kept.
-  check_not_an_input(png);
+  io::check_not_an_input(png);
   std::error_code ec;
   fs::path tmp;
-  std::unique_ptr<InFlight> registration;
+  std::unique_ptr<io::InFlight> registration;
   std::random_device seed;
   for (int attempt = 0; attempt < 100; ++attempt) {
     std::string name = ".";
@@ -50,7 +50,7 @@ void render_to_png(vtkRenderWindow* window, const fs::path& png) {
     tmp = png.parent_path() / name;
     if (!fs::exists(tmp, ec)) break;
   }
-  registration = std::make_unique<InFlight>(tmp, InFlight::Kind::file);
+  registration = std::make_unique<io::InFlight>(tmp, io::InFlight::Kind::file);
   vtkNew<vtkPNGWriter> writer;
   vtkNew<ErrorCatcher> write_errors;
   writer->AddObserver(vtkCommand::ErrorEvent, write_errors);
@@ -64,7 +64,7 @@ void render_to_png(vtkRenderWindow* window, const fs::path& png) {
         (write_errors->message.empty() ? "PNG writer failed" : vtk_message(write_errors->message)));
   }
   {
-    const CommitSection section;
+    const io::CommitSection section;
     fs::rename(tmp, png, ec);
   }
   if (ec) {
@@ -74,4 +74,4 @@ void render_to_png(vtkRenderWindow* window, const fs::path& png) {
   }
 }
 
-} // namespace jointid::io::detail
+} // namespace jointid::report::detail

@@ -1,6 +1,6 @@
 // harmonic_fit_figure(): part of jointid_io_output, with the other figures (the palette lives
 // there).
-#include "io/harmonic_fit_figure.hpp"
+#include "report/harmonic_fit_figure.hpp"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include <numbers>
 #include <stdexcept>
 
-namespace jointid::io {
+namespace jointid::report {
 
 Figure harmonic_fit_figure(const std::vector<identify::Measurement>& tests,
                            const std::vector<fem::NodeDof>& shown) {
@@ -129,4 +129,4 @@ Figure parameter_figure(const identify::FitResult& result,
   return figure;
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

@@ -5,7 +5,7 @@
 #include <functional>
 #include <string>
 
-namespace jointid::io {
+namespace jointid::cli {
 
 class TerminalProgress {
 public:
@@ -24,4 +24,4 @@ private:
   bool on_ = false;
 };
 
-} // namespace jointid::io
+} // namespace jointid::cli

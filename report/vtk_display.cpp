@@ -1,4 +1,4 @@
-#include "io/vtk_display.hpp"
+#include "report/vtk_display.hpp"
 
 #include <vtkRenderingOpenGLConfigure.h> // VTK_USE_X
 
@@ -11,7 +11,7 @@
 #include <X11/Xlib.h>
 #endif
 
-namespace jointid::io::detail {
+namespace jointid::report::detail {
 
 RenderDisplay::RenderDisplay() {
 #ifdef VTK_USE_X
@@ -35,4 +35,4 @@ RenderDisplay::~RenderDisplay() {
 #endif
 }
 
-} // namespace jointid::io::detail
+} // namespace jointid::report::detail

@@ -1,11 +1,11 @@
 // jointid_io_novtk: a build without VTK (-DJOINTID_WITH_VTK=OFF, for headless cluster nodes).
 // The functions that need VTK say so; the discovery report is written without its plots.
-#include "io/chart.hpp"
-#include "io/vtk_output.hpp"
+#include "report/chart.hpp"
+#include "report/vtk_output.hpp"
 
 #include <stdexcept>
 
-namespace jointid::io {
+namespace jointid::report {
 
 bool vtk_available() {
   return false;
@@ -30,4 +30,4 @@ bool can_render_charts(std::string* why) {
   return false;
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace jointid::io {
+namespace jointid::report {
 
 struct Series {
   enum class Style { line, dashed, points, line_points, bars };
@@ -48,4 +48,4 @@ std::array<int, 3> palette_color(std::size_t i);
 /// `why` says what is missing.
 bool can_render_charts(std::string* why = nullptr);
 
-} // namespace jointid::io
+} // namespace jointid::report

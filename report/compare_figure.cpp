@@ -1,5 +1,5 @@
 // compare_figure(): part of jointid_io_output, with the other figures (the palette lives there).
-#include "io/spectra_comparison.hpp"
+#include "report/compare_figure.hpp"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <string>
 
-namespace jointid::io {
+namespace jointid::report {
 
 Figure compare_figure(const identify::Comparison& c) {
   Figure figure;
@@ -22,7 +22,7 @@ Figure compare_figure(const identify::Comparison& c) {
                               "{:g}-{:g} Hz",
                               ch.channel, ch.rms_db, ch.max_db, c.f0_hz, c.f1_hz);
     chart.x_label = "frequency (Hz)";
-    chart.y_label = fmt::format("PSD of {} ({})", ch.channel, psd_unit(ch.channel));
+    chart.y_label = fmt::format("PSD of {} ({})", ch.channel, io::psd_unit(ch.channel));
     chart.log_y = true;
     Series measured, predicted;
     measured.label = "measured";
@@ -45,4 +45,4 @@ Figure compare_figure(const identify::Comparison& c) {
   return figure;
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

@@ -1,8 +1,8 @@
 // The default colours of chart series (see chart.hpp); without VTK too, since the discovery
 // report picks its colours before it knows whether it can draw.
-#include "io/chart.hpp"
+#include "report/chart.hpp"
 
-namespace jointid::io {
+namespace jointid::report {
 
 namespace {
 
@@ -24,4 +24,4 @@ std::array<int, 3> palette_color(std::size_t i) {
   return palette[i % palette.size()];
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

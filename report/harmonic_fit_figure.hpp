@@ -5,11 +5,11 @@
 #include "fem/dof.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
-#include "io/chart.hpp"
+#include "report/chart.hpp"
 
 #include <vector>
 
-namespace jointid::io {
+namespace jointid::report {
 
 /// One chart per test (in order; grid of up to 3 columns): at each of `shown` measured as a
 /// displacement channel, the samples of the record's averaged period (points) and the harmonic
@@ -28,4 +28,4 @@ Figure harmonic_fit_figure(const std::vector<identify::Measurement>& tests,
 Figure parameter_figure(const identify::FitResult& result,
                         const std::vector<joints::Joint>& model_joints);
 
-} // namespace jointid::io
+} // namespace jointid::report

@@ -1,7 +1,7 @@
-#include "io/chart.hpp"
+#include "report/chart.hpp"
 
-#include "io/vtk_display.hpp"
-#include "io/vtk_render.hpp"
+#include "report/vtk_display.hpp"
+#include "report/vtk_render.hpp"
 
 #include <vtkAxis.h>
 #include <vtkBrush.h>
@@ -35,7 +35,7 @@
 #include <string>
 #include <vector>
 
-namespace jointid::io {
+namespace jointid::report {
 
 namespace fs = std::filesystem;
 
@@ -488,4 +488,4 @@ bool can_render_charts(std::string* why) {
   return display.problem().empty();
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

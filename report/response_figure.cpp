@@ -1,5 +1,5 @@
 // response_figure(): part of jointid_io_vtk, with the other figures (the palette lives there).
-#include "io/response_curves.hpp"
+#include "report/response_figure.hpp"
 
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 #include <optional>
 #include <stdexcept>
 
-namespace jointid::io {
+namespace jointid::report {
 
 Figure response_figure(const frf::ResponseCurves& c, const fem::NodeDof& shown) {
   const auto at = std::find(c.dofs.begin(), c.dofs.end(), shown);
@@ -71,4 +71,4 @@ Figure response_figure(const frf::ResponseCurves& c, const fem::NodeDof& shown) 
   return figure;
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

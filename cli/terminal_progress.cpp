@@ -1,4 +1,4 @@
-#include "io/terminal_progress.hpp"
+#include "cli/terminal_progress.hpp"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 
 #include <unistd.h>
 
-namespace jointid::io {
+namespace jointid::cli {
 
 TerminalProgress::TerminalProgress(std::string label, bool enabled)
     : label_(std::move(label)), on_(enabled && isatty(STDERR_FILENO) == 1) {}
@@ -29,4 +29,4 @@ void TerminalProgress::clear() const {
   std::fflush(stderr);
 }
 
-} // namespace jointid::io
+} // namespace jointid::cli

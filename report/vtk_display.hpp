@@ -2,7 +2,7 @@
 /// Internal to jointid_io_vtk: the X display connection that VTK's render window draws on.
 #include <string>
 
-namespace jointid::io::detail {
+namespace jointid::report::detail {
 
 /// Debian's VTK 9.1 renders through GLX and aborts the process when it cannot open the X
 /// display itself. So the library opens the display first, retrying briefly (an Xvfb whose last
@@ -25,4 +25,4 @@ private:
   std::string problem_;
 };
 
-} // namespace jointid::io::detail
+} // namespace jointid::report::detail

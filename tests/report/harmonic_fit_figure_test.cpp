@@ -1,7 +1,7 @@
 // The records-and-harmonic-fits figure of `jointid identify --fit-png`: its data, checked without
 // drawing. A harmonic-balance record holds harmonics 0 … 9 exactly, so a fit of 9 harmonics
 // leaves only rounding; a fit of the fundamental alone leaves the cubic joint's harmonics.
-#include "io/harmonic_fit_figure.hpp"
+#include "report/harmonic_fit_figure.hpp"
 
 #include "frf/substructure.hpp"
 #include "identify/sine_tests.hpp"
@@ -39,7 +39,7 @@ TEST(HarmonicFitFigure, ResidualIsRoundingWithEveryHarmonicAndNotWithTheFundamen
   const std::vector<fem::NodeDof> shown{{7, fem::Dof::uy}};
   identify::MeasureOptions all;
   all.harmonics = 9;
-  const io::Figure exact = io::harmonic_fit_figure(identify::measure(tests, all), shown);
+  const report::Figure exact = report::harmonic_fit_figure(identify::measure(tests, all), shown);
   ASSERT_EQ(exact.charts.size(), 2u);
   for (const auto& chart : exact.charts) {
     ASSERT_EQ(chart.series.size(), 2u);        // samples, fit
@@ -48,10 +48,11 @@ TEST(HarmonicFitFigure, ResidualIsRoundingWithEveryHarmonicAndNotWithTheFundamen
   }
   identify::MeasureOptions fundamental;
   fundamental.harmonics = 1;
-  const io::Figure rough = io::harmonic_fit_figure(identify::measure(tests, fundamental), shown);
+  const report::Figure rough =
+      report::harmonic_fit_figure(identify::measure(tests, fundamental), shown);
   EXPECT_GT(residual_percent(rough.charts[0].title), 1.0) << rough.charts[0].title; // 1 Hz
   // A DOF without a displacement channel: nothing to draw.
-  EXPECT_THROW(io::harmonic_fit_figure(identify::measure(tests, all), {{4, fem::Dof::uy}}),
+  EXPECT_THROW(report::harmonic_fit_figure(identify::measure(tests, all), {{4, fem::Dof::uy}}),
                std::invalid_argument);
 }
 
@@ -69,9 +70,9 @@ TEST(ParameterFigure, RatiosAndIntervalsOfTheTermsTheModelGives) {
                       {{joints::Term::k, 4896.0, 24.0, 4848.0, 4944.0, false, true},
                        {joints::Term::c, 20.0, 0.0, 20.0, 20.0, true, true},
                        {joints::Term::k3, 1.7e8, 1e6, 1.68e8, 1.72e8, false, true}}});
-  const io::Figure f = io::parameter_figure(r, {model});
+  const report::Figure f = report::parameter_figure(r, {model});
   ASSERT_EQ(f.charts.size(), 1u);
-  const io::Chart& c = f.charts[0];
+  const report::Chart& c = f.charts[0];
   // c is fixed and k3 has no value in the model: k alone, at 1.02 with [1.01, 1.03].
   ASSERT_EQ(c.x_categories, std::vector<std::string>{"tip k"});
   ASSERT_EQ(c.series.size(), 3u); // the line at 1, k's interval, the values
@@ -80,7 +81,7 @@ TEST(ParameterFigure, RatiosAndIntervalsOfTheTermsTheModelGives) {
   EXPECT_DOUBLE_EQ(c.series[1].y[1], 1.03);
   EXPECT_DOUBLE_EQ(c.series[2].y[0], 1.02);
   model.given = {false, true, false};
-  EXPECT_THROW(io::parameter_figure(r, {model}), std::invalid_argument);
+  EXPECT_THROW(report::parameter_figure(r, {model}), std::invalid_argument);
 }
 
 } // namespace

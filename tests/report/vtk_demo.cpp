@@ -3,8 +3,8 @@
 // OUTDIR/cantilever_modes.png, OUTDIR/portal_modes.png, OUTDIR/cantilever/, OUTDIR/portal/.
 #include "fem/assembly.hpp"
 #include "fem/modal.hpp"
-#include "io/vtk_models.hpp"
-#include "io/vtk_output.hpp"
+#include "report/vtk_models.hpp"
+#include "report/vtk_output.hpp"
 
 #include <exception>
 #include <filesystem>
@@ -25,15 +25,15 @@ int main(int argc, char** argv) {
     const fem::Model cantilever = test::beam_cantilever(10);
     const fem::Assembled beam = fem::assemble(cantilever);
     const fem::Modes beam_modes = fem::modal_analysis(beam, {.num_modes = 6});
-    io::write_modes_vtk(out / "cantilever", cantilever, beam.dofs, beam_modes);
-    io::render_modes_png(out / "cantilever_modes.png", cantilever, beam.dofs, beam_modes, 6);
+    report::write_modes_vtk(out / "cantilever", cantilever, beam.dofs, beam_modes);
+    report::render_modes_png(out / "cantilever_modes.png", cantilever, beam.dofs, beam_modes, 6);
 
     // 2. A 3D portal frame, 4 elements per member: the first six modes, in and out of plane.
     const fem::Model portal = test::portal_frame(4);
     const fem::Assembled frame = fem::assemble(portal);
     const fem::Modes frame_modes = fem::modal_analysis(frame, {.num_modes = 6});
-    io::write_modes_vtk(out / "portal", portal, frame.dofs, frame_modes);
-    io::render_modes_png(out / "portal_modes.png", portal, frame.dofs, frame_modes, 6);
+    report::write_modes_vtk(out / "portal", portal, frame.dofs, frame_modes);
+    report::render_modes_png(out / "portal_modes.png", portal, frame.dofs, frame_modes, 6);
 
     std::cout << "wrote " << (out / "cantilever_modes.png").string() << " and "
               << (out / "portal_modes.png").string() << "\n";

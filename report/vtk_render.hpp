@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-namespace jointid::io::detail {
+namespace jointid::report::detail {
 
 /// Keeps the last error a VTK object reports (attach with AddObserver(vtkCommand::ErrorEvent)).
 class ErrorCatcher : public vtkCommand {
@@ -27,4 +27,4 @@ std::string vtk_message(const std::string& text);
 /// naming the path when rendering or writing fails.
 void render_to_png(vtkRenderWindow* window, const std::filesystem::path& png);
 
-} // namespace jointid::io::detail
+} // namespace jointid::report::detail

@@ -1,8 +1,8 @@
-#include "io/discovery_report.hpp"
+#include "report/discovery_report.hpp"
 
-#include "io/chart.hpp"
 #include "io/files.hpp"
-#include "io/vtk_output.hpp"
+#include "report/chart.hpp"
+#include "report/vtk_output.hpp"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include <map>
 #include <set>
 
-namespace jointid::io {
+namespace jointid::report {
 
 namespace fs = std::filesystem;
 
@@ -386,9 +386,9 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     for (const auto& w : r.warnings)
       md += "- " + w + "\n";
   }
-  write_file_atomically(dir / "report.md", md);
+  io::write_file_atomically(dir / "report.md", md);
   written.push_back(dir / "report.md");
   return written;
 }
 
-} // namespace jointid::io
+} // namespace jointid::report

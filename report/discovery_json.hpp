@@ -1,0 +1,19 @@
+#pragma once
+/// discovery.json: the result of model discovery as DESIGN.md's JSON contract.
+#include "discover/discover.hpp"
+
+#include <string>
+
+namespace jointid::report {
+
+/// The discovery result as DESIGN.md's JSON, extended (README: "discovery.json"):
+/// {"tests", "compared_values", "noise_gap", "at_noise_level", "start": {"notes", "gap",
+/// "joints"}, "steps": [{"joint", "term", "effect", "value", "std", "ci95", "gap_before",
+/// "gap_after", "explained", "cv_gap_before", "cv_gap_after", "finding", "ranking": [...]}],
+/// "gap": [g0, g1, ...], "diagnosis": {...}, "final_model": {"joints": [...],
+/// "substructure_damping_scale"}, "stop_reason", "last_ranking", "comparisons": {"start": [...],
+/// "final": [...]}, "warnings"}. The substructure's damping scale appears as joint
+/// "substructure", term "damping_scale". NaN and infinite numbers are written as null.
+std::string discovery_json(const discover::Result& result);
+
+} // namespace jointid::report
