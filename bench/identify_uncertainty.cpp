@@ -11,11 +11,11 @@
 //
 //   bench_identify_uncertainty [repetitions (200)] [harmonics|two|oe]   (harmonics: the
 //   harmonics study; two: the two-joint study alone; oe: output error against GLS and the bound)
+#include "cli/terminal_progress.hpp"
 #include "frf/harmonic_balance.hpp"
 #include "identify/fit.hpp"
 #include "identify/output_error.hpp"
 #include "identify/sine_tests.hpp"
-#include "cli/terminal_progress.hpp"
 #include "support/cantilever.hpp"
 
 #include <Eigen/Dense>
@@ -74,7 +74,7 @@ Stats monte_carlo(const frf::Substructure& sub, const Study& s,
   const std::size_t np = params.size();
   Stats st{std::vector<double>(np), std::vector<double>(np), std::vector<double>(np),
            std::vector<double>(np)};
-  const TerminalProgress progress("Monte Carlo");
+  const cli::TerminalProgress progress("Monte Carlo");
   for (int r = 0; r < reps; ++r) {
     progress.show(static_cast<double>(r) / reps);
     std::vector<identify::SineTest> tests;

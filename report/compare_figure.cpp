@@ -1,6 +1,8 @@
 // compare_figure(): part of jointid_io_output, with the other figures (the palette lives there).
 #include "report/compare_figure.hpp"
 
+#include "io/spectra_comparison.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>

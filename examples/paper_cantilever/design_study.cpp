@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
         fo.harmonics = harmonics;
         Eigen::VectorXd square = Eigen::VectorXd::Zero(scale.size());
         int failed = 0;
-        const TerminalProgress progress("paper_design_study: " + design.name);
+        const cli::TerminalProgress progress("paper_design_study: " + design.name);
         for (int r = 0; r < reps; ++r) {
           progress.show(static_cast<double>(r) / reps);
           std::vector<identify::SineTest> tests;

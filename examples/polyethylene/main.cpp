@@ -37,6 +37,7 @@
 #include "io/record_csv.hpp"
 #include "io/spectra_comparison.hpp"
 #include "report/chart.hpp"
+#include "report/compare_figure.hpp"
 
 #include <fmt/format.h>
 

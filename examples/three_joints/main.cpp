@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
       names.push_back(fmt::format("{} {}", truth[j].name, joints::term_name(truth[j].terms[t])));
   covered.assign(names.size(), 0.0);
   bias = square = stds = covered;
-  const TerminalProgress progress("three_joints: Monte Carlo");
+  const cli::TerminalProgress progress("three_joints: Monte Carlo");
   for (int r = 0; r < reps; ++r) {
     progress.show(static_cast<double>(r) / reps);
     const identify::FitResult fit = identify_once(r);

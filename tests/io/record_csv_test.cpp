@@ -13,6 +13,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 
 namespace jointid::io {
 namespace {
@@ -550,7 +551,7 @@ TEST_F(RecordCsvTest, SteppedSineTableFromRecordsHoldsTheFundamentals) {
   const std::complex<double> X1a = std::polar(4e-3, 0.3), X1b = std::polar(9e-3, -2.0);
   const std::vector<identify::Record> records{harmonic_record(2.5, X1a, 4, true, 4.0),
                                               harmonic_record(3.7, X1b, 3, false, 0.0)};
-  const SteppedSineTable t = stepped_sine_table(records);
+  const SteppedSineTable t = identify::stepped_sine_table(records);
   EXPECT_EQ(t.channels, (std::vector<std::string>{"f@7:uy", "x@7:uy", "v@7:uy"}));
   ASSERT_EQ(t.freq_hz.size(), 2u);
   EXPECT_EQ(t.freq_hz[0], 2.5);
@@ -578,9 +579,9 @@ TEST_F(RecordCsvTest, SteppedSineTableFromRecordsHoldsTheFundamentals) {
   std::vector<identify::Record> mixed = records;
   mixed[1].channels.pop_back();
   try {
-    stepped_sine_table(mixed);
+    identify::stepped_sine_table(mixed);
     FAIL() << "differing channels accepted";
-  } catch (const Error& e) {
+  } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find(mixed[1].source), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("channels differ"), std::string::npos) << e.what();
   }
@@ -589,12 +590,12 @@ TEST_F(RecordCsvTest, SteppedSineTableFromRecordsHoldsTheFundamentals) {
   for (auto& c : short_record.channels)
     c.samples.conservativeResize(100);
   try {
-    stepped_sine_table({short_record});
+    identify::stepped_sine_table({short_record});
     FAIL() << "a record shorter than a period accepted";
-  } catch (const Error& e) {
+  } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()), short_record.source + ": shorter than one period of 2.5 Hz");
   }
-  EXPECT_TRUE(stepped_sine_table({}).freq_hz.empty());
+  EXPECT_TRUE(identify::stepped_sine_table({}).freq_hz.empty());
 }
 
 // Fuzzing regressions (docs/fuzzing.md): stepped_sine_table let std::invalid_argument escape from
@@ -612,8 +613,8 @@ TEST_F(RecordCsvTest, SteppedSineTableRefusesRecordsItCannotFit) {
   const auto error_of = [&](const std::string& text) {
     const identify::Record record = read_record(write(text));
     try {
-      stepped_sine_table({record});
-    } catch (const Error& e) {
+      identify::stepped_sine_table({record});
+    } catch (const std::invalid_argument& e) {
       return std::string(e.what());
     }
     return std::string("(no error)");
