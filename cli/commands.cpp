@@ -170,9 +170,8 @@ std::pair<double, double> parse_band(const std::string& option, const std::strin
 }
 
 // Progress on a terminal, from MPI rank 0 only.
-struct TerminalProgress : TerminalProgress {
-  explicit TerminalProgress(std::string label)
-      : TerminalProgress(std::move(label), output_rank()) {}
+struct RankProgress : TerminalProgress {
+  explicit RankProgress(std::string label) : TerminalProgress(std::move(label), output_rank()) {}
 };
 
 identify::TransientRoute parse_route(const std::string& text) {
@@ -300,7 +299,7 @@ void simulate_signal(const SimulateOptions& o) {
     options.extra_outputs.push_back(resolve(file, sub, "--outputs", text));
   io::check_not_an_input(o.output_dir / name);
   identify::ForcedTest test;
-  const TerminalProgress progress{"jointid simulate: time simulation"};
+  const RankProgress progress{"jointid simulate: time simulation"};
   options.progress = progress.callback();
   try {
     test = identify::simulate_forced(sub, file.joints, input, options);
@@ -402,7 +401,7 @@ void simulate(const SimulateOptions& o) {
 
   // 3. Simulate every test, keeping the records in memory: nothing is written unless all succeed.
   std::vector<identify::SimulatedTest> tests;
-  const TerminalProgress progress{fmt::format("jointid simulate: {} sine tests", plans.size())};
+  const RankProgress progress{fmt::format("jointid simulate: {} sine tests", plans.size())};
   options.progress = progress.callback();
   try {
     tests = identify::simulate_sine_tests(sub, file.joints, force_at, plans, options);
@@ -1005,7 +1004,7 @@ void design(const DesignOptions& o) {
   options.max_misfit = o.max_misfit;
   std::vector<identify::CandidateTest> candidates;
   identify::Design chosen;
-  const TerminalProgress progress{
+  const RankProgress progress{
       fmt::format("jointid design: predicting {} candidates", plans.size())};
   options.progress = progress.callback();
   try {
@@ -1099,7 +1098,7 @@ void compare(const CompareOptions& o) {
 
   // 3. Predict and compare.
   identify::Comparison result;
-  const TerminalProgress progress{"jointid compare: predicting"};
+  const RankProgress progress{"jointid compare: predicting"};
   options.simulation.progress = progress.callback();
   try {
     result = identify::compare_spectra(sub, file.joints, record, options);
