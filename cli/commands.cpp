@@ -252,7 +252,7 @@ void simulate_signal(const SimulateOptions& o) {
   // 2. The force history.
   identify::ForceInput input;
   std::string name;
-  double duration = o.duration;
+  double duration = o.duration, default_fade = 0.0;
   if (from_record) {
     const identify::Record record = io::read_record(o.force_from);
     try {
@@ -261,6 +261,7 @@ void simulate_signal(const SimulateOptions& o) {
       throw io::Error(std::string("--force-from ") + e.what());
     }
     duration = static_cast<double>(record.t.size()) / input.sample_rate_hz;
+    default_fade = identify::default_fade_in_s(input);
     name = o.force_from.stem().string() + "_simulated.csv";
   } else {
     const identify::ExcitationSpec spec{kind == "random"  ? identify::Excitation::random
@@ -278,13 +279,9 @@ void simulate_signal(const SimulateOptions& o) {
       throw io::Error(std::string("--band, --duration, --sample-rate: ") + e.what());
     }
     name = identify::excitation_record_name(spec);
+    default_fade = identify::default_fade_in_s(spec);
   }
-  // Default: 5 % of the duration, none for a record's force that already starts at zero.
-  const bool starts_at_zero =
-      input.samples.row(0).cwiseAbs().maxCoeff() <= 1e-9 * input.samples.cwiseAbs().maxCoeff();
-  const double fade = o.fade_in                       ? *o.fade_in
-                      : from_record && starts_at_zero ? 0.0
-                                                      : 0.05 * duration;
+  const double fade = o.fade_in.value_or(default_fade);
   if (!(fade >= 0.0 && fade < duration))
     throw io::Error(
         fmt::format("--fade-in: expected 0 to below the duration ({} s), got {}", duration, fade));
@@ -310,15 +307,7 @@ void simulate_signal(const SimulateOptions& o) {
   progress.clear();
   test.record.source = name;
   test.comments.insert(test.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
-  if (o.noise > 0.0) {
-    // Not the random force's own seed: the same generator state would make the noise the very
-    // white sequence the force was filtered from, correlated with it.
-    const unsigned long long noise_seed = o.seed + 1000003ULL;
-    identify::add_noise(test.record, o.noise, noise_seed);
-    test.comments.push_back(fmt::format(
-        "noise: white Gaussian, RMS {} of each channel's RMS, on every channel (seed {})", o.noise,
-        noise_seed));
-  }
+  identify::add_noise(test, o.noise, o.seed);
   for (const auto& w : test.warnings)
     warn(w);
 
@@ -413,15 +402,9 @@ void simulate(const SimulateOptions& o) {
     throw;
   }
   progress.clear();
-  for (std::size_t i = 0; i < tests.size(); ++i) {
-    auto& t = tests[i];
+  identify::add_noise(tests, o.noise, o.seed);
+  for (auto& t : tests) {
     t.comments.insert(t.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
-    if (o.noise > 0.0) {
-      identify::add_noise(t.record, o.noise, o.seed + i);
-      t.comments.push_back(fmt::format(
-          "noise: white Gaussian, RMS {} of each channel's RMS, on every channel (seed {})",
-          o.noise, o.seed + i));
-    }
     for (const auto& w : t.warnings)
       warn(w);
   }
@@ -430,11 +413,9 @@ void simulate(const SimulateOptions& o) {
   if (!output_rank()) return;
   std::vector<std::pair<fs::path, std::string>> outputs;
   if (o.table) {
-    std::vector<std::string> comments{"jointid simulate", "model: " + o.model.string(),
-                                      "one sine test a row: fundamentals of the records"};
-    for (const auto& c : tests.front().comments) // how they were made, as in the records
-      if (c.rfind("joint ", 0) == 0 || c.rfind("method", 0) == 0 || c.rfind("noise", 0) == 0)
-        comments.push_back(c);
+    std::vector<std::string> comments{"jointid simulate", "model: " + o.model.string()};
+    for (const auto& c : identify::stepped_sine_comments(tests))
+      comments.push_back(c);
     std::vector<identify::Record> records;
     for (const auto& t : tests)
       records.push_back(t.record);
@@ -520,13 +501,8 @@ void identify(const IdentifyOptions& o) {
   std::vector<std::pair<fs::path, std::function<report::Figure()>>> pictures;
   if (!o.fit_png.empty())
     pictures.push_back({o.fit_png, [&] {
-                          std::vector<fem::NodeDof> shown;
-                          for (const joints::Joint& j : file.joints)
-                            for (const int node : {j.node, j.node_b})
-                              if (node != 0 && std::find(shown.begin(), shown.end(),
-                                                         fem::NodeDof{node, j.dof}) == shown.end())
-                                shown.push_back({node, j.dof});
-                          return report::harmonic_fit_figure(measured, shown);
+                          return report::harmonic_fit_figure(
+                              measured, report::harmonic_fit_dofs(file.joints));
                         }});
   if (!o.params_png.empty())
     pictures.push_back(
@@ -749,11 +725,7 @@ void response(const ResponseOptions& o) {
   const fem::NodeDof force_at = resolve(file, sub, "--force", o.force);
   const fem::NodeDof shown =
       o.plot_dof.empty() ? force_at : resolve(file, sub, "--plot-dof", o.plot_dof);
-  bool drawable = shown == force_at;
-  for (const joints::Joint& j : file.joints)
-    drawable = drawable || shown == fem::NodeDof{j.node, j.dof} ||
-               (j.node_b != 0 && shown == fem::NodeDof{j.node_b, j.dof});
-  if (!drawable)
+  if (!report::response_figure_can_show(file.joints, force_at, shown))
     throw io::Error(fmt::format("--plot-dof {}: expected the force DOF ({}) or a joint's DOF",
                                 o.plot_dof, fem::to_string(force_at)));
 
@@ -842,10 +814,7 @@ void frf(const FrfOptions& o) {
     responses.push_back(e);
   }
   if (responses.empty()) responses.push_back(sub.dofs().equation(drive));
-  std::vector<double> freq(static_cast<std::size_t>(o.points));
-  for (int i = 0; i < o.points; ++i) // exact ends; evenly spaced (dataset 58's even spacing)
-    freq[static_cast<std::size_t>(i)] =
-        i + 1 == o.points ? f1 : f0 + (f1 - f0) * i / (o.points - 1.0);
+  std::vector<double> freq = frf::evenly_spaced_hz(f0, f1, o.points);
 
   // 3. The FRFs.
   frf::FrfSweep sweep;
@@ -1000,7 +969,6 @@ void design(const DesignOptions& o) {
   options.noise = o.noise;
   options.periods = o.periods;
   options.balance.harmonics = o.balance_harmonics;
-  options.samples_per_period = std::max(256, 8 * (o.balance_harmonics + 1));
   options.max_misfit = o.max_misfit;
   std::vector<identify::CandidateTest> candidates;
   identify::Design chosen;
