@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <utility>
 
@@ -12,10 +13,22 @@ namespace jointid::cli {
 TerminalProgress::TerminalProgress(std::string label, bool enabled)
     : label_(std::move(label)), on_(enabled && isatty(STDERR_FILENO) == 1) {}
 
-void TerminalProgress::show(double fraction) const {
-  if (!on_) return;
-  fmt::print(stderr, "\r{}: {:3.0f} %", label_, 100.0 * fraction);
+TerminalProgress::~TerminalProgress() {
+  clear();
+}
+
+void TerminalProgress::print(const std::string& line) const {
+  fmt::print(stderr, "\r{}", line);
   std::fflush(stderr);
+  shown_ = std::max(shown_, line.size());
+}
+
+void TerminalProgress::show(double fraction) const {
+  if (on_) print(fmt::format("{}: {:3.0f} %", label_, 100.0 * fraction));
+}
+
+void TerminalProgress::show(std::string_view step, double fraction) const {
+  if (on_) print(fmt::format("{}: {}: {:3.0f} %", label_, step, 100.0 * fraction));
 }
 
 std::function<void(double)> TerminalProgress::callback() const {
@@ -24,9 +37,10 @@ std::function<void(double)> TerminalProgress::callback() const {
 }
 
 void TerminalProgress::clear() const {
-  if (!on_) return;
-  fmt::print(stderr, "\r{}\r", std::string(label_.size() + 8, ' '));
+  if (!on_ || shown_ == 0) return;
+  fmt::print(stderr, "\r{}\r", std::string(shown_, ' '));
   std::fflush(stderr);
+  shown_ = 0;
 }
 
 } // namespace jointid::cli

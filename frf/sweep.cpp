@@ -1,5 +1,7 @@
 #include "frf/sweep.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -67,6 +69,18 @@ FrfSweep frf_sweep(const Substructure& sub, int drive, std::vector<int> response
   out.responses = std::move(responses);
   out.freq_hz = std::move(freq_hz);
   return out;
+}
+
+std::vector<double> evenly_spaced_hz(double f0_hz, double f1_hz, int points) {
+  if (points < 2 || !std::isfinite(f0_hz) || !std::isfinite(f1_hz))
+    throw std::invalid_argument(fmt::format(
+        "frequencies: expected at least 2 points between finite ends, got {} from {} to {} Hz",
+        points, f0_hz, f1_hz));
+  std::vector<double> freq(static_cast<std::size_t>(points));
+  for (int i = 0; i < points; ++i)
+    freq[static_cast<std::size_t>(i)] =
+        i + 1 == points ? f1_hz : f0_hz + (f1_hz - f0_hz) * i / (points - 1.0);
+  return freq;
 }
 
 } // namespace jointid::frf

@@ -38,4 +38,9 @@ struct FrfSweep {
 FrfSweep frf_sweep(const Substructure& sub, int drive, std::vector<int> responses,
                    std::vector<double> freq_hz, FrfKind kind = FrfKind::receptance);
 
+/// `points` frequencies from f0_hz to f1_hz (Hz) evenly spaced, as a universal file's dataset 58
+/// stores them (a start and a step), with both ends exact: f0 + (f1 − f0) i / (points − 1), the
+/// last f1 itself. Throws std::invalid_argument for fewer than 2 points or ends not finite.
+std::vector<double> evenly_spaced_hz(double f0_hz, double f1_hz, int points);
+
 } // namespace jointid::frf

@@ -92,10 +92,13 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
     throw std::invalid_argument(
         fmt::format("design: harmonics: expected 0 to {} (the prediction's harmonics), got {}",
                     o.balance.harmonics, fmt::join(o.harmonics, ",")));
-  if (o.samples_per_period < 4 * (o.balance.harmonics + 1))
+  const int samples_per_period = o.samples_per_period != 0
+                                     ? o.samples_per_period
+                                     : std::max(256, 8 * (o.balance.harmonics + 1));
+  if (samples_per_period < 4 * (o.balance.harmonics + 1))
     throw std::invalid_argument(fmt::format(
         "design: samples per period: expected at least {} for harmonics 0 to {}, got {}",
-        4 * (o.balance.harmonics + 1), o.balance.harmonics, o.samples_per_period));
+        4 * (o.balance.harmonics + 1), o.balance.harmonics, samples_per_period));
   if (candidates.empty()) throw std::invalid_argument("design: no candidate tests");
   if (design_unknowns(joints).empty())
     throw std::invalid_argument("design: every joint term is fixed; nothing to identify");
@@ -103,7 +106,7 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
   SimulationOptions sim;
   sim.method = SimulationMethod::harmonic_balance;
   sim.periods = 2; // noise-free: the periods are equal; the noise is set below
-  sim.steps_per_period = o.samples_per_period;
+  sim.steps_per_period = samples_per_period;
   sim.quantities = o.quantities;
   sim.balance = o.balance;
   sim.skip_unconverged = true;

@@ -29,7 +29,9 @@ struct DesignOptions {
   std::vector<int> harmonics{1}; ///< the harmonics whose equations the fit will use
   double noise = 0.01;           ///< noise RMS / channel RMS, every channel (force too)
   int periods = 8;               ///< periods in each record, averaged before the fit
-  int samples_per_period = 256;  ///< samples of a period
+  /// Samples of a period; 0: max(256, 8 (K + 1)) for the prediction's harmonics 0 … K, eight
+  /// samples to the highest harmonic's period and never fewer than 256.
+  int samples_per_period = 0;
   /// Response channels recorded at the joints' DOFs and the force DOF.
   std::vector<Quantity> quantities{Quantity::displacement, Quantity::velocity};
   frf::HarmonicBalanceOptions balance{}; ///< the prediction (harmonics 0 … K)

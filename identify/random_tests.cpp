@@ -230,4 +230,25 @@ std::string excitation_record_name(const ExcitationSpec& s) {
                      s.kind == Excitation::random ? fmt::format("_seed{}", s.seed) : "");
 }
 
+double default_fade_in_s(const ExcitationSpec& spec) {
+  return 0.05 * spec.duration_s;
+}
+
+double default_fade_in_s(const ForceInput& measured) {
+  if (measured.samples.size() == 0 || !(measured.sample_rate_hz > 0.0)) return 0.0;
+  const bool starts_at_zero = measured.samples.row(0).cwiseAbs().maxCoeff() <=
+                              1e-9 * measured.samples.cwiseAbs().maxCoeff();
+  const double duration = static_cast<double>(measured.samples.rows()) / measured.sample_rate_hz;
+  return starts_at_zero ? 0.0 : 0.05 * duration;
+}
+
+void add_noise(ForcedTest& test, double level, std::uint64_t force_seed) {
+  if (level == 0.0) return;
+  const std::uint64_t seed = force_seed + 1000003ULL;
+  add_noise(test.record, level, seed);
+  test.comments.push_back(
+      fmt::format("noise: white Gaussian, RMS {} of each channel's RMS, on every channel (seed {})",
+                  level, seed));
+}
+
 } // namespace jointid::identify

@@ -87,4 +87,18 @@ std::string excitation_record_name(const ExcitationSpec& spec);
 /// naming the record when it has none or its sampling is not uniform).
 ForceInput force_input(const Record& record);
 
+/// The fade-in (ForcedOptions::fade_in_s) of a generated force unless told otherwise: 5 % of
+/// its duration, so that a structure at rest is not struck by the force at full level.
+double default_fade_in_s(const ExcitationSpec& spec);
+
+/// The fade-in of a measured force (force_input) unless told otherwise: none when it already
+/// starts at zero (its first samples within 1e-9 of its peak), else 5 % of its duration.
+double default_fade_in_s(const ForceInput& measured);
+
+/// Measurement noise on a simulated record (add_noise, every channel, force too), drawn from
+/// seed + 1000003, not from the force's own seed: the same generator state would make the
+/// noise the very white sequence a random force was filtered from, correlated with it. A
+/// comment line says the level and the seed. Level 0: nothing.
+void add_noise(ForcedTest& test, double level, std::uint64_t force_seed);
+
 } // namespace jointid::identify

@@ -297,4 +297,23 @@ void add_noise(Record& record, double level, std::uint64_t seed, bool force) {
   }
 }
 
+void add_noise(std::vector<SimulatedTest>& tests, double level, std::uint64_t seed) {
+  if (level == 0.0) return;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    add_noise(tests[i].record, level, seed + i);
+    tests[i].comments.push_back(fmt::format(
+        "noise: white Gaussian, RMS {} of each channel's RMS, on every channel (seed {})", level,
+        seed + i));
+  }
+}
+
+std::vector<std::string> stepped_sine_comments(const std::vector<SimulatedTest>& tests) {
+  std::vector<std::string> comments{"one sine test a row: fundamentals of the records"};
+  if (tests.empty()) return comments;
+  for (const auto& c : tests.front().comments)
+    if (c.rfind("joint ", 0) == 0 || c.rfind("method", 0) == 0 || c.rfind("noise", 0) == 0)
+      comments.push_back(c);
+  return comments;
+}
+
 } // namespace jointid::identify

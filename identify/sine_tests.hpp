@@ -76,4 +76,15 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& substruc
 /// given generator state.
 void add_noise(Record& record, double level, std::uint64_t seed, bool force = true);
 
+/// Measurement noise on a series of simulated tests (add_noise, every channel, force too): test
+/// i draws from seed + i, so that each record's noise is its own and the series is repeated
+/// exactly from one seed. Each record's comments say the level and its seed. Level 0: nothing.
+void add_noise(std::vector<SimulatedTest>& tests, double level, std::uint64_t seed);
+
+/// The comment lines of a stepped-sine table made of these tests' fundamentals
+/// (identify::stepped_sine_table): what a row is, then how the series was made — the first
+/// test's lines on its joints, its method and its noise (those of one test alone, its force,
+/// periods and convergence, are left out).
+std::vector<std::string> stepped_sine_comments(const std::vector<SimulatedTest>& tests);
+
 } // namespace jointid::identify

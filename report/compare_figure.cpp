@@ -1,4 +1,4 @@
-// compare_figure(): part of jointid_io_output, with the other figures (the palette lives there).
+// compare_figure(): the figure of `jointid compare` (report/compare_figure.hpp).
 #include "report/compare_figure.hpp"
 
 #include "io/spectra_comparison.hpp"

@@ -77,6 +77,16 @@ Figure harmonic_fit_figure(const std::vector<identify::Measurement>& tests,
   return figure;
 }
 
+std::vector<fem::NodeDof> harmonic_fit_dofs(const std::vector<joints::Joint>& joints) {
+  std::vector<fem::NodeDof> shown;
+  for (const joints::Joint& j : joints)
+    for (const int node : {j.node, j.node_b})
+      if (node != 0 &&
+          std::find(shown.begin(), shown.end(), fem::NodeDof{node, j.dof}) == shown.end())
+        shown.push_back({node, j.dof});
+  return shown;
+}
+
 Figure parameter_figure(const identify::FitResult& result,
                         const std::vector<joints::Joint>& model_joints) {
   Chart chart;

@@ -21,6 +21,10 @@ namespace jointid::report {
 Figure harmonic_fit_figure(const std::vector<identify::Measurement>& tests,
                            const std::vector<fem::NodeDof>& shown);
 
+/// The DOFs harmonic_fit_figure shows for these joints: each joint's DOF at its node and, for a
+/// joint between nodes, at its second node; each once, in the joints' order.
+std::vector<fem::NodeDof> harmonic_fit_dofs(const std::vector<joints::Joint>& joints);
+
 /// Every identified term whose value the model gives (a simulation's truth, or a prior guess),
 /// as identified / model value (points) with its 95 % interval (a vertical line) over the
 /// terms ("joint term"), and the line at 1. Throws std::invalid_argument when no identified

@@ -71,4 +71,13 @@ Figure response_figure(const frf::ResponseCurves& c, const fem::NodeDof& shown) 
   return figure;
 }
 
+bool response_figure_can_show(const std::vector<joints::Joint>& joints,
+                              const fem::NodeDof& force_at, const fem::NodeDof& dof) {
+  if (dof == force_at) return true;
+  return std::any_of(joints.begin(), joints.end(), [&](const joints::Joint& j) {
+    return dof == fem::NodeDof{j.node, j.dof} ||
+           (j.node_b != 0 && dof == fem::NodeDof{j.node_b, j.dof});
+  });
+}
+
 } // namespace jointid::report

@@ -11,4 +11,9 @@ namespace jointid::report {
 /// determined dotted (points), folds marked with black dots.
 Figure response_figure(const frf::ResponseCurves& curves, const fem::NodeDof& shown);
 
+/// Whether response_figure can show `dof` on the curves of these joints under a force at
+/// `force_at`: the curves hold the joints' DOFs and the force DOF (frf::ResponseCurves::dofs).
+bool response_figure_can_show(const std::vector<joints::Joint>& joints,
+                              const fem::NodeDof& force_at, const fem::NodeDof& dof);
+
 } // namespace jointid::report

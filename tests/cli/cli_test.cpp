@@ -285,10 +285,10 @@ TEST_F(CliTest, IdentifyByOutputError) {
   EXPECT_NE(run.err.find("output error: the model misses the data by more than their noise"),
             std::string::npos)
       << run.err;
-  args.insert(args.end() - 2, {"--hb-harmonics", "2"});
+  args.insert(args.end() - 2, {"--balance-harmonics", "2"});
   expect_one_line_error(
       jointid(args, dir()),
-      "--hb-harmonics: expected from 3 (the largest of --harmonics) to 200, got 2");
+      "--balance-harmonics: expected from 3 (the largest of --harmonics) to 200, got 2");
 }
 
 TEST_F(CliTest, ModesMatchTheCantileverTheory) {
@@ -699,9 +699,9 @@ TEST_F(CliTest, DiscoverChecksItsOptionsBeforeReading) {
       jointid({"discover", model().string(), rec, "--harmonics", "0", "-o", out.string()}, dir()),
       "--harmonics");
   expect_one_line_error(
-      jointid({"discover", model().string(), rec, "--hb-harmonics", "2", "-o", out.string()},
+      jointid({"discover", model().string(), rec, "--balance-harmonics", "2", "-o", out.string()},
               dir()),
-      "--hb-harmonics");
+      "--balance-harmonics: expected from 3 (the largest of --harmonics) to 200, got 2");
   expect_one_line_error(
       jointid({"discover", model().string(), rec, "--terms", "k4", "-o", out.string()}, dir()),
       "--terms");
@@ -919,10 +919,10 @@ TEST_F(CliTest, ResponseWritesTheContractWithFoldsAndStability) {
   const fs::path model =
       fs::path(JOINTID_SOURCE_DIR) / "examples" / "response" / "hardening_tip.toml";
   const fs::path out = dir() / "response";
-  const Outcome run =
-      jointid({"response", model.string(), "--force", "7:uy", "--amplitude", "10,80",
-               "--freq-range", "15:30", "--harmonics", "5", "--no-plot", "-o", out.string()},
-              dir());
+  const Outcome run = jointid({"response", model.string(), "--force", "7:uy", "--amplitude",
+                               "10,80", "--freq-range", "15:30", "--balance-harmonics", "5",
+                               "--no-plot", "-o", out.string()},
+                              dir());
   ASSERT_EQ(run.status, 0) << run.err;
   EXPECT_TRUE(run.err.empty()) << run.err; // not a terminal: no progress
   EXPECT_FALSE(fs::exists(out / "response.png"));
@@ -1348,8 +1348,8 @@ TEST_F(CliTest, OptionsOutOfRangeAreNamedBeforeAnythingIsRead) {
   expect_one_line_error(sine({"--steps-per-period", "64", "--samples-per-period", "48"}),
                         "jointid: --samples-per-period: expected at least 8 and a divisor of "
                         "--steps-per-period (64), got 48");
-  expect_one_line_error(sine({"--method", "hb", "--harmonics", "0"}),
-                        "jointid: --harmonics: expected at least 1, got 0");
+  expect_one_line_error(sine({"--method", "hb", "--balance-harmonics", "0"}),
+                        "jointid: --balance-harmonics: expected at least 1, got 0");
   expect_one_line_error(sine({"--channels", "x,v,x"}), "jointid: --channels: x is listed twice");
   expect_one_line_error(sine({"--channels", "x,d"}),
                         "jointid: --channels: expected x, v or a, got \"d\"");
@@ -1397,9 +1397,9 @@ TEST_F(CliTest, OptionsOutOfRangeAreNamedBeforeAnythingIsRead) {
   for (const std::string k : {"0", "201"})
     expect_one_line_error(
         jointid({"response", model_path, "--force", "7:uy", "--amplitude", "10", "--freq-range",
-                 "2:4", "--harmonics", k, "--no-plot", "-o", out.string()},
+                 "2:4", "--balance-harmonics", k, "--no-plot", "-o", out.string()},
                 dir()),
-        "jointid: --harmonics: expected 1 to 200, got " + k);
+        "jointid: --balance-harmonics: expected 1 to 200, got " + k);
 
   auto design = [&](const std::vector<std::string>& extra) {
     std::vector<std::string> args{"design", model_path, "--force", "7:uy",
@@ -1672,6 +1672,155 @@ TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
   EXPECT_NE(run.err.find("); term k of 'tip' is a combination of the others: "), std::string::npos)
       << run.err;
   EXPECT_FALSE(fs::exists(result));
+}
+
+// The commands and the shortest complete command line of each (every required option), with
+// `extra` options added and the output under `out`.
+std::vector<std::string> command_line(const std::string& command, const fs::path& model,
+                                      const std::string& record, const fs::path& out,
+                                      const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args{command, model.string()};
+  if (command == "simulate")
+    args.insert(args.end(), {"--force", "7:uy", "--freq", "3", "--amplitude", "1"});
+  if (command == "frf") args.insert(args.end(), {"--drive", "7:uy", "--freq-range", "0:10"});
+  if (command == "response")
+    args.insert(args.end(), {"--force", "7:uy", "--amplitude", "1", "--freq-range", "2:4"});
+  if (command == "design")
+    args.insert(args.end(), {"--force", "7:uy", "--freq", "2", "--amplitude", "1", "-n", "1"});
+  if (command == "identify" || command == "discover" || command == "compare")
+    args.push_back(record);
+  args.insert(args.end(), extra.begin(), extra.end());
+  args.insert(args.end(), {"-o", (command == "identify" ? out / "result.json" : out).string()});
+  return args;
+}
+
+const std::vector<std::string> commands{"modes",    "frf",      "simulate", "identify",
+                                        "discover", "response", "design",   "compare"};
+
+TEST_F(CliTest, VersionIsTheProjects) {
+  const Outcome run = jointid({"--version"}, dir());
+  EXPECT_EQ(run.status, 0);
+  EXPECT_EQ(run.out, "jointid " JOINTID_VERSION "\n");
+  EXPECT_TRUE(run.err.empty()) << run.err;
+}
+
+// Every option whose value is one of a list shows the list in --help, and a value not in it is
+// refused before anything is read, naming the option and the choices.
+TEST_F(CliTest, EnumeratedOptionsListTheirChoices) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  struct Enumerated {
+    std::string command, option, choices, named;
+  };
+  const std::string large = "{auto,slepc}", large_named = "auto or slepc";
+  std::vector<Enumerated> options{
+      {"simulate", "--method", "{time,hb}", "time or hb"},
+      {"simulate", "--excitation", "{sine,random,sweep,multisine,record}",
+       "sine, random, sweep, multisine or record"},
+      {"simulate", "--route", "{modal,full}", "modal or full"},
+      {"simulate", "--channels", "{x,v,a}", "x, v or a"},
+      {"compare", "--route", "{modal,full}", "modal or full"},
+      {"frf", "--kind", "{receptance,mobility,accelerance}", "receptance, mobility or accelerance"},
+      {"discover", "--terms", "{k,c,k2,k3,c2,c3,fc}", "k, c, k2, k3, c2, c3 or fc"},
+      {"modes", "--engine", "{auto,dense,sparse,slepc}", "auto, dense, sparse or slepc"}};
+  for (const char* command : {"simulate", "frf", "identify", "discover", "response", "design"})
+    options.push_back({command, "--engine", large, large_named});
+  const fs::path out = dir() / "never_enumerated";
+  for (const auto& o : options) {
+    const Outcome help = jointid({o.command, "--help"}, dir());
+    EXPECT_NE(help.out.find(o.option + " TEXT:" + o.choices), std::string::npos)
+        << o.command << " " << o.option << "\n"
+        << help.out;
+    expect_one_line_error(
+        jointid(command_line(o.command, model(), record_files()[0], out, {o.option, "zzz"}), dir()),
+        "jointid: " + o.option + ": expected " + o.named + ", got \"zzz\"");
+  }
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// A flag's help is its name: no "{false}" (CLI11's mark of a negated flag) nor a default.
+TEST_F(CliTest, FlagsShowNoDefaultAndEveryPictureHasNoPlot) {
+  for (const auto& command : commands) {
+    const Outcome help = jointid({command, "--help"}, dir());
+    ASSERT_EQ(help.status, 0) << command;
+    EXPECT_EQ(help.out.find("{false}"), std::string::npos) << command << "\n" << help.out;
+    EXPECT_EQ(help.out.find("{true}"), std::string::npos) << command << "\n" << help.out;
+    const bool draws = command != "simulate" && command != "design";
+    EXPECT_EQ(help.out.find("  --no-plot ") != std::string::npos, draws) << command;
+    // The old spellings still work, but --help shows only the new ones.
+    EXPECT_EQ(help.out.find("--no-plots"), std::string::npos) << command;
+    EXPECT_EQ(help.out.find("--hb-harmonics"), std::string::npos) << command;
+  }
+}
+
+// --balance-harmonics is the harmonic balance's truncation in every command that runs one: a
+// value out of its range is refused naming it (so the command took it for the truncation).
+TEST_F(CliTest, EveryHarmonicBalanceTakesBalanceHarmonics) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path out = dir() / "never_balanced";
+  const std::string rec = record_files()[0];
+  auto fails = [&](const std::string& command, std::vector<std::string> extra,
+                   const std::string& message) {
+    expect_one_line_error(jointid(command_line(command, model(), rec, out, extra), dir()),
+                          "jointid: --balance-harmonics: " + message);
+  };
+  fails("simulate", {"--method", "hb", "--balance-harmonics", "0"}, "expected at least 1, got 0");
+  fails("response", {"--balance-harmonics", "201"}, "expected 1 to 200, got 201");
+  fails("design", {"--balance-harmonics", "0"}, "expected 1 to 200, got 0");
+  fails("identify", {"--harmonics", "1,2", "--output-error", "--balance-harmonics", "1"},
+        "expected from 2 (the largest of --harmonics) to 200, got 1");
+  fails("discover", {"--balance-harmonics", "2"},
+        "expected from 3 (the largest of --harmonics) to 200, got 2");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// The old spellings still work for now, each with a warning naming the new one: --hb-harmonics
+// (identify, discover), --harmonics where it meant the truncation (simulate, response) and
+// --no-plots (discover).
+TEST_F(CliTest, OldSpellingsStillWorkAndWarn) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const std::string renamed_harmonics =
+      "jointid: warning: --harmonics is now --balance-harmonics\n";
+  const fs::path sim = dir() / "old_simulate";
+  const Outcome hb = jointid(command_line("simulate", model(), "", sim,
+                                          {"--method", "hb", "--harmonics", "3",
+                                           "--steps-per-period", "64", "--periods", "2"}),
+                             dir());
+  ASSERT_EQ(hb.status, 0) << hb.err;
+  EXPECT_EQ(hb.err, renamed_harmonics);
+  EXPECT_NE(test::read_text(sim / "sine_f3Hz_F1N.csv")
+                .find("# method: hb (harmonic balance, harmonics 0 to 3;"),
+            std::string::npos);
+
+  const fs::path curves = dir() / "old_response";
+  const Outcome resp = jointid(
+      command_line("response", model(), "", curves, {"--harmonics", "3", "--no-plot"}), dir());
+  ASSERT_EQ(resp.status, 0) << resp.err;
+  EXPECT_EQ(resp.err, renamed_harmonics);
+  EXPECT_EQ(json::parse(test::read_text(curves / "response.json"))["harmonics"], 3);
+
+  // Out of range: refused as the new option, after the warning.
+  const std::string renamed_hb = "jointid: warning: --hb-harmonics is now --balance-harmonics\n";
+  const Outcome identify =
+      jointid(command_line("identify", model(), record_files()[0], dir() / "never_old",
+                           {"--harmonics", "1,2", "--output-error", "--hb-harmonics", "1"}),
+              dir());
+  EXPECT_NE(identify.status, 0);
+  EXPECT_EQ(identify.err, renamed_hb + "jointid: --balance-harmonics: expected from 2 (the "
+                                       "largest of --harmonics) to 200, got 1\n");
+
+  const fs::path report = dir() / "old_discover";
+  std::vector<std::string> args{"discover", model().string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  args.insert(args.end(),
+              {"--hb-harmonics", "5", "--no-plots", "--max-steps", "1", "-o", report.string()});
+  const Outcome discover = jointid(args, dir());
+  ASSERT_EQ(discover.status, 0) << discover.err;
+  EXPECT_EQ(discover.err.rfind(renamed_hb + "jointid: warning: --no-plots is now --no-plot\n", 0),
+            0u)
+      << discover.err;
+  EXPECT_TRUE(fs::exists(report / "report.md"));
+  EXPECT_FALSE(fs::exists(report / "gap.png"));
 }
 
 } // namespace

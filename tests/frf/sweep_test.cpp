@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <complex>
 #include <numbers>
 #include <stdexcept>
@@ -65,6 +66,21 @@ TEST(FrfSweep, CantileverEqualsTheDirectSolve) {
     const Eigen::VectorXcd got = s.values.row(static_cast<Eigen::Index>(i)).transpose();
     EXPECT_LE((got - direct.col(0)).norm(), 1e-9 * direct.norm()) << freq[i] << " Hz";
   }
+}
+
+// The frequency lines of a sweep: evenly spaced from the first to the last, both exact.
+TEST(FrfSweep, EvenlySpacedLinesEndExactly) {
+  const std::vector<double> f = frf::evenly_spaced_hz(1.1, 5.3, 7);
+  ASSERT_EQ(f.size(), 7u);
+  EXPECT_EQ(f.front(), 1.1);
+  EXPECT_EQ(f.back(), 5.3); // 1.1 + (5.3 - 1.1) * 6 / 6 rounds to 5.299999999999999
+  for (std::size_t i = 0; i < f.size(); ++i)
+    EXPECT_NEAR(f[i], 1.1 + 0.7 * static_cast<double>(i), 4e-15 * 5.3) << i;
+  const std::vector<double> g = frf::evenly_spaced_hz(0.0, 100.0, 1001);
+  EXPECT_EQ(g[500], 50.0);
+  EXPECT_EQ(g.back(), 100.0);
+  EXPECT_THROW(frf::evenly_spaced_hz(0.0, 10.0, 1), std::invalid_argument);
+  EXPECT_THROW(frf::evenly_spaced_hz(0.0, std::nan(""), 10), std::invalid_argument);
 }
 
 TEST(FrfSweep, BadArgumentsAreRefused) {

@@ -182,6 +182,29 @@ TEST(Design, BadOptionsAreNamed) {
   }
 }
 
+// Samples of a period unless told otherwise: max(256, 8 (K + 1)) for the prediction's harmonics
+// 0 … K: 256 at K = 9, 568 at K = 70 (where 256 is too few: fewer than 4 (K + 1) = 284).
+TEST(Design, SamplesPerPeriodFollowTheHarmonicBalance) {
+  const frf::Substructure sub(test::paper_cantilever());
+  const auto joints = model_I();
+  const std::vector<identify::SineTestPlan> plans{{3.0, 40.0}};
+  for (const auto& [K, samples] : {std::pair{9, 256}, std::pair{70, 568}}) {
+    identify::DesignOptions automatic;
+    automatic.balance.harmonics = K;
+    identify::DesignOptions given = automatic;
+    given.samples_per_period = samples;
+    const auto a = identify::predict_candidates(sub, joints, tip, plans, automatic);
+    const auto b = identify::predict_candidates(sub, joints, tip, plans, given);
+    ASSERT_TRUE(a[0].usable) << a[0].reason;
+    EXPECT_EQ(a[0].information, b[0].information) << K; // the same computation, bit for bit
+  }
+  identify::DesignOptions too_few;
+  too_few.balance.harmonics = 70;
+  too_few.samples_per_period = 256;
+  EXPECT_THROW(identify::predict_candidates(sub, joints, tip, plans, too_few),
+               std::invalid_argument);
+}
+
 // A test in which a friction joint sticks is left out, and says why: there the Coulomb basis
 // sign(ẏ) does not describe the force, and the equations miss at the true values. On a smooth
 // joint (model I) every candidate's misfit is the harmonic balance's truncation, nothing more.

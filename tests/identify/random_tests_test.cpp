@@ -3,6 +3,7 @@
 #include "identify/random_tests.hpp"
 
 #include "fem/excitation.hpp"
+#include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
 
 #include <gtest/gtest.h>
@@ -105,6 +106,43 @@ TEST(RandomTests, ForceChannelsOfARecordDriveTheModel) {
   const Eigen::VectorXd& a = made.record.channels[1].samples;
   EXPECT_LT((again.record.channels[1].samples - a).cwiseAbs().maxCoeff(),
             1e-9 * a.cwiseAbs().maxCoeff());
+}
+
+// The fade-in unless told otherwise: 5 % of a generated force's duration; for a measured force
+// none when it starts at zero (within 1e-9 of its peak), else 5 % of the record.
+TEST(RandomTests, DefaultFadeIn) {
+  ExcitationSpec spec;
+  spec.duration_s = 8.0;
+  spec.sample_rate_hz = 256.0;
+  EXPECT_DOUBLE_EQ(default_fade_in_s(spec), 0.4);
+  ForceInput in = random_input(); // 2048 samples at 256 Hz: 8 s
+  ASSERT_EQ(in.samples.rows(), 2048);
+  ASSERT_GT(std::abs(in.samples(0, 0)), 1e-9 * in.samples.cwiseAbs().maxCoeff());
+  EXPECT_DOUBLE_EQ(default_fade_in_s(in), 0.4);
+  in.samples(0, 0) = 0.5e-9 * in.samples.cwiseAbs().maxCoeff();
+  EXPECT_EQ(default_fade_in_s(in), 0.0);
+  in.samples(0, 0) = 2e-9 * in.samples.cwiseAbs().maxCoeff();
+  EXPECT_DOUBLE_EQ(default_fade_in_s(in), 0.4);
+}
+
+// A simulated record's noise is not drawn from the random force's own seed (which would make it
+// the white sequence the force was filtered from) but from seed + 1000003; a comment says which.
+TEST(RandomTests, NoiseIsDrawnBesideTheForcesSeed) {
+  ForcedTest test;
+  test.record.t = Eigen::VectorXd::LinSpaced(256, 0.0, 255.0 / 256.0);
+  test.record.channels.push_back({Quantity::force, mid, random_input().samples.col(0).head(256)});
+  const ForcedTest clean = test;
+  add_noise(test, 0.05, 9);
+  Record expected = clean.record;
+  add_noise(expected, 0.05, 9 + 1000003);
+  EXPECT_EQ(test.record.channels[0].samples, expected.channels[0].samples);
+  ASSERT_EQ(test.comments.size(), 1u);
+  EXPECT_EQ(test.comments[0], "noise: white Gaussian, RMS 0.05 of each channel's RMS, on every "
+                              "channel (seed 1000012)");
+  ForcedTest quiet = clean;
+  add_noise(quiet, 0.0, 9);
+  EXPECT_TRUE(quiet.comments.empty());
+  EXPECT_EQ(quiet.record.channels[0].samples, clean.record.channels[0].samples);
 }
 
 TEST(RandomTests, TwoForcesSuperposeOnTheLinearStructure) {

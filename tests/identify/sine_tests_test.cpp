@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <functional>
@@ -300,6 +301,45 @@ TEST(SimulateSineTests, AddNoiseHasTheAskedLevelAndIsReproducible) {
     EXPECT_EQ(none.channels[c].samples, clean.channels[c].samples);
   EXPECT_THROW(add_noise(none, -0.01, 1), std::invalid_argument);
   EXPECT_THROW(add_noise(none, std::nan(""), 1), std::invalid_argument);
+}
+
+// A series' noise: test i draws from seed + i (so two tests of one run never share their noise,
+// and one seed repeats the run), and its comments say so; a table of the series keeps the lines
+// on how the series was made, not those of one test alone.
+TEST(SimulateSineTests, NoiseOnASeriesAndTheCommentsItsTableKeeps) {
+  const joints::Joint joint = make_joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8});
+  SimulationOptions o;
+  o.method = SimulationMethod::harmonic_balance;
+  o.periods = 2;
+  o.steps_per_period = 64;
+  const std::vector<SimulatedTest> clean =
+      simulate_sine_tests(cantilever(), {joint}, tip, {{3.0, 10.0}, {4.0, 10.0}}, o);
+  std::vector<SimulatedTest> noisy = clean;
+  add_noise(noisy, 0.02, 7);
+  for (std::size_t i = 0; i < clean.size(); ++i) {
+    Record expected = clean[i].record;
+    add_noise(expected, 0.02, 7 + i);
+    for (std::size_t c = 0; c < expected.channels.size(); ++c)
+      EXPECT_EQ(noisy[i].record.channels[c].samples, expected.channels[c].samples) << i << c;
+    EXPECT_EQ(noisy[i].comments.back(), "noise: white Gaussian, RMS 0.02 of each channel's RMS, "
+                                        "on every channel (seed " +
+                                            std::to_string(7 + i) + ")");
+  }
+  std::vector<SimulatedTest> quiet = clean;
+  add_noise(quiet, 0.0, 7);
+  EXPECT_EQ(quiet[0].comments, clean[0].comments);
+  EXPECT_EQ(quiet[1].record.channels[1].samples, clean[1].record.channels[1].samples);
+
+  const std::vector<std::string> kept = stepped_sine_comments(noisy);
+  ASSERT_EQ(kept.size(), 4u) << ::testing::PrintToString(kept);
+  EXPECT_EQ(kept[0], "one sine test a row: fundamentals of the records");
+  EXPECT_EQ(kept[1], joint_comment(joint));
+  EXPECT_EQ(kept[2].rfind("method: hb (harmonic balance, harmonics 0 to 9", 0), 0u) << kept[2];
+  EXPECT_EQ(kept[3], noisy[0].comments.back());
+  for (const auto& line : noisy[0].comments) // the lines of the first test alone are left out
+    if (line.rfind("sine force", 0) == 0 || line.rfind("harmonic balance:", 0) == 0)
+      EXPECT_EQ(std::find(kept.begin(), kept.end(), line), kept.end()) << line;
+  EXPECT_EQ(stepped_sine_comments({}).size(), 1u);
 }
 
 TEST(SimulateSineTests, ModalSubstructureNeedsHarmonicBalance) {

@@ -56,6 +56,19 @@ TEST(HarmonicFitFigure, ResidualIsRoundingWithEveryHarmonicAndNotWithTheFundamen
                std::invalid_argument);
 }
 
+// The DOFs shown: every joint's DOF at both its nodes, each once, in the joints' order.
+TEST(HarmonicFitFigure, ShowsEveryJointDofOnce) {
+  using fem::Dof;
+  auto joint = [](int node, int node_b, Dof dof) {
+    return joints::Joint{"j", node, node_b, dof, {joints::Term::k}, {1.0}, {false}, {}};
+  };
+  const std::vector<fem::NodeDof> shown = report::harmonic_fit_dofs(
+      {joint(7, 0, Dof::uy), joint(3, 5, Dof::uy), joint(3, 0, Dof::ux), joint(5, 7, Dof::uy)});
+  const std::vector<fem::NodeDof> expected{{7, Dof::uy}, {3, Dof::uy}, {5, Dof::uy}, {3, Dof::ux}};
+  EXPECT_EQ(shown, expected);
+  EXPECT_TRUE(report::harmonic_fit_dofs({}).empty());
+}
+
 TEST(ParameterFigure, RatiosAndIntervalsOfTheTermsTheModelGives) {
   joints::Joint model{"tip",
                       7,

@@ -1,0 +1,249 @@
+// jointid design: D-optimal experiment design. The `-n` candidate tests (frequencies x
+// amplitudes) that determine the joints' non-fixed terms best, predicted at the model's values;
+// DIR/design.json, and the chosen tests and the standard deviations to expect printed.
+#include "identify/design.hpp"
+#include "cli/command.hpp"
+#include "cli/common.hpp"
+#include "io/files.hpp"
+#include "io/results_json.hpp"
+#include "joints/basis.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace jointid::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// "3", "1.5e3" or a range "F0:STEP:F1" (F0, F0 + STEP, … up to F1 within a millionth of STEP),
+// every value finite and > 0; sorted, each once.
+std::vector<double> parse_values(const std::string& option, const std::vector<std::string>& items,
+                                 const char* unit) {
+  auto refuse = [&](const std::string& item) {
+    return io::Error(fmt::format("{}: expected numbers ({}) or ranges START:STEP:STOP, got \"{}\"",
+                                 option, unit, item));
+  };
+  auto number = [&](const std::string& text, const std::string& item) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v)) throw refuse(item);
+    return v;
+  };
+  std::vector<double> out;
+  for (const auto& item : items) {
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    for (std::size_t c = item.find(':'); c != std::string::npos; c = item.find(':', start)) {
+      parts.push_back(item.substr(start, c - start));
+      start = c + 1;
+    }
+    parts.push_back(item.substr(start));
+    if (parts.size() == 1) {
+      out.push_back(number(parts[0], item));
+    } else if (parts.size() == 3) {
+      const double a = number(parts[0], item), step = number(parts[1], item),
+                   b = number(parts[2], item);
+      if (!(step > 0.0) || b < a)
+        throw io::Error(fmt::format(
+            "{} {}: expected START:STEP:STOP with STEP > 0 and STOP >= START", option, item));
+      const double n = std::floor((b - a) / step + 1e-6);
+      if (n > 10000) throw io::Error(fmt::format("{} {}: more than 10000 values", option, item));
+      for (int i = 0; i <= static_cast<int>(n); ++i)
+        out.push_back(a + i * step);
+    } else {
+      throw refuse(item);
+    }
+  }
+  if (out.empty())
+    throw io::Error(fmt::format("{}: expected at least one value ({})", option, unit));
+  for (double v : out)
+    if (!(v > 0.0))
+      throw io::Error(fmt::format("{}: expected values > 0 {}, got {}", option, unit, v));
+  std::sort(out.begin(), out.end());
+  if (std::adjacent_find(out.begin(), out.end()) != out.end())
+    throw io::Error(fmt::format("{}: a value is listed twice", option));
+  return out;
+}
+
+class Design final : public Command {
+public:
+  explicit Design(CLI::App& parent)
+      : Command(parent, "design",
+                "Experiment design: choose the N sine tests (of candidate frequencies x force "
+                "levels) that determine the joints' terms best (D-optimal, predicted at the "
+                "model's values as prior guesses); writes DIR/design.json") {
+    add_model("Model file (TOML); joint values = prior guesses");
+    app().add_option("--force", force_, "DOF of the sine force, NODE:DOF (e.g. 7:uy)")->required();
+    app()
+        .add_option("--freq", frequencies_,
+                    "Candidate frequencies, Hz: values or ranges START:STEP:STOP (comma-separated)")
+        ->required()
+        ->delimiter(',')
+        ->allow_extra_args(false);
+    app()
+        .add_option("--amplitude", amplitudes_,
+                    "Candidate force amplitudes (peak), N or N m: values or ranges START:STEP:STOP")
+        ->required()
+        ->delimiter(',')
+        ->allow_extra_args(false);
+    app().add_option("-n", count_, "Number of tests to choose")->capture_default_str();
+    add_harmonics(options_.harmonics,
+                  "Harmonics whose equations the identification will use, e.g. 1,2,3");
+    app()
+        .add_option("--noise", options_.noise,
+                    "Expected measurement noise: RMS as a fraction of each channel's RMS, on "
+                    "force and response")
+        ->capture_default_str();
+    app()
+        .add_option("--periods", options_.periods, "Periods in each record (averaged)")
+        ->capture_default_str();
+    add_balance_harmonics(options_.balance.harmonics,
+                          "Harmonics 0 … K of the harmonic balance that predicts the tests");
+    app()
+        .add_option("--max-misfit", options_.max_misfit,
+                    "Leave out candidates whose equations, at the model's values, miss by more "
+                    "than this many noise standard deviations (e.g. where a friction joint sticks)")
+        ->capture_default_str();
+    add_output_dir();
+    add_engine();
+  }
+
+  void run() override;
+
+private:
+  void check_options() const;
+  void print(const identify::Design& chosen, const std::vector<identify::CandidateTest>& candidates,
+             const std::vector<identify::DesignUnknown>& unknowns) const;
+
+  std::string force_;                    ///< NODE:DOF of the sine force
+  std::vector<std::string> frequencies_; ///< Hz: values or ranges F0:STEP:F1
+  std::vector<std::string> amplitudes_;  ///< N or N·m (peak): values or ranges A0:STEP:A1
+  int count_ = 10;                       ///< tests to choose
+  identify::DesignOptions options_;      ///< the library's defaults
+};
+
+void Design::check_options() const {
+  check_harmonics(options_.harmonics, 0);
+  if (count_ < 1) throw io::Error(fmt::format("-n: expected at least 1 test, got {}", count_));
+  if (!(options_.noise > 0.0 && options_.noise < 1.0))
+    throw io::Error(fmt::format("--noise: expected a fraction between 0 and 1 (e.g. 0.01), got {}",
+                                options_.noise));
+  if (!(options_.max_misfit > 0.0))
+    throw io::Error(fmt::format("--max-misfit: expected a number > 0 (noise standard deviations), "
+                                "got {}",
+                                options_.max_misfit));
+  if (options_.periods < 2 || options_.periods > 100000)
+    throw io::Error(fmt::format("--periods: expected 2 to 100000, got {}", options_.periods));
+  check_balance_harmonics(options_.balance.harmonics, 1);
+  if (*std::max_element(options_.harmonics.begin(), options_.harmonics.end()) >
+      options_.balance.harmonics)
+    throw io::Error(fmt::format("--harmonics: expected at most --balance-harmonics ({})",
+                                options_.balance.harmonics));
+}
+
+void Design::run() {
+  // 1. The options.
+  const std::vector<double> freqs = parse_values("--freq", frequencies_, "Hz");
+  const std::vector<double> amps = parse_values("--amplitude", amplitudes_, "N or N m");
+  check_options();
+  const std::size_t n_candidates = freqs.size() * amps.size();
+  if (static_cast<std::size_t>(count_) > n_candidates)
+    throw io::Error(fmt::format("-n {}: more than the {} candidates ({} frequencies x {} "
+                                "amplitudes)",
+                                count_, n_candidates, freqs.size(), amps.size()));
+  check_output_dir(output_dir_);
+
+  // 2. The model and its unknowns.
+  const Model model(model_, engine());
+  if (model.file.joints.empty())
+    throw io::Error(model.name() + ": no [[joints]]: nothing to design tests for");
+  const std::vector<identify::DesignUnknown> unknowns =
+      identify::design_unknowns(model.file.joints);
+  if (unknowns.empty())
+    throw io::Error(model.name() + ": every joint term is fixed; nothing to identify");
+  for (const auto& u : unknowns)
+    if (u.prior == 0.0)
+      warn(fmt::format("{}: joint '{}', term {}: its value (the prior guess) is 0; the prediction "
+                       "has no such force",
+                       model.name(), u.joint, joints::term_name(u.term)));
+  const fem::NodeDof force_at = model.dof("--force", force_);
+
+  // 3. Predict the candidates, choose.
+  std::vector<identify::SineTestPlan> plans;
+  for (double f : freqs)
+    for (double a : amps)
+      plans.push_back({f, a});
+  identify::DesignOptions options = options_;
+  const std::vector<identify::CandidateTest> candidates =
+      with_progress(fmt::format("jointid design: predicting {} candidates", plans.size()),
+                    [&](const auto& progress) {
+                      options.progress = progress.callback();
+                      return for_model(model, [&] {
+                        return identify::predict_candidates(model.sub, model.file.joints, force_at,
+                                                            plans, options);
+                      });
+                    });
+  const auto usable = std::count_if(candidates.begin(), candidates.end(),
+                                    [](const identify::CandidateTest& c) { return c.usable; });
+  if (usable < count_)
+    throw io::Error(fmt::format("-n {}: only {} of the {} candidates can be predicted at the "
+                                "model's values (no periodic solution, coexisting responses, "
+                                "or equations the basis functions do not describe: --max-misfit)",
+                                count_, usable, candidates.size()));
+  const identify::Design chosen =
+      for_model(model, [&] { return identify::choose_tests(candidates, unknowns, count_); });
+  if (!output_rank()) return;
+
+  // 4. Write and report.
+  make_output_dir(output_dir_);
+  const fs::path json = output_dir_ / "design.json";
+  io::write_json(json, io::design_json(chosen, candidates, unknowns, options));
+  fmt::print("wrote {}\n", json.string());
+  if (const auto skipped = static_cast<std::ptrdiff_t>(candidates.size()) - usable; skipped > 0)
+    warn(fmt::format("{} of {} candidates left out: no periodic solution at the model's values, "
+                     "coexisting responses, or equations the basis functions do not describe, as "
+                     "where a friction joint sticks (design.json gives each reason)",
+                     skipped, candidates.size()));
+  print(chosen, candidates, unknowns);
+}
+
+void Design::print(const identify::Design& chosen,
+                   const std::vector<identify::CandidateTest>& candidates,
+                   const std::vector<identify::DesignUnknown>& unknowns) const {
+  fmt::print("D-optimal {} of {} candidates ({} exchanges after the greedy choice), noise {:g} % "
+             "RMS, {} periods a record, harmonics {}:\n",
+             count_, candidates.size(), chosen.exchanges, 100.0 * options_.noise, options_.periods,
+             fmt::join(options_.harmonics, ","));
+  fmt::print("  {:>12} {:>12}\n", "freq (Hz)", "force (N)");
+  for (int i : chosen.chosen)
+    fmt::print("  {:>12.6g} {:>12.6g}\n", candidates[static_cast<std::size_t>(i)].plan.frequency_hz,
+               candidates[static_cast<std::size_t>(i)].plan.amplitude);
+  fmt::print("expected standard deviations and bias:\n  {:<12} {:<6} {:>14} {:>14} {:>10} {:>10}\n",
+             "joint", "term", "prior", "std", "relative", "bias");
+  for (std::size_t u = 0; u < unknowns.size(); ++u) {
+    const double sd = chosen.std(static_cast<Eigen::Index>(u));
+    const double prior = std::abs(unknowns[u].prior);
+    fmt::print("  {:<12} {:<6} {:>14.6g} {:>14.4g} {:>9.3g}% {:>+9.2g}%\n", unknowns[u].joint,
+               joints::term_name(unknowns[u].term), unknowns[u].prior, sd, 100.0 * sd / prior,
+               100.0 * chosen.bias(static_cast<Eigen::Index>(u)) / prior);
+  }
+  for (const auto& w : chosen.warnings)
+    warn(w);
+}
+
+} // namespace
+
+std::unique_ptr<Command> design_command(CLI::App& parent) {
+  return std::make_unique<Design>(parent);
+}
+
+} // namespace jointid::cli

@@ -1,0 +1,132 @@
+// jointid discover: model discovery; DIR/discovery.json and DIR/report.md with its plots.
+#include "discover/discover.hpp"
+#include "cli/command.hpp"
+#include "cli/common.hpp"
+#include "identify/measurement.hpp"
+#include "io/files.hpp"
+#include "io/record_csv.hpp"
+#include "io/results_json.hpp"
+#include "joints/basis.hpp"
+#include "report/discovery_json.hpp"
+#include "report/discovery_report.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace jointid::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class Discover final : public Command {
+public:
+  explicit Discover(CLI::App& parent)
+      : Command(parent, "discover",
+                "Find where the model and the measurement disagree, name the missing joint "
+                "effect, add it and show the gap shrink; writes DIR/discovery.json and "
+                "DIR/report.md with plots") {
+    add_model("Model file (TOML): the starting model");
+    app()
+        .add_option("TESTS", records_, "Measurement records or stepped-sine tables (CSV)")
+        ->required();
+    add_output_dir();
+    add_harmonics(options_.harmonics, "Harmonics used in the fits; 0 to the largest are compared");
+    add_balance_harmonics(options_.balance.harmonics,
+                          "Harmonics 0 … K of the harmonic-balance re-simulations");
+    app().add_option("--max-steps", options_.max_steps, "Most terms added")->capture_default_str();
+    std::vector<std::string> names;
+    for (const joints::Term t : joints::all_terms)
+      names.emplace_back(joints::term_name(t));
+    app()
+        .add_option("--terms", terms_, "Candidate terms tried at every joint (default: all)")
+        ->check(choices(names))
+        ->delimiter(',')
+        ->allow_extra_args(false);
+    app().add_flag_callback(
+        "--no-damping-candidate", [this] { options_.substructure_damping = false; },
+        "Do not try scaling the substructure's damping");
+    add_no_plot("plots in the report");
+    add_engine();
+  }
+
+  void run() override;
+
+private:
+  void print(const discover::Result& result) const;
+
+  std::vector<fs::path> records_;
+  discover::Options options_; ///< the library's defaults
+  std::vector<std::string> terms_;
+};
+
+void Discover::run() {
+  // 1. The options.
+  if (records_.empty()) throw io::Error("expected at least one record or table (CSV file)");
+  check_harmonics(options_.harmonics, 1);
+  const int K = *std::max_element(options_.harmonics.begin(), options_.harmonics.end());
+  check_balance_harmonics(options_.balance.harmonics, K, "the largest of --harmonics");
+  if (options_.max_steps < 1)
+    throw io::Error(fmt::format("--max-steps: expected at least 1, got {}", options_.max_steps));
+  discover::Options options = options_;
+  if (!terms_.empty()) {
+    options.terms.clear();
+    for (const auto& t : terms_)
+      options.terms.push_back(joints::parse_term(t)); // checked by --terms' choices
+  }
+  check_output_dir(output_dir_);
+
+  // 2. The inputs.
+  const Model model(model_, engine());
+  if (model.file.joints.empty())
+    throw io::Error(model.name() + ": no [[joints]]: discovery starts from the joints' terms");
+  const std::vector<identify::SineTest> tests = io::read_tests(records_);
+  for (const char* name : {"discovery.json", "report.md"})
+    io::check_not_an_input(output_dir_ / name);
+  const std::vector<identify::Measurement> measured = identify::measure(tests, {.harmonics = K});
+
+  // 3. Discover.
+  const discover::Result result =
+      discover::discover(model.sub, model.file.joints, measured, options);
+  if (!output_rank()) return;
+
+  // 4. Write and report.
+  make_output_dir(output_dir_);
+  const fs::path json = output_dir_ / "discovery.json";
+  io::write_json(json, report::discovery_json(result));
+  std::vector<std::string> warnings = result.warnings;
+  report::ReportContext context{model_.string(), {}, plot_};
+  for (const auto& p : records_)
+    context.inputs.push_back(p.string());
+  const std::vector<fs::path> written =
+      report::write_discovery_report(output_dir_, result, context, warnings);
+  print(result);
+  fmt::print("wrote {}", json.string());
+  for (const auto& p : written)
+    fmt::print(", {}", p.filename().string());
+  fmt::print("\n");
+  for (const auto& w : warnings)
+    warn(w);
+}
+
+void Discover::print(const discover::Result& result) const {
+  for (std::size_t i = 0; i + 1 < result.diagnosis.findings.size(); ++i)
+    fmt::print("{}\n", result.diagnosis.findings[i]);
+  fmt::print("\n{:<5} {:<28} {:<26} {:>12} {:>11} {:>11}\n", "step", "added", "effect", "value",
+             "gap before", "gap after");
+  for (std::size_t i = 0; i < result.steps.size(); ++i) {
+    const auto& s = result.steps[i];
+    fmt::print("{:<5} {:<28} {:<26} {:>12.5g} {:>11.4g} {:>11.4g}\n", i + 1, s.added.name(),
+               s.added.effect(), s.added.value, s.gap_before, s.gap_after);
+  }
+  fmt::print("\n{}\nStopped: {}.\n", result.diagnosis.findings.back(), result.stop_reason);
+}
+
+} // namespace
+
+std::unique_ptr<Command> discover_command(CLI::App& parent) {
+  return std::make_unique<Discover>(parent);
+}
+
+} // namespace jointid::cli

@@ -1,0 +1,175 @@
+#include "cli/common.hpp"
+
+#include "io/files.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <set>
+#include <stdexcept>
+
+namespace jointid::cli {
+
+namespace fs = std::filesystem;
+
+void warn(const std::string& what) {
+  std::cerr << "jointid: warning: " << what << "\n";
+}
+
+void check_output_dir(const fs::path& dir) {
+  std::error_code ec;
+  if (dir.empty()) throw io::Error("-o: expected a directory");
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw io::Error(fmt::format("-o {}: exists and is not a directory", dir.string()));
+}
+
+void make_output_dir(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec)
+    throw io::Error(fmt::format("{}: cannot create the directory: {}", dir.string(), ec.message()));
+}
+
+void check_output_file(const fs::path& file, const std::string& option) {
+  std::error_code ec;
+  if (file.filename().empty() || fs::is_directory(file, ec))
+    throw io::Error(
+        fmt::format("{} {}: expected a file name, got a directory", option, file.string()));
+  const fs::path parent = file.parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, ec))
+    throw io::Error(fmt::format("{} {}: the directory {} does not exist", option, file.string(),
+                                parent.string()));
+}
+
+void check_harmonics(const std::vector<int>& harmonics, int lowest) {
+  if (harmonics.empty()) throw io::Error("--harmonics: expected at least one harmonic, e.g. 1,2,3");
+  if (harmonics.size() == 1 && harmonics[0] == 0)
+    throw io::Error("--harmonics: 0 alone is the mean (static) balance, which a sine test does not "
+                    "excite: add harmonic 1 (e.g. 0,1,2,3)");
+  std::set<int> seen;
+  for (int k : harmonics) {
+    if (k < lowest || k > 50)
+      throw io::Error(
+          fmt::format("--harmonics: expected harmonics from {} to 50, got {}", lowest, k));
+    if (!seen.insert(k).second)
+      throw io::Error(fmt::format("--harmonics: harmonic {} is listed twice", k));
+  }
+}
+
+void check_balance_harmonics(int harmonics, int lowest, const std::string& why) {
+  if (harmonics < lowest || harmonics > 200)
+    throw io::Error(why.empty() ? fmt::format("--balance-harmonics: expected {} to 200, got {}",
+                                              lowest, harmonics)
+                                : fmt::format("--balance-harmonics: expected from {} ({}) to 200, "
+                                              "got {}",
+                                              lowest, why, harmonics));
+}
+
+void check_amplitudes(const std::vector<double>& amplitudes) {
+  if (amplitudes.empty()) throw io::Error("--amplitude: expected at least one amplitude (N)");
+  for (double a : amplitudes)
+    if (!(std::isfinite(a) && a > 0.0))
+      throw io::Error(
+          fmt::format("--amplitude: expected finite amplitudes > 0 (N or N m), got {}", a));
+}
+
+void check_noise(double noise) {
+  if (!(std::isfinite(noise) && noise >= 0.0 && noise < 1.0))
+    throw io::Error(fmt::format(
+        "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", noise));
+}
+
+std::pair<double, double> parse_pair(const std::string& option, const std::string& text,
+                                     const char* example) {
+  double f0 = 0.0, f1 = 0.0;
+  const auto colon = text.find(':');
+  bool ok = colon != std::string::npos;
+  if (ok) {
+    try {
+      std::size_t n0 = 0, n1 = 0;
+      const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+      f0 = std::stod(a, &n0);
+      f1 = std::stod(b, &n1);
+      ok = n0 == a.size() && n1 == b.size() && std::isfinite(f0) && std::isfinite(f1);
+    } catch (const std::exception&) {
+      ok = false;
+    }
+  }
+  if (!ok)
+    throw io::Error(
+        fmt::format("{}: expected F0:F1 in Hz, e.g. {}, got \"{}\"", option, example, text));
+  return {f0, f1};
+}
+
+std::pair<double, double> parse_band(const std::string& option, const std::string& text) {
+  const auto [f0, f1] = parse_pair(option, text, "2:40");
+  if (!(f0 >= 0.0 && f1 > f0))
+    throw io::Error(fmt::format("{}: expected 0 <= F0 < F1 (Hz), got {} and {}", option, f0, f1));
+  return {f0, f1};
+}
+
+std::vector<identify::Quantity> parse_channels(const std::vector<std::string>& channels) {
+  std::vector<identify::Quantity> out;
+  for (const auto& c : channels) {
+    const identify::Quantity q =
+        c == "x"   ? identify::Quantity::displacement
+        : c == "v" ? identify::Quantity::velocity
+        : c == "a" ? identify::Quantity::acceleration
+                   : throw io::Error(fmt::format("--channels: expected x, v or a, got \"{}\"", c));
+    if (std::find(out.begin(), out.end(), q) != out.end())
+      throw io::Error(fmt::format("--channels: {} is listed twice", c));
+    out.push_back(q);
+  }
+  if (out.empty()) throw io::Error("--channels: expected x, v and/or a");
+  return out;
+}
+
+identify::TransientRoute parse_route(const std::string& text) {
+  if (text == "modal") return identify::TransientRoute::modal;
+  if (text == "full") return identify::TransientRoute::full;
+  throw io::Error(fmt::format("--route: expected modal or full, got \"{}\"", text));
+}
+
+Model::Model(const fs::path& path, Engine engine)
+    : file(io::read_model(path)), sub(file.substructure()) {
+  use_engine(sub, engine);
+}
+
+fem::NodeDof Model::dof(const std::string& option, const std::string& text) const {
+  try {
+    const fem::NodeDof at = io::resolve_node_dof(file, text);
+    sub.dofs().equation(at);
+    return at;
+  } catch (const std::invalid_argument& e) {
+    throw io::Error(fmt::format("{} {}: {} (expected NODE:DOF of a free DOF of {}, e.g. 7:uy, or "
+                                "a one-node Gmsh group such as tip:uy)",
+                                option, text, e.what(), name()));
+  }
+}
+
+void draw_chart(const fs::path& png, const std::function<report::Figure()>& figure) {
+  std::string why;
+  if (!report::can_render_charts(&why)) {
+    warn("no " + png.string() + ": " + why + " (run under xvfb-run -a)");
+    return;
+  }
+  try {
+    report::write_chart_png(png, figure());
+    fmt::print("wrote {}\n", png.string());
+  } catch (const std::invalid_argument& e) {
+    warn("no " + png.string() + ": " + e.what());
+  }
+}
+
+void write_outputs(const std::vector<std::pair<fs::path, std::string>>& outputs) {
+  io::OutputFiles files;
+  for (const auto& [path, text] : outputs)
+    files.add(path, text);
+  files.commit();
+  for (const auto& [path, text] : outputs)
+    fmt::print("wrote {}\n", path.string());
+}
+
+} // namespace jointid::cli
