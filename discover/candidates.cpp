@@ -111,10 +111,7 @@ Outcome consider_variation(const Problem& problem, const State& state, const Sim
     v.frequency_hz.push_back(tests[i].frequency_hz);
   }
   State s = problem.evaluate_each(state.joints, per_test, sim, &state);
-  summarise(v, c, state.joints[jj]);
-  fill(c, s);
-  if (c.rejected.empty()) c.rejected = agreement_problem(v);
-  c.varies = std::move(v);
+  judge_variation(c, std::move(v), s, state.joints[jj]);
   return {std::move(c), std::move(s)};
 }
 

@@ -248,6 +248,14 @@ std::string agreement_problem(const Variation& variation) {
                      number(v.chi2), v.dof);
 }
 
+void judge_variation(Candidate& candidate, Variation variation, const State& state,
+                     const joints::Joint& joint) {
+  summarise(variation, candidate, joint);
+  fill(candidate, state);
+  if (candidate.rejected.empty()) candidate.rejected = agreement_problem(variation);
+  candidate.varies = std::move(variation);
+}
+
 double rank_correlation(const std::vector<double>& a, const std::vector<double>& b) {
   auto ranks = [](const std::vector<double>& x) {
     std::vector<std::size_t> order(x.size());

@@ -100,6 +100,11 @@ void summarise(Variation& variation, Candidate& candidate, const joints::Joint& 
 /// Its values must disagree: χ² about their weighted mean more than 3 standard deviations
 /// (√(2 dof)) above its degrees of freedom, else "its values agree between the tests (…)".
 std::string agreement_problem(const Variation& variation);
+/// A per-test candidate's verdict: `variation` summarised into the candidate (summarise), its
+/// gap and criterion from the state that simulates each test at its own value (rule 1), and its
+/// values must disagree (agreement_problem); the candidate then holds the variation.
+void judge_variation(Candidate& candidate, Variation variation, const State& state,
+                     const joints::Joint& joint);
 /// Spearman's rank correlation (ties get their mean rank); 0 when either side is constant.
 double rank_correlation(const std::vector<double>& a, const std::vector<double>& b);
 /// What a variation says, in one sentence: "fc at 'spring' is not one number: …".
