@@ -25,6 +25,7 @@ struct Simulator {
 class Problem {
 public:
   /// Checks and sets up the comparison. Throws std::invalid_argument as discover() says.
+  /// `substructure` and `tests` are referred to, not copied: they must outlive the problem.
   Problem(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,
           const std::vector<identify::Measurement>& tests, const Options& options);
 
