@@ -49,11 +49,16 @@ struct OneMode {
                        {0.0, receptance(f_hz, k, c) * F1}, {variance, variance}, false);
   }
 
-  std::vector<identify::Measurement> tests(const std::vector<double>& frequencies,
-                                           double F0) const {
+  // Tests at these frequencies and one level; `relative_noise` > 0: each harmonic's noise
+  // standard deviation that share of the response's fundamental, else 1e-8 m.
+  std::vector<identify::Measurement> tests(const std::vector<double>& frequencies, double F0,
+                                           double relative_noise = 0.0) const {
     std::vector<identify::Measurement> out;
     for (double f : frequencies)
-      out.push_back(test(f, F0));
+      out.push_back(test(f, F0,
+                         relative_noise > 0.0
+                             ? std::pow(relative_noise, 2) * std::norm(receptance(f, k, c) * F0)
+                             : 1e-16));
     return out;
   }
 };

@@ -18,9 +18,7 @@ TEST(Refine, FromWrongValuesReachesTheTrueJoint) {
   const frf::Substructure sub = m.substructure();
   // Noise of 1e-4 of the response's size (its variance known), none in the data: the misfit at
   // the truth is 0, so the values reached are the truth to the search's own tolerance.
-  std::vector<identify::Measurement> tests;
-  for (double f : {2.5, 2.8, 3.0, 3.2, 3.5, 4.0})
-    tests.push_back(m.test(f, 10.0, 1e-8 * std::norm(m.receptance(f, m.k, m.c) * 10.0)));
+  const auto tests = m.tests({2.5, 2.8, 3.0, 3.2, 3.5, 4.0}, 10.0, 1e-4);
   Problem problem(sub, {m.joint(0.0, 0.0)}, tests, test::fundamental_only());
   const Simulator& sim = problem.simulator(1.0);
   const discover::State start = problem.evaluate({m.joint(300.0, 3.0)}, sim);
@@ -45,9 +43,7 @@ TEST(Refine, FromWrongValuesReachesTheTrueJoint) {
 TEST(Refine, NegativeDampingIsBroughtBackFirst) {
   const test::OneMode m;
   const frf::Substructure sub = m.substructure();
-  std::vector<identify::Measurement> tests;
-  for (double f : {2.5, 3.0, 3.5, 4.0})
-    tests.push_back(m.test(f, 10.0, 1e-8 * std::norm(m.receptance(f, m.k, m.c) * 10.0)));
+  const auto tests = m.tests({2.5, 3.0, 3.5, 4.0}, 10.0, 1e-4);
   Problem problem(sub, {m.joint(0.0, 0.0)}, tests, test::fundamental_only());
   const Simulator& sim = problem.simulator(1.0);
   const discover::State refined =

@@ -73,6 +73,13 @@ TEST(Score, AStateAgainstHandComputedGapChi2AndCriterion) {
   EXPECT_NEAR(s.criterion, 5.0 * std::log(1.05 / 5.0) + 2.0 * std::log(5.0), 1e-12);
 }
 
+// The model now: its gap and criterion.
+State current(double gap, double criterion) {
+  State now;
+  now.gap = gap, now.criterion = criterion;
+  return now;
+}
+
 // A state that converged with the candidate's joint and a fit that holds its estimate.
 State with_estimate(Term term, double value, double ci_low, double ci_high, double c = 20.0) {
   State s;
@@ -123,8 +130,7 @@ TEST(Rule2, AnIntervalThatHoldsZeroRejectsATerm) {
 
 TEST(Rule3, ACandidateThatDoesNotLowerTheCriterionIsRejected) {
   // Explains 75 % of the squared gap, but its criterion (105) is above the model's (100).
-  State now;
-  now.gap = 0.2, now.criterion = 100.0;
+  const State now = current(0.2, 100.0);
   std::vector<discover::Candidate> ranking{candidate(Term::c2, 0.1, 105.0)};
   screen(ranking, now, 0.05);
   EXPECT_NEAR(ranking[0].explained, 0.75, 1e-15);
@@ -136,8 +142,7 @@ TEST(Rule3, ACandidateThatDoesNotLowerTheCriterionIsRejected) {
 
 TEST(Rule4, ACandidateThatExplainsLessThanTheMinimumIsRejected) {
   // Its criterion falls (90 < 100), but the gap only from 0.2 to 0.198: 1 − 0.99² = 1.99 %.
-  State now;
-  now.gap = 0.2, now.criterion = 100.0;
+  const State now = current(0.2, 100.0);
   std::vector<discover::Candidate> ranking{candidate(Term::fc, 0.198, 90.0)};
   screen(ranking, now, 0.05);
   EXPECT_NEAR(ranking[0].explained, 0.0199, 1e-14);
@@ -174,8 +179,7 @@ TEST(Rule5, ACandidateThatPredictsHeldOutTestsWorseIsRejectedAndTheNextChosen) {
 TEST(Selection, EachRuleRejectsItsCandidateAndTheAdmissibleOneIsAdded) {
   // Six candidates from a model with gap 0.2 and criterion 100, each failing one rule only, the
   // damping scale failing none. Ranked by the criterion, the damping scale comes last.
-  State now;
-  now.gap = 0.2, now.criterion = 100.0;
+  const State now = current(0.2, 100.0);
   std::vector<discover::Candidate> ranking{
       candidate(Term::k2, 0.05, 60.0),                // rule 1: did not converge
       candidate(Term::c3, 0.05, 62.0),                // rule 2: interval holds 0
@@ -297,8 +301,7 @@ TEST(VariesPerTest, ValuesThatFallWithTheAmplitudeAreAdmittedAndChosenAsOutside)
             std::string::npos)
       << c.varies->description;
   // The best by the criterion among the admissible: the loop stops there, adding nothing.
-  State now;
-  now.gap = 0.01, now.criterion = 100.0;
+  const State now = current(0.01, 100.0);
   std::vector<discover::Candidate> ranking{candidate(Term::k3, 0.005, 60.0), c};
   const Choice choice = choose(
       ranking, screen(ranking, now, 0.05), [] { return 0.2; }, [](std::size_t) { return 0.1; });
