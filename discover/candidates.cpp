@@ -1,0 +1,199 @@
+#include "discover/candidates.hpp"
+
+#include "discover/selection.hpp"
+#include "fem/minimise.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+namespace jointid::discover::detail {
+
+namespace {
+constexpr double inf = std::numeric_limits<double>::infinity();
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+} // namespace
+
+Outcome refused(Candidate c, const State& state, const std::string& why) {
+  c.rejected = why;
+  c.gap = c.criterion = inf;
+  return {std::move(c), state};
+}
+
+Outcome consider_refit(const Problem& problem, const State& state, const Simulator& sim) {
+  Candidate c;
+  c.refit = true;
+  c.joint = state.joints.front().name;
+  try {
+    const identify::FitResult fit = problem.identify(state.joints, sim, problem.all_tests());
+    State s = problem.evaluate(fit.identified(state.joints), sim);
+    s.fit = fit;
+    fill(c, s);
+    if (c.rejected.empty()) c.rejected = physical_problem(s.joints);
+    return {std::move(c), std::move(s)};
+  } catch (const std::invalid_argument& e) {
+    return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
+  }
+}
+
+Outcome consider_term(const Problem& problem, const State& state, const Simulator& sim,
+                      const std::string& joint, joints::Term term) {
+  Candidate c;
+  c.joint = joint;
+  c.term = term;
+  std::vector<joints::Joint> joints = state.joints;
+  for (auto& j : joints)
+    if (j.name == joint) {
+      j.terms.push_back(term);
+      j.values.push_back(0.0);
+      j.fixed.push_back(false);
+      if (!j.given.empty()) j.given.push_back(false);
+    }
+  try {
+    const identify::FitResult fit = problem.identify(joints, sim, problem.all_tests());
+    joints = fit.identified(joints);
+    take_fit(c, fit, joint, term);
+    // Not simulated: negative dry friction has no steady state to compare.
+    if (const std::string why = friction_problem(joints); !why.empty())
+      return refused(std::move(c), state, why);
+    State s = problem.evaluate(joints, sim);
+    s.fit = fit;
+    judge(c, s);
+    return {std::move(c), std::move(s)};
+  } catch (const std::invalid_argument& e) {
+    return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
+  }
+}
+
+Outcome consider_variation(const Problem& problem, const State& state, const Simulator& sim,
+                           const std::string& joint, joints::Term term) {
+  const auto& tests = problem.tests();
+  Candidate c;
+  c.joint = joint;
+  c.term = term;
+  Variation v;
+  std::vector<joints::Joint> held = state.joints;
+  std::size_t jj = 0;
+  for (std::size_t j = 0; j < held.size(); ++j)
+    for (std::size_t t = 0; t < held[j].terms.size(); ++t) {
+      const bool free = held[j].name == joint && held[j].terms[t] == term;
+      held[j].fixed[t] = !free;
+      if (free) jj = j;
+    }
+  std::vector<std::vector<joints::Joint>> per_test;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    try {
+      const identify::FitResult fit = problem.identify(held, sim, {static_cast<int>(i)});
+      Candidate one;
+      take_fit(one, fit, joint, term);
+      if (!std::isfinite(one.std) || !(one.std > 0.0))
+        return refused(std::move(c), state,
+                       fmt::format("not determined by {} alone", tests[i].source));
+      per_test.push_back(fit.identified(held));
+      v.value.push_back(one.value);
+      v.std.push_back(one.std);
+    } catch (const std::invalid_argument& e) {
+      return refused(
+          std::move(c), state,
+          fmt::format("cannot be identified from {} alone: {}", tests[i].source, e.what()));
+    }
+    if (std::string why = physical_problem(per_test.back()); !why.empty())
+      return refused(std::move(c), state, tests[i].source + ": " + why);
+    if (std::string why = friction_problem(per_test.back()); !why.empty())
+      return refused(std::move(c), state, tests[i].source + ": " + why);
+    v.tests.push_back(tests[i].source);
+    v.amplitude.push_back(
+        std::abs(problem.measured_deformation(i)(1, static_cast<Eigen::Index>(jj))));
+    v.frequency_hz.push_back(tests[i].frequency_hz);
+  }
+  State s = problem.evaluate_each(state.joints, per_test, sim, &state);
+  judge_variation(c, std::move(v), s, state.joints[jj]);
+  return {std::move(c), std::move(s)};
+}
+
+Outcome consider_damping(const Problem& problem, const State& state) {
+  const Compared& compared = problem.compared();
+  Candidate c;
+  c.joint = "substructure";
+  std::map<double, State> tried;
+  auto trial = [&](double u) -> double {
+    if (const auto it = tried.find(u); it != tried.end()) return it->second.criterion;
+    try {
+      const auto sim = problem.make_simulator(std::exp(u), false);
+      const identify::FitResult fit = problem.identify(state.joints, *sim, problem.all_tests());
+      State st = problem.evaluate(fit.identified(state.joints), *sim);
+      st.fit = fit;
+      if (!st.converged || !physical_problem(st.joints).empty()) return inf;
+      const double f = st.criterion;
+      tried.emplace(u, std::move(st));
+      return f;
+    } catch (const std::invalid_argument&) {
+      return inf;
+    }
+  };
+  const double lo = std::log(0.05), hi = std::log(20.0);
+  double best_u = 0.0, best_f = inf;
+  for (int i = 0; i <= 6; ++i) {
+    const double u = lo + (hi - lo) * i / 6.0, f = trial(u);
+    if (f < best_f) best_f = f, best_u = u;
+  }
+  const double width = (hi - lo) / 6.0;
+  fem::golden_section_minimum(trial, best_u - width, best_u + width, 10); // (tried: the best)
+  if (tried.empty()) return refused(std::move(c), state, "no damping scale gives a model");
+  const double u = std::min_element(tried.begin(), tried.end(), [](const auto& x, const auto& y) {
+                     return x.second.criterion < y.second.criterion;
+                   })->first;
+  // Its uncertainty from the curvature of the misfit in ln s: χ² with known noise, else
+  // S / σ̂² with σ̂² = S_min / (N − p); σ_u² = 2 / (∂²misfit/∂u²).
+  const double h = 0.02;
+  double sigma_u = nan;
+  if (std::isfinite(trial(u + h)) && std::isfinite(trial(u - h))) {
+    const State &s0 = tried.at(u), &sp = tried.at(u + h), &sm = tried.at(u - h);
+    const double sigma2 =
+        s0.gap * s0.gap * compared.measured2 / std::max(1, compared.values - s0.parameters);
+    auto misfit = [&](const State& st) {
+      return compared.noise_known ? st.chi2 : st.gap * st.gap * compared.measured2 / sigma2;
+    };
+    const double curvature = (misfit(sp) - 2.0 * misfit(s0) + misfit(sm)) / (h * h);
+    if (curvature > 0.0) sigma_u = std::sqrt(2.0 / curvature);
+  }
+  State st = tried.at(u);
+  c.value = std::exp(u);
+  c.std = c.value * sigma_u;
+  c.ci_low = std::exp(u - 1.96 * sigma_u);
+  c.ci_high = std::exp(u + 1.96 * sigma_u);
+  fill(c, st);
+  if (c.rejected.empty()) c.rejected = interval_problem(c);
+  return {std::move(c), std::move(st)};
+}
+
+std::vector<std::function<Outcome()>> candidate_jobs(const Problem& problem, const State& state,
+                                                     const Simulator& current, bool values_fitted) {
+  const Problem* p = &problem;
+  const State* s = &state;
+  const Simulator* sim = &current;
+  std::vector<std::function<Outcome()>> jobs;
+  if (!values_fitted) jobs.push_back([=] { return consider_refit(*p, *s, *sim); });
+  for (const auto& j : state.joints)
+    for (joints::Term t : problem.options().terms)
+      if (j.term_index(t) < 0)
+        jobs.push_back([=, name = j.name] { return consider_term(*p, *s, *sim, name, t); });
+  if (problem.options().substructure_damping && problem.synthesis().num_modes() > 0)
+    jobs.push_back([=] { return consider_damping(*p, *s); });
+  // What the library cannot add: a term of the model whose coefficient changes between tests
+  // (with four tests or more: fewer leave too little to tell a trend from a fit).
+  if (problem.tests().size() >= 4)
+    for (const auto& j : state.joints)
+      for (std::size_t t = 0; t < j.terms.size(); ++t)
+        if (!j.fixed[t])
+          jobs.push_back([=, name = j.name, term = j.terms[t]] {
+            return consider_variation(*p, *s, *sim, name, term);
+          });
+  return jobs;
+}
+
+} // namespace jointid::discover::detail

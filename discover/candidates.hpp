@@ -1,0 +1,43 @@
+#pragma once
+/// The candidates of a step (discover.hpp): each term of the library at each joint that lacks
+/// it, a scale factor on the substructure's damping, a refit of starting values never fitted,
+/// and each term of the model with a value per test. Each is identified and re-simulated, and
+/// judged by rules 1 and 2 (selection.hpp); rules 3–5 compare it with the others.
+#include "discover/problem.hpp"
+
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace jointid::discover::detail {
+
+/// A candidate and the state it gives.
+using Outcome = std::pair<Candidate, State>;
+
+/// A candidate that gives no model: rejected with `why`, its gap and criterion infinite.
+Outcome refused(Candidate candidate, const State& state, const std::string& why);
+
+/// The starting values identified again (when none was identified at the start).
+Outcome consider_refit(const Problem& problem, const State& state, const Simulator& sim);
+/// `term` added at `joint`, every non-fixed term identified again by equation error.
+Outcome consider_term(const Problem& problem, const State& state, const Simulator& sim,
+                      const std::string& joint, joints::Term term);
+/// The joint's `term` identified from each test alone (every other term held at the state's
+/// value), and every test simulated at its own value: does the coefficient change between
+/// tests, beyond the noise, and with what? Admissible when the values disagree
+/// (agreement_problem).
+Outcome consider_variation(const Problem& problem, const State& state, const Simulator& sim,
+                           const std::string& joint, joints::Term term);
+/// The substructure's damping scaled by s: ln s is searched by a coarse scan and a golden
+/// section on the criterion, every joint term identified again at each trial.
+Outcome consider_damping(const Problem& problem, const State& state);
+
+/// Every candidate of a step from `state` (simulated with `current`), as jobs to run in
+/// parallel: a refit unless `values_fitted`, the library's terms at every joint, the damping
+/// scale (if asked and the substructure has modes), and, with four tests or more, a value per
+/// test of every non-fixed term. The jobs refer to the arguments, which must outlive them.
+std::vector<std::function<Outcome()>> candidate_jobs(const Problem& problem, const State& state,
+                                                     const Simulator& current, bool values_fitted);
+
+} // namespace jointid::discover::detail

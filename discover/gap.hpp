@@ -1,0 +1,67 @@
+#pragma once
+/// The disagreement between a model and the measurement (discover.hpp defines the terms): the
+/// values compared, their squared difference and χ², the gap, and the noise level.
+#include "discover/discover.hpp"
+#include "identify/measurement.hpp"
+
+#include <Eigen/Core>
+
+#include <complex>
+#include <limits>
+#include <vector>
+
+namespace jointid::discover::detail {
+
+/// A value compared: test i, response j, harmonic k (a displacement, m or rad).
+struct Entry {
+  int test = 0, response = 0, harmonic = 0;
+  std::complex<double> measured;
+  double variance = 0.0;   ///< E|δX|² of the measurement noise, NaN when unknown
+  double simulation = 0.0; ///< E|δX|² of the simulation's own error (harmonic truncation)
+  double force = 0.0;      ///< E|δX_sim|² from the noise in the measured force that drives it
+  /// The variance of the difference measured − simulated, and its real degrees of freedom.
+  double total() const { return variance + simulation + force; }
+  int dof() const { return harmonic == 0 ? 1 : 2; }
+};
+
+/// Every value compared, and what they add up to.
+struct Compared {
+  std::vector<Entry> entries;
+  int harmonics = 1;       ///< K: harmonics 0 … K are compared
+  int values = 0;          ///< N: real values (harmonic 0 counts one, the others two)
+  double measured2 = 0.0;  ///< Σ |X_meas|²
+  bool noise_known = true; ///< every value's noise variance is known
+  double noise_gap = std::numeric_limits<double>::quiet_NaN(); ///< the noise level, if known
+};
+
+/// The values of harmonics 0 … K at every response of every test: harmonic 0 only where the
+/// mean displacement was measured, a table's harmonic 1 only. The noise level is that of the
+/// responses' own noise (estimate_simulation_error adds the force's). Throws
+/// std::invalid_argument when every response is zero.
+Compared compared_values(const std::vector<identify::Measurement>& tests, int harmonics);
+
+/// Σ |X_meas − X_sim|² over the compared values, and χ² = Σ dof · |X_meas − X_sim|² / total
+/// (NaN when the noise is unknown). X: per test, (K+1) × responses.
+struct Misfit {
+  double squared = 0.0;
+  double chi2 = 0.0;
+};
+Misfit misfit(const Compared& compared, const std::vector<Eigen::MatrixXcd>& X);
+
+/// The gap of a squared misfit: sqrt(S / Σ |X_meas|²).
+double gap(const Compared& compared, double squared);
+
+/// The noise level: the gap a perfect model would leave, from the responses' noise and the
+/// measured force's, propagated (Entry::variance and Entry::force).
+double noise_level(const Compared& compared);
+
+/// χ² per value of each compared harmonic 0 … K (NaN where none is compared).
+std::vector<double> chi2_by_harmonic(const Compared& compared,
+                                     const std::vector<Eigen::MatrixXcd>& X);
+
+/// At the noise level: the noise known, the state converged, and its χ² per value within 3
+/// standard deviations (√(2/N)) of 1, overall and for every compared harmonic on its own (so
+/// that a misfit of the few large fundamentals is not averaged away by many small harmonics).
+bool at_noise_level(const Compared& compared, const State& state);
+
+} // namespace jointid::discover::detail

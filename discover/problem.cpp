@@ -1,0 +1,243 @@
+#include "discover/problem.hpp"
+
+#include "discover/selection.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace jointid::discover::detail {
+
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+void add_unique(std::vector<int>& list, int value) {
+  if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
+}
+
+} // namespace
+
+Problem::Problem(const frf::Substructure& sub, const std::vector<joints::Joint>& start,
+                 const std::vector<identify::Measurement>& tests, const Options& o)
+    : sub_(sub), dofs_(sub.dofs()), tests_(tests), o_(o) {
+  if (tests.empty()) throw std::invalid_argument("discover: no tests");
+  if (start.empty()) throw std::invalid_argument("discover: the model has no joints");
+  if (o.harmonics.empty()) throw std::invalid_argument("discover: no harmonics to fit");
+  for (int k : o.harmonics)
+    if (k < 0) throw std::invalid_argument("discover: harmonics must be >= 0");
+  K_ = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
+  if (o.balance.harmonics < K_)
+    throw std::invalid_argument("discover: the harmonic balance needs at least as many "
+                                "harmonics as are compared");
+  joints::validate_joints(start, dofs_);
+  layout_ = start;
+  set_up_equations(start);
+  set_up_drive_and_start(start);
+  base_ = std::make_unique<frf::ModalSynthesis>(sub.synthesis(synthesis_dofs_, f_max_, &notes_));
+  compared_ = compared_values(tests, K_);
+}
+
+int Problem::equation(const identify::Measurement& m, const std::string& what,
+                      const fem::NodeDof& at) {
+  try {
+    return dofs_.equation(at);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(m.source + ": channel " + what + fem::to_string(at) + ": " +
+                                e.what());
+  }
+}
+
+// Equations: the joints' DOFs, every force and every response of every test; the band the
+// re-simulations need.
+void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
+  synthesis_dofs_ = joints::joint_dof_set(start, dofs_);
+  double f_max = 0.0;
+  for (const auto& m : tests_) {
+    if (m.harmonics < K_ && !m.fundamental_only)
+      throw std::invalid_argument(m.source + ": measured to harmonic " +
+                                  std::to_string(m.harmonics) + ", but " + std::to_string(K_) +
+                                  " are compared");
+    std::vector<int> forces, responses;
+    for (const auto& at : m.force_at)
+      forces.push_back(equation(m, "force channel f@", at));
+    for (std::size_t j = 0; j < m.response_at.size(); ++j)
+      responses.push_back(equation(
+          m, std::string(1, identify::quantity_letter(m.measured_as[j])) + "@", m.response_at[j]));
+    for (int e : forces)
+      add_unique(synthesis_dofs_, e);
+    for (int e : responses)
+      add_unique(synthesis_dofs_, e);
+    force_eq_.push_back(std::move(forces));
+    response_eq_.push_back(std::move(responses));
+    f_max = std::max(f_max, m.frequency_hz);
+  }
+  fit_to_measured_band(f_max);
+  f_max_ = frf::synthesis_band_hz(f_max, 2 * o_.balance.harmonics); // refined: twice K
+}
+
+// Measured FRFs end at their band: the re-simulations keep to the harmonics whose doubles (the
+// refined simulations) stay in it.
+void Problem::fit_to_measured_band(double f_max) {
+  const double top = sub_.band_top_hz(synthesis_dofs_);
+  if (!std::isfinite(top)) return;
+  const int reach = static_cast<int>(std::floor(top / f_max * (1.0 + 1e-12)));
+  const int usable = std::min(o_.balance.harmonics, reach / 2);
+  if (usable < K_)
+    throw std::invalid_argument(fmt::format(
+        "discover: the measured FRFs reach {} Hz; the re-simulations need harmonic {} (twice "
+        "the {} compared, to estimate their own error) of the highest test frequency, {} Hz: "
+        "{} Hz. Measure to that, or compare fewer harmonics",
+        top, 2 * K_, K_, f_max, 2 * K_ * f_max));
+  if (usable < o_.balance.harmonics) {
+    notes_.push_back(fmt::format(
+        "the measured FRFs reach {} Hz: the re-simulations use {} harmonics (not {}), so "
+        "that the refined ones (twice as many) at {} Hz stay in the band",
+        top, usable, o_.balance.harmonics, f_max));
+    o_.balance.harmonics = usable;
+  }
+}
+
+void Problem::set_up_drive_and_start(const std::vector<joints::Joint>& start) {
+  // The force that drives each re-simulation: the measured harmonics, except those that are
+  // noise (a force harmonic within 5 standard deviations of 0 is taken as 0): driven through
+  // a resonance, noise alone would give the model responses the structure never had.
+  for (const auto& m : tests_) {
+    Eigen::MatrixXcd F = m.F;
+    for (Eigen::Index k = 0; k < F.rows(); ++k)
+      for (Eigen::Index c = 0; c < F.cols(); ++c)
+        if (k != 1 && m.F_variance.size() > 0 && std::norm(F(k, c)) <= 25.0 * m.F_variance(k, c))
+          F(k, c) = 0.0;
+    drive_.push_back(std::move(F));
+  }
+  // The measured joint deformations: the harmonic balance starts from them, so that it
+  // finds the periodic solution on the measured branch (hardening joints have several).
+  const std::vector<int> set2 = joints::joint_dof_set(start, dofs_);
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(start, dofs_, set2);
+  for (const auto& m : tests_) {
+    Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(o_.balance.harmonics + 1, B.cols());
+    for (std::size_t d = 0; d < set2.size(); ++d) {
+      const int r = m.response_index(dofs_.node_dof(set2[d]));
+      if (r < 0)
+        throw std::invalid_argument(m.source + ": no response channel at joint DOF " +
+                                    fem::to_string(dofs_.node_dof(set2[d])) +
+                                    " (discovery needs x, v or a at every joint DOF)");
+      for (int k = 0; k <= std::min(m.harmonics, o_.balance.harmonics); ++k) {
+        if (!m.has_harmonic(k) || (k == 0 && !m.has_mean[r])) continue;
+        Y.row(k) += m.X(k, r) * B.row(static_cast<Eigen::Index>(d)).cast<std::complex<double>>();
+      }
+    }
+    measured_start_.push_back(std::move(Y));
+  }
+}
+
+std::vector<int> Problem::all_tests() const {
+  std::vector<int> all(tests_.size());
+  for (std::size_t i = 0; i < all.size(); ++i)
+    all[i] = static_cast<int>(i);
+  return all;
+}
+
+std::unique_ptr<Simulator> Problem::make_simulator(double scale, bool refined) const {
+  const int harmonics = o_.balance.harmonics * (refined ? 2 : 1);
+  auto s = std::make_unique<Simulator>(
+      Simulator{scale, harmonics, scale == 1.0 ? *base_ : base_->with_damping_scale(scale), {}});
+  frf::HarmonicBalanceOptions options = o_.balance;
+  options.harmonics = harmonics;
+  for (std::size_t i = 0; i < tests_.size(); ++i)
+    s->balance.emplace_back(s->synthesis, layout_, dofs_, force_eq_[i], response_eq_[i],
+                            tests_[i].frequency_hz, options);
+  return s;
+}
+
+const Simulator& Problem::simulator(double scale, bool refined) {
+  const int harmonics = o_.balance.harmonics * (refined ? 2 : 1);
+  for (const auto& s : simulators_)
+    if (s->scale == scale && s->harmonics == harmonics) return *s;
+  simulators_.push_back(make_simulator(scale, refined));
+  return *simulators_.back();
+}
+
+identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
+                                      const Simulator& sim, const std::vector<int>& use) const {
+  std::vector<std::string> warnings;
+  std::vector<identify::TestSpectrum> spectra;
+  for (int i : use)
+    spectra.push_back(identify::spectrum(tests_[i], dofs_, joints, warnings));
+  const identify::ReceptanceFn H = [&sim](double w, std::span<const int> rows,
+                                          std::span<const int> cols) {
+    return sim.synthesis.receptance(w, rows, cols);
+  };
+  identify::FitOptions fo;
+  fo.harmonics = o_.harmonics;
+  identify::FitResult fit = identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
+  // Terms the tests cannot separate: this model cannot be identified (a refused candidate).
+  if (fit.status != identify::FitStatus::ok) throw std::invalid_argument("identify: " + fit.reason);
+  return fit;
+}
+
+int Problem::parameters(const std::vector<joints::Joint>& joints, double scale) const {
+  int p = scale != 1.0 ? 1 : 0;
+  for (const auto& j : joints)
+    for (bool f : j.fixed)
+      p += f ? 0 : 1;
+  return p;
+}
+
+State Problem::evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim,
+                        const State* warm) const {
+  return evaluate_each(joints, {}, sim, warm);
+}
+
+State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
+                             const std::vector<std::vector<joints::Joint>>& per_test,
+                             const Simulator& sim, const State* warm) const {
+  State s;
+  s.joints = joints;
+  s.damping_scale = sim.scale;
+  s.parameters = parameters(joints, sim.scale) +
+                 (per_test.empty() ? 0 : static_cast<int>(per_test.size()) - 1);
+  s.X.assign(tests_.size(), Eigen::MatrixXcd());
+  s.Y.assign(tests_.size(), Eigen::MatrixXcd());
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
+    const frf::HarmonicBalanceResult r =
+        solve(sim, static_cast<int>(i), per_test.empty() ? joints : per_test[i], start);
+    s.converged = s.converged && r.converged && r.X.allFinite();
+    s.X[i] = r.X.topRows(K_ + 1);
+    s.Y[i] = r.Y;
+  }
+  score(s);
+  return s;
+}
+
+frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,
+                                          const std::vector<joints::Joint>& joints,
+                                          const Eigen::MatrixXcd* warm) const {
+  if (!friction_problem(joints).empty()) { // fc < 0: no steady state to speak of
+    frf::HarmonicBalanceResult none;
+    none.X = Eigen::MatrixXcd::Constant(sim.harmonics + 1, response_eq_[i].size(), nan);
+    return none;
+  }
+  frf::HarmonicBalanceResult r;
+  if (warm && warm->rows() == sim.harmonics + 1) {
+    r = sim.balance[i].solve(joints, drive_[i], warm);
+    if (r.converged) return r;
+  }
+  r = sim.balance[i].solve(joints, drive_[i], &measured_start_[i]);
+  if (!r.converged) {
+    frf::HarmonicBalanceResult again = sim.balance[i].solve(joints, drive_[i]);
+    again.iterations += r.iterations;
+    if (again.converged || again.residual < r.residual) r = std::move(again);
+  }
+  return r;
+}
+
+void Problem::score(State& state) const {
+  detail::score(state, compared_);
+}
+
+} // namespace jointid::discover::detail

@@ -1,0 +1,115 @@
+#pragma once
+/// What discovery works on: the substructure, the tests and the values compared, set up once;
+/// the re-simulation of every test with a model (harmonic balance, driven by the measured force,
+/// started from the measured deformation), the identification of a model's terms from the tests,
+/// and the estimate of what a perfect model would still miss (the simulation's own error and the
+/// measured force's noise).
+#include "discover/discover.hpp"
+#include "discover/gap.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace jointid::discover::detail {
+
+/// The substructure's receptance (its damping scaled) and the harmonic-balance problems of
+/// every test built on it.
+struct Simulator {
+  double scale = 1.0;
+  int harmonics = 0;
+  frf::ModalSynthesis synthesis;
+  std::vector<frf::HarmonicBalance> balance;
+};
+
+class Problem {
+public:
+  /// Checks and sets up the comparison. Throws std::invalid_argument as discover() says.
+  /// `substructure` and `tests` are referred to, not copied: they must outlive the problem.
+  Problem(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,
+          const std::vector<identify::Measurement>& tests, const Options& options);
+
+  /// The options of the run (the harmonic balance's harmonics possibly lowered to the band of
+  /// measured FRFs).
+  const Options& options() const { return o_; }
+  const std::vector<identify::Measurement>& tests() const { return tests_; }
+  const Compared& compared() const { return compared_; }
+  /// The joints as given at the start: the layout every model shares.
+  const std::vector<joints::Joint>& layout() const { return layout_; }
+  const fem::DofMap& dofs() const { return dofs_; }
+  /// The substructure's receptance with its own damping.
+  const frf::ModalSynthesis& synthesis() const { return *base_; }
+  /// Test i's force and response equations.
+  const std::vector<int>& force_equations(std::size_t i) const { return force_eq_[i]; }
+  const std::vector<int>& response_equations(std::size_t i) const { return response_eq_[i]; }
+  /// Test i's measured joint deformations: (harmonic-balance harmonics + 1) × joints.
+  const Eigen::MatrixXcd& measured_deformation(std::size_t i) const { return measured_start_[i]; }
+  /// What the set-up had to say (e.g. fewer harmonics in the band of measured FRFs).
+  const std::vector<std::string>& notes() const { return notes_; }
+  std::vector<int> all_tests() const;
+
+  /// The harmonic-balance problems of every test with the damping scaled, at the options'
+  /// harmonics or (`refined`) twice as many, to estimate the truncation error.
+  std::unique_ptr<Simulator> make_simulator(double scale, bool refined) const;
+  /// The same, kept for reuse: never evicted (a run makes a few: the model's damping, and each
+  /// damping scale that was added or cross-validated), so references stay valid. Not for
+  /// concurrent use: the candidates of a step share one made before they run.
+  const Simulator& simulator(double scale, bool refined = false);
+
+  /// Identifies every non-fixed term from the tests `use`, with the damping scaled. Throws
+  /// std::invalid_argument when the tests cannot separate the terms.
+  identify::FitResult identify(const std::vector<joints::Joint>& joints, const Simulator& sim,
+                               const std::vector<int>& use) const;
+  /// Identified coefficients: the non-fixed terms, and the damping scale if not 1.
+  int parameters(const std::vector<joints::Joint>& joints, double scale) const;
+  /// Simulates every test with these joints, and scores the state.
+  State evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim,
+                 const State* warm = nullptr) const;
+  /// The same with test i's joints `per_test[i]` where given (the state holds `joints` and
+  /// counts, for the criterion, one parameter per test for the term that varies).
+  State evaluate_each(const std::vector<joints::Joint>& joints,
+                      const std::vector<std::vector<joints::Joint>>& per_test, const Simulator& sim,
+                      const State* warm = nullptr) const;
+  /// Test i's steady state: from `warm` or the measured deformation first, else from the linear
+  /// response with load continuation.
+  frf::HarmonicBalanceResult solve(const Simulator& sim, int i,
+                                   const std::vector<joints::Joint>& joints,
+                                   const Eigen::MatrixXcd* warm = nullptr) const;
+  /// The gap, χ² and criterion of a simulated state.
+  void score(State& state) const;
+
+  /// What a perfect model would still miss at this state, besides the response's own noise:
+  /// the simulation's error and the measured force's noise propagated through the model, kept
+  /// as every compared value's variances (and in the noise level). The state is scored again
+  /// with them. Returns the simulation error as a gap.
+  double estimate_simulation_error(State& state);
+
+private:
+  int equation(const identify::Measurement& m, const std::string& what, const fem::NodeDof& at);
+  void set_up_equations(const std::vector<joints::Joint>& start);
+  void fit_to_measured_band(double f_max);
+  void set_up_drive_and_start(const std::vector<joints::Joint>& start);
+  /// Every test's steady state by time integration with exact stick–slip (empty where that is
+  /// not possible).
+  std::vector<Eigen::MatrixXcd> time_integrated(const State& state) const;
+  /// Each test's force harmonics perturbed by their noise: E|δX_sim|² into Entry::force.
+  void propagate_force_noise(const State& state, const Simulator& sim);
+
+  const frf::Substructure& sub_;
+  const fem::DofMap& dofs_;
+  const std::vector<identify::Measurement>& tests_;
+  Options o_;
+  int K_ = 1;
+  std::vector<joints::Joint> layout_;
+  std::vector<int> synthesis_dofs_;
+  std::vector<std::vector<int>> force_eq_, response_eq_;
+  double f_max_ = 0.0;
+  std::vector<std::string> notes_;
+  std::unique_ptr<frf::ModalSynthesis> base_;
+  std::vector<std::unique_ptr<Simulator>> simulators_;
+  Compared compared_;
+  std::vector<Eigen::MatrixXcd> measured_start_; // per test: (K_hb+1) × joints
+  std::vector<Eigen::MatrixXcd> drive_;          // per test: the force harmonics that drive it
+};
+
+} // namespace jointid::discover::detail

@@ -1,0 +1,210 @@
+#include "discover/refine.hpp"
+
+#include "discover/selection.hpp"
+#include "identify/statistics.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace jointid::discover::detail {
+
+namespace {
+
+using Complex = std::complex<double>;
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// The Levenberg–Marquardt search of one refinement: the parameters (every non-fixed term), the
+// weighted residual of a state, and the Jacobian by finite differences.
+class OutputError {
+public:
+  OutputError(const Problem& problem, const Simulator& sim, const State& start)
+      : problem_(problem), compared_(problem.compared()), sim_(sim) {
+    for (std::size_t j = 0; j < start.joints.size(); ++j)
+      for (std::size_t t = 0; t < start.joints[j].terms.size(); ++t)
+        if (!start.joints[j].fixed[t]) params_.push_back({j, t});
+    for (const auto& e : compared_.entries)
+      weight_.push_back(compared_.noise_known ? 1.0 / std::sqrt(e.total() / e.dof()) : 1.0);
+  }
+
+  Eigen::Index size() const { return static_cast<Eigen::Index>(params_.size()); }
+
+  // Steps stay among physical models (no negative damping or friction); a start outside them
+  // (an equation-error estimate biased by noise) is first brought back to zero damping there.
+  State begin(const State& start) const {
+    if (physical_problem(start.joints).empty()) return start;
+    std::vector<joints::Joint> clamped = start.joints;
+    clamp_dissipative(clamped);
+    State begin = problem_.evaluate(clamped, sim_, &start);
+    begin.fit = start.fit;
+    return begin;
+  }
+
+  // Minimises the weighted misfit from `begin`; returns the state reached.
+  State search(const State& start, const State& begin) {
+    const Eigen::Index p = size();
+    b_.resize(p), step_.resize(p);
+    joints_ = begin.joints;
+    std::vector<bool> dissipative(p);
+    for (Eigen::Index q = 0; q < p; ++q) {
+      const joints::Term term = joints_[params_[q].joint].terms[params_[q].term];
+      dissipative[q] = joints::term_info(term).nature == joints::Nature::dissipative;
+      b_(q) = joints_[params_[q].joint].values[params_[q].term];
+      // A finite-difference step of the parameter's own scale: its value, or (at 0, e.g. a
+      // damping brought back to 0) its equation-error estimate and standard deviation.
+      double scale = std::max(std::abs(b_(q)),
+                              std::abs(start.joints[params_[q].joint].values[params_[q].term]));
+      for (const auto& je : start.fit.joints)
+        if (je.name == joints_[params_[q].joint].name)
+          for (const auto& te : je.terms)
+            if (te.term == term && std::isfinite(te.std)) scale = std::max(scale, te.std);
+      step_(q) = 1e-5 * std::max(scale, 1e-12);
+    }
+    current_ = begin;
+    r_ = residual(current_);
+    cost_ = r_.squaredNorm();
+    double mu = 1e-3;
+    J_.resize(r_.size(), p);
+    for (int iteration = 0; iteration < 12; ++iteration) {
+      J_.setConstant(nan);
+      if (!jacobian()) break; // keep what was reached
+      const Eigen::MatrixXd A = J_.transpose() * J_;
+      const Eigen::VectorXd g = J_.transpose() * r_;
+      bool accepted = false;
+      double gain = 0.0;
+      for (int tries = 0; tries < 10 && !accepted; ++tries, mu *= 10.0) {
+        Eigen::MatrixXd M = A;
+        M.diagonal() += mu * A.diagonal() + Eigen::VectorXd::Constant(p, 1e-300);
+        Eigen::VectorXd nb = b_ - M.ldlt().solve(g);
+        for (Eigen::Index q = 0; q < p; ++q) // projected onto non-negative damping and friction
+          if (dissipative[q]) nb(q) = std::max(nb(q), 0.0);
+        const std::vector<joints::Joint> nj = joints_with(nb);
+        if (!nb.allFinite() || !physical_problem(nj).empty()) continue;
+        State sn = problem_.evaluate(nj, sim_, &current_);
+        if (!sn.converged) continue;
+        const Eigen::VectorXd rn = residual(sn);
+        if (rn.squaredNorm() < cost_) {
+          gain = (cost_ - rn.squaredNorm()) / cost_;
+          b_ = nb, current_ = std::move(sn), r_ = rn, cost_ = r_.squaredNorm();
+          mu = std::max(mu / 100.0, 1e-9); // (×10 on leaving the loop)
+          accepted = true;
+        }
+      }
+      if (!accepted || gain < 1e-5) break; // a 0.001 % smaller misfit is no longer worth a step
+    }
+    return current_;
+  }
+
+  // The fit of the values reached: intervals from the Jacobian there, or NaN (undetermined)
+  // when it cannot be formed or there is no redundancy.
+  identify::FitResult fit(const identify::FitResult& begin_fit) {
+    const Eigen::Index p = size();
+    const int values = compared_.values;
+    J_.setConstant(nan);
+    const int dof = values - static_cast<int>(p);
+    const bool determined = jacobian() && dof > 0;
+    Eigen::MatrixXd C = Eigen::MatrixXd::Constant(p, p, nan);
+    double tq = nan;
+    if (determined) {
+      double s2 = cost_ / dof;
+      if (compared_.noise_known) s2 = std::max(s2, 1.0);
+      C = s2 * (J_.transpose() * J_).completeOrthogonalDecomposition().pseudoInverse();
+      tq = identify::student_t_quantile(0.975, dof);
+    }
+    identify::FitResult fit = begin_fit;
+    std::size_t q = 0;
+    fit.joints.clear();
+    for (const auto& joint : current_.joints) {
+      identify::JointEstimate je{joint.name, {}};
+      for (std::size_t t = 0; t < joint.terms.size(); ++t) {
+        identify::TermEstimate te;
+        te.term = joint.terms[t];
+        te.value = joint.values[t];
+        te.fixed = joint.fixed[t];
+        if (!te.fixed) {
+          const auto qi = static_cast<Eigen::Index>(q++);
+          te.std = std::isfinite(C(qi, qi)) ? std::sqrt(std::max(C(qi, qi), 0.0)) : nan;
+        }
+        te.ci_low = te.value - tq * te.std;
+        te.ci_high = te.value + tq * te.std;
+        if (te.fixed) te.ci_low = te.ci_high = te.value;
+        je.terms.push_back(te);
+      }
+      fit.joints.push_back(std::move(je));
+    }
+    fit.equations = values;
+    fit.unknowns = static_cast<int>(p);
+    fit.residual_relative = current_.gap;
+    return fit;
+  }
+
+private:
+  struct Param {
+    std::size_t joint, term;
+  };
+
+  Eigen::VectorXd residual(const State& st) const {
+    Eigen::VectorXd r(compared_.values);
+    Eigen::Index n = 0;
+    for (std::size_t i = 0; i < compared_.entries.size(); ++i) {
+      const auto& e = compared_.entries[i];
+      const Complex err = e.measured - st.X[e.test](e.harmonic, e.response);
+      r(n++) = weight_[i] * err.real();
+      if (e.harmonic != 0) r(n++) = weight_[i] * err.imag();
+    }
+    return r;
+  }
+
+  std::vector<joints::Joint> joints_with(const Eigen::VectorXd& b) const {
+    std::vector<joints::Joint> j = joints_;
+    for (Eigen::Index q = 0; q < size(); ++q)
+      j[params_[q].joint].values[params_[q].term] = b(q);
+    return j;
+  }
+
+  // The Jacobian at the current values, by a forward difference (backward where forward leaves
+  // the physical models or does not converge); false where a column cannot be formed.
+  bool jacobian() {
+    for (Eigen::Index q = 0; q < size(); ++q) {
+      for (double h : {step_(q), -step_(q)}) {
+        Eigen::VectorXd bq = b_;
+        bq(q) += h;
+        const std::vector<joints::Joint> jq = joints_with(bq);
+        if (!physical_problem(jq).empty()) continue;
+        const State sq = problem_.evaluate(jq, sim_, &current_);
+        if (!sq.converged) continue;
+        J_.col(q) = (residual(sq) - r_) / h;
+        break;
+      }
+      if (!J_.col(q).allFinite()) return false;
+    }
+    return true;
+  }
+
+  const Problem& problem_;
+  const Compared& compared_;
+  const Simulator& sim_;
+  std::vector<Param> params_;
+  std::vector<double> weight_;
+  std::vector<joints::Joint> joints_; // the layout and fixed values the parameters go into
+  Eigen::VectorXd b_, step_, r_;
+  Eigen::MatrixXd J_;
+  State current_;
+  double cost_ = 0.0;
+};
+
+} // namespace
+
+State refine(const Problem& problem, const State& start, const Simulator& sim) {
+  OutputError search(problem, sim, start);
+  if (search.size() == 0) return start;
+  const State begin = search.begin(start);
+  if (!begin.converged || !physical_problem(begin.joints).empty()) return start;
+  State refined = search.search(start, begin);
+  refined.fit = search.fit(begin.fit);
+  return refined;
+}
+
+} // namespace jointid::discover::detail

@@ -1,0 +1,93 @@
+#include "discover/result.hpp"
+
+#include "discover/text.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace jointid::discover {
+
+std::string Candidate::name() const {
+  if (refit) return "refit of the starting values";
+  if (!term) return "substructure damping";
+  if (varies) return fmt::format("{} at '{}', a value per test", joints::term_name(*term), joint);
+  return fmt::format("{} at '{}'", joints::term_name(*term), joint);
+}
+
+std::string Candidate::effect() const {
+  if (refit) return "linear terms identified again";
+  if (!term) return "substructure damping";
+  if (varies)
+    return fmt::format("{} that changes between tests (no term of the library)",
+                       joints::term_effect(*term));
+  return std::string(joints::term_effect(*term));
+}
+
+bool Candidate::linear() const {
+  return !varies && (refit || !term || joints::is_linear(*term));
+}
+
+namespace detail {
+
+std::vector<Comparison> comparisons(const std::vector<identify::Measurement>& tests, int K,
+                                    const State& s) {
+  std::vector<Comparison> out;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    const auto& m = tests[i];
+    for (std::size_t j = 0; j < m.response_at.size(); ++j) {
+      const auto jj = static_cast<Eigen::Index>(j);
+      Comparison c;
+      c.test = m.source;
+      c.channel = channel_name(m, j);
+      c.frequency_hz = m.frequency_hz;
+      c.force = identify::force_level(m);
+      c.measured = m.X(1, jj);
+      c.simulated = s.X[i](1, jj);
+      c.amplitude_error = std::abs(c.simulated) / std::max(std::abs(c.measured), 1e-300) - 1.0;
+      c.phase_error_deg = std::arg(c.simulated / c.measured) * 180.0 / std::numbers::pi;
+      double hm = 0.0, hs = 0.0;
+      if (!m.fundamental_only)
+        for (int k = 2; k <= K; ++k)
+          hm += std::norm(m.X(k, jj)), hs += std::norm(s.X[i](k, jj));
+      c.harmonics_measured = std::sqrt(hm) / std::max(std::abs(c.measured), 1e-300);
+      c.harmonics_simulated = std::sqrt(hs) / std::max(std::abs(c.measured), 1e-300);
+      out.push_back(c);
+    }
+  }
+  return out;
+}
+
+std::string finding(const Step& s) {
+  return fmt::format(
+      "Added {} ({}) = {} [{}, {}]: the gap fell from {} to {} ({} of it explained).",
+      s.added.name(), s.added.effect(), number(s.added.value), number(s.added.ci_low),
+      number(s.added.ci_high), number(s.gap_before), number(s.gap_after), pct(s.added.explained));
+}
+
+std::string summary(const Result& r, const Compared& compared) {
+  std::string added;
+  for (const auto& s : r.steps)
+    added += (added.empty() ? "" : ", ") + s.added.name();
+  const double first = r.gap.front(), last = r.gap.back();
+  std::string floor;
+  if (!compared.noise_known)
+    floor = "; the noise level is unknown (stepped-sine tables)";
+  else
+    floor = fmt::format(
+        "; the noise level is {}{}, {}", number(compared.noise_gap),
+        r.simulation_gap > 0.1 * compared.noise_gap
+            ? fmt::format(" and the simulation's own error {}", number(r.simulation_gap))
+            : std::string(),
+        r.at_noise_level ? "which it has reached"
+                         : fmt::format("not reached (χ² per value {:.3g})", r.chi2_per_value));
+  if (added.empty())
+    return fmt::format("Nothing was added: the gap stays at {}{}.", number(last), floor);
+  return fmt::format("Added {}: the gap shrank from {} to {} ({}× smaller){}.", added,
+                     number(first), number(last), number(first / std::max(last, 1e-300)), floor);
+}
+
+} // namespace detail
+} // namespace jointid::discover

@@ -1,0 +1,320 @@
+#include "discover/selection.hpp"
+
+#include "discover/problem.hpp"
+#include "discover/text.hpp"
+#include "fem/parallel.hpp"
+
+#include <Eigen/Core>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+namespace jointid::discover::detail {
+
+namespace {
+constexpr double inf = std::numeric_limits<double>::infinity();
+} // namespace
+
+double information_criterion(const Compared& compared, const Misfit& misfit, int parameters,
+                             bool converged) {
+  const double N = compared.values, penalty = parameters * std::log(N);
+  return !converged ? inf
+         : compared.noise_known
+             ? misfit.chi2 + penalty
+             : N * std::log(std::max(misfit.squared, 1e-300 * compared.measured2) / N) + penalty;
+}
+
+void score(State& state, const Compared& compared) {
+  const Misfit m = misfit(compared, state.X);
+  state.gap = gap(compared, m.squared);
+  state.chi2 = m.chi2;
+  state.criterion = information_criterion(compared, m, state.parameters, state.converged);
+}
+
+std::string physical_problem(const std::vector<joints::Joint>& joints) {
+  for (const auto& j : joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t)
+      if (joints::term_info(j.terms[t]).nature == joints::Nature::dissipative && j.values[t] < 0.0)
+        return fmt::format("not physical: {} of '{}' came out negative ({}), a joint that "
+                           "gives energy",
+                           joints::term_name(j.terms[t]), j.name, number(j.values[t]));
+  return {};
+}
+
+std::string friction_problem(const std::vector<joints::Joint>& joints) {
+  for (const auto& j : joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t)
+      if (joints::is_dry_friction(j.terms[t]) && j.values[t] < 0.0)
+        return fmt::format("not physical: fc of '{}' came out negative ({})", j.name,
+                           number(j.values[t]));
+  return {};
+}
+
+void clamp_dissipative(std::vector<joints::Joint>& joints) {
+  for (auto& j : joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t)
+      if (joints::term_info(j.terms[t]).nature == joints::Nature::dissipative && !j.fixed[t])
+        j.values[t] = std::max(j.values[t], 0.0);
+}
+
+void fill(Candidate& candidate, const State& state) {
+  candidate.gap = state.gap;
+  candidate.criterion = state.criterion;
+  candidate.converged = state.converged;
+  if (!state.converged) candidate.rejected = "a re-simulation did not converge";
+}
+
+void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::string& joint,
+              joints::Term term) {
+  for (const auto& je : fit.joints)
+    if (je.name == joint)
+      for (const auto& te : je.terms)
+        if (te.term == term) {
+          candidate.value = te.value;
+          candidate.std = te.std;
+          candidate.ci_low = te.ci_low;
+          candidate.ci_high = te.ci_high;
+        }
+}
+
+void judge(Candidate& candidate, const State& state) {
+  candidate.rejected.clear();
+  if (candidate.term) take_fit(candidate, state.fit, candidate.joint, *candidate.term);
+  fill(candidate, state);
+  if (candidate.rejected.empty()) candidate.rejected = physical_problem(state.joints);
+  if (candidate.rejected.empty() && !candidate.refit)
+    candidate.rejected = interval_problem(candidate);
+}
+
+std::string interval_problem(const Candidate& candidate) {
+  const double none = candidate.term ? 0.0 : 1.0;
+  if (!std::isfinite(candidate.ci_low) || !std::isfinite(candidate.ci_high))
+    return "not determined: its 95 % interval could not be estimated";
+  if (candidate.ci_low > none || candidate.ci_high < none) return {};
+  return fmt::format("not significant: its 95 % interval [{}, {}] holds {}",
+                     number(candidate.ci_low), number(candidate.ci_high), none);
+}
+
+std::string criterion_problem(const Candidate& candidate, double criterion_now) {
+  if (candidate.criterion < criterion_now) return {};
+  return fmt::format("not significant (information criterion {} vs {} now)",
+                     number(candidate.criterion), number(criterion_now));
+}
+
+double explained(double gap, double gap_now) {
+  return 1.0 - std::pow(gap / gap_now, 2);
+}
+
+std::string explained_problem(const Candidate& candidate, double min_explained) {
+  if (!(candidate.explained < min_explained)) return {};
+  return fmt::format("explains too little: {} of the gap (at least {} needed)",
+                     pct(candidate.explained), pct(min_explained));
+}
+
+std::string cross_validation_problem(double cv_gap, double cv_now) {
+  if (!(cv_now >= 0.0 && cv_gap >= 0.0 && !(cv_gap < cv_now))) return {};
+  return fmt::format("does not predict held-out tests better (cross-validated gap {} vs {} now)",
+                     number(cv_gap), number(cv_now));
+}
+
+std::vector<std::size_t> screen(std::vector<Candidate>& ranking, const State& now,
+                                double min_explained) {
+  std::vector<std::size_t> order(ranking.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = i;
+    Candidate& c = ranking[i];
+    c.explained = explained(c.gap, now.gap);
+    if (c.rejected.empty()) c.rejected = criterion_problem(c, now.criterion);
+    if (c.rejected.empty()) c.rejected = explained_problem(c, min_explained);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return ranking[a].criterion < ranking[b].criterion;
+  });
+  return order;
+}
+
+Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& order,
+              const std::function<double()>& cv_now,
+              const std::function<double(std::size_t)>& cv_of) {
+  Choice choice;
+  for (std::size_t i : order) {
+    Candidate& c = ranking[i];
+    if (!c.rejected.empty()) continue;
+    if (c.varies) {
+      choice.outside = i;
+      break;
+    }
+    if (!choice.cv_now) choice.cv_now = cv_now();
+    c.cv_gap = cv_of(i);
+    c.rejected = cross_validation_problem(c.cv_gap, *choice.cv_now);
+    if (!c.rejected.empty()) continue;
+    choice.chosen = i;
+    break;
+  }
+  return choice;
+}
+
+std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int count) {
+  std::vector<std::size_t> by(ranking.size());
+  std::iota(by.begin(), by.end(), std::size_t{0});
+  std::stable_sort(by.begin(), by.end(), [&](std::size_t a, std::size_t b) {
+    return ranking[a].criterion < ranking[b].criterion;
+  });
+  std::vector<std::size_t> out;
+  for (std::size_t i : by)
+    if (std::isfinite(ranking[i].criterion) && ranking[i].converged && !ranking[i].varies &&
+        out.size() < static_cast<std::size_t>(count))
+      out.push_back(i);
+  return out;
+}
+
+std::vector<std::vector<int>> held_out(int tests, int folds) {
+  if (tests < 4) return {};
+  const int k = tests <= 30 ? tests : folds;
+  std::vector<std::vector<int>> held(k);
+  for (int i = 0; i < tests; ++i)
+    held[i % k].push_back(i);
+  return held;
+}
+
+double cross_validated(Problem& problem, const std::vector<joints::Joint>& joints, double scale) {
+  const int n = static_cast<int>(problem.tests().size());
+  const std::vector<std::vector<int>> folds = held_out(n, problem.options().folds);
+  if (folds.empty()) return -1.0;
+  const Simulator& sim = problem.simulator(scale);
+  const Compared& compared = problem.compared();
+  // One job per fold: the squared error of its held-out tests; -1 when it cannot be fitted.
+  std::vector<std::function<double()>> jobs;
+  for (std::size_t f = 0; f < folds.size(); ++f)
+    jobs.push_back([&, f]() -> double {
+      const std::vector<int>& held = folds[f];
+      std::vector<int> train;
+      for (int i = 0; i < n; ++i)
+        if (std::find(held.begin(), held.end(), i) == held.end()) train.push_back(i);
+      std::vector<joints::Joint> fitted;
+      try {
+        fitted = problem.identify(joints, sim, train).identified(joints);
+      } catch (const std::invalid_argument&) {
+        return -1.0;
+      }
+      // A fold's estimate may come out with negative damping or friction (fewer tests, more
+      // noise): brought back to 0, as the output-error refinement does.
+      clamp_dissipative(fitted);
+      double S = 0.0;
+      for (int i : held) {
+        const frf::HarmonicBalanceResult r = problem.solve(sim, i, fitted);
+        for (const auto& e : compared.entries) // a failed prediction counts as predicting nothing
+          if (e.test == i)
+            S += r.converged ? std::norm(e.measured - r.X(e.harmonic, e.response))
+                             : std::norm(e.measured);
+      }
+      return S;
+    });
+  double S = 0.0;
+  for (double part : fem::parallel_map(jobs)) {
+    if (part < 0.0) return -1.0;
+    S += part;
+  }
+  return std::sqrt(S / compared.measured2);
+}
+
+void summarise(Variation& variation, Candidate& candidate, const joints::Joint& joint) {
+  Variation& v = variation;
+  double sw = 0.0, swv = 0.0;
+  for (std::size_t i = 0; i < v.value.size(); ++i)
+    sw += 1.0 / (v.std[i] * v.std[i]), swv += v.value[i] / (v.std[i] * v.std[i]);
+  candidate.value = swv / sw;
+  candidate.std = std::sqrt(1.0 / sw);
+  candidate.ci_low = candidate.value - 1.96 * candidate.std;
+  candidate.ci_high = candidate.value + 1.96 * candidate.std;
+  v.chi2 = 0.0;
+  for (std::size_t i = 0; i < v.value.size(); ++i)
+    v.chi2 += std::pow((v.value[i] - candidate.value) / v.std[i], 2);
+  v.dof = static_cast<int>(v.value.size()) - 1;
+  v.amplitude_correlation = rank_correlation(v.value, v.amplitude);
+  v.frequency_correlation = rank_correlation(v.value, v.frequency_hz);
+  v.description = describe(v, candidate, joint);
+}
+
+std::string agreement_problem(const Variation& variation) {
+  const Variation& v = variation;
+  if (v.chi2 > v.dof + 3.0 * std::sqrt(2.0 * v.dof)) return {};
+  return fmt::format("its values agree between the tests (χ² {} for {} degrees of freedom)",
+                     number(v.chi2), v.dof);
+}
+
+void judge_variation(Candidate& candidate, Variation variation, const State& state,
+                     const joints::Joint& joint) {
+  summarise(variation, candidate, joint);
+  fill(candidate, state);
+  if (candidate.rejected.empty()) candidate.rejected = agreement_problem(variation);
+  candidate.varies = std::move(variation);
+}
+
+double rank_correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  auto ranks = [](const std::vector<double>& x) {
+    std::vector<std::size_t> order(x.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t p, std::size_t q) { return x[p] < x[q]; });
+    Eigen::VectorXd r(static_cast<Eigen::Index>(x.size()));
+    for (std::size_t i = 0; i < order.size();) {
+      std::size_t j = i;
+      while (j + 1 < order.size() && x[order[j + 1]] == x[order[i]])
+        ++j;
+      for (std::size_t q = i; q <= j; ++q)
+        r(static_cast<Eigen::Index>(order[q])) = 0.5 * static_cast<double>(i + j);
+      i = j + 1;
+    }
+    return r;
+  };
+  const Eigen::VectorXd ra = ranks(a), rb = ranks(b);
+  const Eigen::VectorXd da = ra.array() - ra.mean(), db = rb.array() - rb.mean();
+  const double d = da.norm() * db.norm();
+  return d > 0.0 ? da.dot(db) / d : 0.0;
+}
+
+// "fc at 'spring' is not one number: identified from each test alone it goes from 0.5963 N at
+// the smallest deformation amplitude (0.98 mm) to 0.3412 N at the largest (2.94 mm), …"
+std::string describe(const Variation& v, const Candidate& c, const joints::Joint& j) {
+  const bool by_amplitude = std::abs(v.amplitude_correlation) >= std::abs(v.frequency_correlation);
+  const std::vector<double>& x = by_amplitude ? v.amplitude : v.frequency_hz;
+  const auto lo = std::min_element(x.begin(), x.end()) - x.begin();
+  const auto hi = std::max_element(x.begin(), x.end()) - x.begin();
+  const bool rotational = fem::is_rotation(j.dof);
+  const joints::TermInfo& info = joints::term_info(*c.term);
+  const std::string unit(rotational ? info.rotational_unit : info.unit);
+  auto where = [&](std::ptrdiff_t i) {
+    return by_amplitude ? fmt::format("{} {}", number(v.amplitude[i]), rotational ? "rad" : "m")
+                        : fmt::format("{} Hz", number(v.frequency_hz[i]));
+  };
+  const double rho = by_amplitude ? v.amplitude_correlation : v.frequency_correlation;
+  std::string law;
+  if (std::abs(rho) >= 0.7)
+    law = fmt::format(
+        "; it {} with the {} (rank correlation {:+.2f}): the joint needs a {} whose coefficient "
+        "depends on the {}{}",
+        rho < 0 ? "falls" : "grows", by_amplitude ? "deformation amplitude" : "frequency", rho,
+        joints::term_effect(*c.term), by_amplitude ? "amplitude" : "frequency",
+        *c.term == joints::Term::fc && by_amplitude
+            ? " (e.g. a contact whose normal load changes as the vibration grows)"
+            : "");
+  else
+    law = fmt::format("; it follows neither the amplitude (rank correlation {:+.2f}) nor the "
+                      "frequency ({:+.2f})",
+                      v.amplitude_correlation, v.frequency_correlation);
+  return fmt::format(
+      "{} at '{}' is not one number: identified from each test alone it goes from {} {} at the "
+      "{} {} ({}) to {} {} at the {} ({}), beyond the noise (χ² {} for {} degrees of freedom)"
+      "{}. No term of the library has such a coefficient.",
+      joints::term_name(*c.term), j.name, number(v.value[lo]), unit, "smallest",
+      by_amplitude ? "amplitude" : "frequency", where(lo), number(v.value[hi]), unit, "largest",
+      where(hi), number(v.chi2), v.dof, law);
+}
+
+} // namespace jointid::discover::detail

@@ -1,0 +1,114 @@
+#pragma once
+/// Which candidate is added (discover.hpp states the rules): the information criterion, the five
+/// admissibility rules — each a function that gives the reason a candidate fails it, empty when
+/// it passes —, the choice among the admissible, cross-validation, and the test that a
+/// coefficient identified per test varies between the tests.
+#include "discover/discover.hpp"
+#include "discover/gap.hpp"
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace jointid::discover::detail {
+
+class Problem;
+
+// The information criterion.
+
+/// The Bayesian information criterion of a model with `parameters` identified coefficients:
+/// χ² + p ln N with known noise, else N ln(S/N) + p ln N (S the squared misfit, N the real
+/// values compared); +∞ for a model whose re-simulations did not all converge.
+double information_criterion(const Compared& compared, const Misfit& misfit, int parameters,
+                             bool converged);
+/// A simulated state's gap, χ² (NaN when the noise is unknown) and information criterion.
+void score(State& state, const Compared& compared);
+
+// Rule 1: every re-simulation converged and the values are physical.
+
+/// Negative damping or friction: "not physical: c of 'tip' came out negative (…), …".
+std::string physical_problem(const std::vector<joints::Joint>& joints);
+/// A negative friction limit, which has no steady state to simulate.
+std::string friction_problem(const std::vector<joints::Joint>& joints);
+/// Negative damping and friction among the identified terms brought back to 0.
+void clamp_dissipative(std::vector<joints::Joint>& joints);
+/// The candidate's gap, criterion and convergence from its state; a state that did not
+/// converge rejects it ("a re-simulation did not converge").
+void fill(Candidate& candidate, const State& state);
+/// The value and interval of `joint`'s `term` in a fit.
+void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::string& joint,
+              joints::Term term);
+/// Rules 1 and 2 for a candidate and the state it gives (its value taken from the state's fit).
+void judge(Candidate& candidate, const State& state);
+
+// Rule 2: the 95 % interval is known and excludes 0 (a term) or 1 (the damping scale).
+std::string interval_problem(const Candidate& candidate);
+
+// Rule 3: the information criterion falls.
+std::string criterion_problem(const Candidate& candidate, double criterion_now);
+
+// Rule 4: the candidate explains at least `min_explained` of the squared gap.
+/// The share of the squared gap that a state with `gap` removes from one with `gap_now`.
+double explained(double gap, double gap_now);
+std::string explained_problem(const Candidate& candidate, double min_explained);
+
+// Rule 5: the cross-validated gap falls (both known: < 0 is "could not be computed").
+std::string cross_validation_problem(double cv_gap, double cv_now);
+
+/// Sets every candidate's share explained and applies rules 3 and 4 to those not yet rejected.
+/// Returns the candidates' indices by criterion, lowest first (a stable order).
+std::vector<std::size_t> screen(std::vector<Candidate>& ranking, const State& now,
+                                double min_explained);
+
+struct Choice {
+  std::optional<std::size_t> chosen;  ///< the addition
+  std::optional<std::size_t> outside; ///< the best admissible is a coefficient varying per test
+  std::optional<double> cv_now;       ///< the current model's cross-validated gap, if computed
+};
+/// Walks `order` (from screen) to the first candidate not rejected: a coefficient that varies
+/// per test is `outside`; an addition must also pass rule 5, else it is rejected with the reason
+/// and the walk goes on. The cross-validated gaps are computed as needed: the current model's
+/// once, and each candidate's walked to (stored in its cv_gap).
+Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& order,
+              const std::function<double()>& cv_now,
+              const std::function<double(std::size_t)>& cv_of);
+
+/// The candidates refined by output error: the best `count` by the criterion among those with a
+/// finite criterion, converged, and not varying per test.
+std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int count);
+
+// Cross-validation.
+
+/// The held-out tests of each fold: every test alone up to 30 tests, else `folds` folds (test i
+/// in fold i mod folds). Empty below 4 tests (too few to leave any out).
+std::vector<std::vector<int>> held_out(int tests, int folds);
+/// The gap of the folds' predictions: each fold's tests predicted by the model identified from
+/// the others (negative damping or friction brought back to 0; a failed prediction counts as
+/// predicting nothing). < 0 when it cannot be computed (fewer than 4 tests, or a fold that
+/// cannot be identified).
+double cross_validated(Problem& problem, const std::vector<joints::Joint>& joints, double scale);
+
+// A coefficient identified per test.
+
+/// From the per-test values and standard deviations of `variation`: the candidate's value (their
+/// weighted mean), its standard deviation and 95 % interval, the values' χ² about the mean and
+/// its degrees of freedom, their rank correlations with the amplitude and the frequency, and the
+/// description.
+void summarise(Variation& variation, Candidate& candidate, const joints::Joint& joint);
+/// Its values must disagree: χ² about their weighted mean more than 3 standard deviations
+/// (√(2 dof)) above its degrees of freedom, else "its values agree between the tests (…)".
+std::string agreement_problem(const Variation& variation);
+/// A per-test candidate's verdict: `variation` summarised into the candidate (summarise), its
+/// gap and criterion from the state that simulates each test at its own value (rule 1), and its
+/// values must disagree (agreement_problem); the candidate then holds the variation.
+void judge_variation(Candidate& candidate, Variation variation, const State& state,
+                     const joints::Joint& joint);
+/// Spearman's rank correlation (ties get their mean rank); 0 when either side is constant.
+double rank_correlation(const std::vector<double>& a, const std::vector<double>& b);
+/// What a variation says, in one sentence: "fc at 'spring' is not one number: …".
+std::string describe(const Variation& variation, const Candidate& candidate,
+                     const joints::Joint& joint);
+
+} // namespace jointid::discover::detail

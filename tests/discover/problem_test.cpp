@@ -1,0 +1,95 @@
+// The problem discovery works on, on a substructure whose response is known in closed form: the
+// re-simulation of every test against the exact receptance, its gap and criterion, and the
+// set-up's refusals.
+#include "discover/problem.hpp"
+
+#include "one_mode.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace jointid {
+namespace {
+
+using namespace discover::detail;
+
+TEST(Problem, ReSimulatesEveryTestAsTheClosedForm) {
+  const test::OneMode m;
+  const frf::Substructure sub = m.substructure();
+  const auto tests = m.tests({2.5, 3.0, 3.5, 4.0}, 10.0);
+  Problem problem(sub, {m.joint(0.0, 0.0)}, tests, test::fundamental_only());
+  EXPECT_EQ(problem.compared().values, 8);
+  EXPECT_TRUE(problem.compared().noise_known);
+  // The true joint: every fundamental as the closed form, the gap at rounding.
+  const discover::State truth = problem.evaluate({m.joint(m.k, m.c)}, problem.simulator(1.0));
+  ASSERT_TRUE(truth.converged);
+  EXPECT_EQ(truth.parameters, 2);
+  for (std::size_t i = 0; i < tests.size(); ++i)
+    EXPECT_LT(std::abs(truth.X[i](1, 0) - tests[i].X(1, 0)), 1e-9 * std::abs(tests[i].X(1, 0)))
+        << tests[i].source;
+  EXPECT_LT(truth.gap, 1e-9);
+  // Another stiffness: its gap is the closed form's relative difference.
+  const discover::State stiffer = problem.evaluate({m.joint(500.0, m.c)}, problem.simulator(1.0));
+  double S = 0.0, S0 = 0.0;
+  for (const auto& t : tests) {
+    const std::complex<double> X = m.receptance(t.frequency_hz, 500.0, m.c) * t.F(1, 0);
+    S += std::norm(t.X(1, 0) - X), S0 += std::norm(t.X(1, 0));
+  }
+  EXPECT_NEAR(stiffer.gap, std::sqrt(S / S0), 1e-9 * std::sqrt(S / S0));
+  // χ² weighs each squared difference by its variance over its 2 real values.
+  EXPECT_NEAR(stiffer.chi2, 2.0 * S / 1e-16, 1e-8 * 2.0 * S / 1e-16);
+  // Held terms are not parameters; a damping scale is one.
+  EXPECT_EQ(problem.parameters({m.joint(m.k, m.c, true)}, 1.0), 0);
+  EXPECT_EQ(problem.parameters({m.joint(m.k, m.c)}, 1.5), 3);
+}
+
+TEST(Problem, ADampingScaleScalesTheSubstructuresDamping) {
+  // The substructure's damping doubled is the closed form with ζ doubled.
+  test::OneMode m;
+  const frf::Substructure sub = m.substructure();
+  const auto tests = m.tests({2.5, 3.0, 3.5}, 10.0);
+  Problem problem(sub, {m.joint(0.0, 0.0)}, tests, test::fundamental_only());
+  const auto sim = problem.make_simulator(2.0, false);
+  const discover::State s = problem.evaluate({m.joint(m.k, m.c)}, *sim);
+  EXPECT_EQ(s.damping_scale, 2.0);
+  m.zeta *= 2.0;
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    const std::complex<double> X = m.receptance(tests[i].frequency_hz, m.k, m.c) * tests[i].F(1, 0);
+    EXPECT_LT(std::abs(s.X[i](1, 0) - X), 1e-9 * std::abs(X));
+  }
+}
+
+TEST(Problem, RefusesWhatCannotBeCompared) {
+  const test::OneMode m;
+  const frf::Substructure sub = m.substructure();
+  const auto tests = m.tests({3.0}, 10.0);
+  auto refused = [&](const std::vector<identify::Measurement>& t,
+                     const std::vector<joints::Joint>& start, const discover::Options& o) {
+    try {
+      Problem problem(sub, start, t, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const discover::Options o = test::fundamental_only();
+  EXPECT_EQ(refused({}, {m.joint(0.0, 0.0)}, o), "discover: no tests");
+  EXPECT_EQ(refused(tests, {}, o), "discover: the model has no joints");
+  discover::Options few = o;
+  few.harmonics = {1, 2, 3, 4};
+  EXPECT_EQ(refused(tests, {m.joint(0.0, 0.0)}, few),
+            "discover: the harmonic balance needs at least as many harmonics as are compared");
+  few.balance.harmonics = 15;
+  EXPECT_NE(refused(tests, {m.joint(0.0, 0.0)}, few)
+                .find("measured to harmonic 1, but 4 are "
+                      "compared"),
+            std::string::npos);
+  auto silent = tests;
+  silent[0].X.setZero();
+  EXPECT_EQ(refused(silent, {m.joint(0.0, 0.0)}, o), "discover: every response is zero");
+}
+
+} // namespace
+} // namespace jointid
