@@ -174,13 +174,13 @@ void write_uff58(const std::filesystem::path& path, const std::vector<Uff58Funct
 ///    rx ry rz); a negative direction flips the sign of the samples. Reference node and
 ///    direction are not used.
 ///  - Units, converted to SI: the axis units label (record 9 field 6) when given: length m, mm,
-///    cm, um (µm); velocity m/s, mm/s, cm/s, um/s, in/s; acceleration m/s^2 (also m/s2, m/s²,
-///    m/s**2), mm/s^2, cm/s^2, in/s^2, g (9.80665 m/s²); force N, kN, mN, lbf; rotations rad,
-///    mrad, deg (and /s, /s^2); moments N m (N*m, N.m, Nm, N·m), kN m, N mm; without a label
+///    cm, um (µm), in; velocity m/s, mm/s, cm/s, um/s, in/s; acceleration m/s^2 (also m/s2, m/s²,
+///    m/s**2), mm/s^2, cm/s^2, in/s^2, g or G (9.80665 m/s²); force N, kN, mN, lbf; rotations rad,
+///    mrad, deg (and /s, /s^2); moments N m (N*m, N.m, Nm, N·m), kN m, N mm, mN m; without a label
 ///    ("NONE" or blank) the dataset 164 in force (factors of length and force, with the
 ///    exponents of the standard's Addendum A for the quantity), or SI without one. Time (record
 ///    8 label): s, ms, or none ("Time", which some writers put there, reads as s). A label not in
-///    this list is refused, naming it.
+///    this list is refused, naming it. io/uff_units.hpp holds these labels and factors.
 ///  - Unit exponents (record 9 fields 2–4) must be 0 0 0 (not given) or those of Addendum A for
 ///    the quantity (translational motion 1 0 0, force 0 1 0, rotation 0 0 0, moment 1 1 0).
 ///  - `excitation_hz = <Hz>` in any ID line gives Record::excitation_hz (the functions of one
