@@ -265,6 +265,7 @@ PAPER_OWN_WORST = {"I": ("0.32 %", "c, case II"), "II": ("3.2 %", "c, case III")
 
 
 def run_paper(r: Runner, out: dict):
+    r.path("out").mkdir(exist_ok=True)  # as scripts/run_paper_study.sh does
     out["paper_text"] = r.run("paper", PAPER_ARGV)
     out["paper"] = load_json(r.path("out/paper_study.json"))
 
@@ -437,11 +438,14 @@ def render_record_head(out) -> str:
 
 
 def excerpt(value, items: int = 2):
-    """A JSON value with lists cut to their first items ("..." marks the cut) and numbers to
-    6 significant digits."""
+    """A JSON value with lists cut to their first items ("..." marks the cut; lists of up to three
+    numbers, such as intervals and complex amplitudes, are kept) and numbers to 6 significant
+    digits."""
     if isinstance(value, dict):
         return {k: excerpt(v, items) for k, v in value.items()}
     if isinstance(value, list):
+        if len(value) <= 3 and not any(isinstance(v, (dict, list)) for v in value):
+            return [excerpt(v, items) for v in value]  # an interval, a complex number
         cut = [excerpt(v, items) for v in value[:items]]
         return cut + ["..."] if len(value) > items else cut
     if isinstance(value, float):
@@ -488,7 +492,7 @@ def render_json_compare(out) -> str:
 
 
 def render_json_discover(out) -> str:
-    return json_block(out["discovery"], 2)
+    return json_block(out["discovery"], 1)
 
 
 def render_response_example(out) -> str:
@@ -606,7 +610,7 @@ def render_three_joints(out) -> str:
                   for u in design["unknowns"] if (u["joint"], u["term"]) in scatter]
         if ratios:
             text += ("\n\nThe standard deviations `jointid design` predicted before any test was "
-                     f"simulated are {g(min(ratios), 3)}–{g(max(ratios), 3)} times the Monte "
+                     f"simulated are {min(ratios):.2f}–{max(ratios):.2f} times the Monte "
                      "Carlo scatter above.")
     return text
 
