@@ -74,6 +74,7 @@ class Runner:
         (self.work / "build").symlink_to(build)
         self.env = dict(os.environ)
         self.env["PATH"] = f"{self.work / 'build' / 'cli'}:{self.env.get('PATH', '')}"
+        self.env["LC_ALL"] = "C"  # the shell's globs (out/tests/*.csv) in one order everywhere
         self.times = {}  # group -> [wall s, cpu s]
         self.vtk = "JOINTID_WITH_VTK:BOOL=OFF" not in read(build / "CMakeCache.txt", "")
 
