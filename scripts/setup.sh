@@ -4,6 +4,9 @@ set -euo pipefail
 packages=(build-essential cmake pkg-config libeigen3-dev libspectra-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev libgmock-dev
   libbenchmark-dev libvtk9-dev xvfb xauth
+  # Python 3 (standard library only): the documentation's figures and their checks
+  # (scripts/update_docs.py, tests/docs).
+  python3
   # FFTW (pkg-config fftw3): random excitation signals and Welch spectra (fem/fft.hpp).
   libfftw3-dev
   # OpenBLAS takes over libblas.so.3 (Debian's alternatives) from the reference BLAS, which
