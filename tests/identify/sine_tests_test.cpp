@@ -336,9 +336,11 @@ TEST(SimulateSineTests, NoiseOnASeriesAndTheCommentsItsTableKeeps) {
   EXPECT_EQ(kept[1], joint_comment(joint));
   EXPECT_EQ(kept[2].rfind("method: hb (harmonic balance, harmonics 0 to 9", 0), 0u) << kept[2];
   EXPECT_EQ(kept[3], noisy[0].comments.back());
-  for (const auto& line : noisy[0].comments) // the lines of the first test alone are left out
-    if (line.rfind("sine force", 0) == 0 || line.rfind("harmonic balance:", 0) == 0)
+  for (const auto& line : noisy[0].comments) { // the lines of the first test alone are left out
+    if (line.rfind("sine force", 0) == 0 || line.rfind("harmonic balance:", 0) == 0) {
       EXPECT_EQ(std::find(kept.begin(), kept.end(), line), kept.end()) << line;
+    }
+  }
   EXPECT_EQ(stepped_sine_comments({}).size(), 1u);
 }
 
