@@ -103,5 +103,10 @@ def test_bad_arguments(cantilever):
                                                  amplitude=-1.0)) == (
         "amplitude: expected finite amplitudes > 0 (N or N m), got -1")
     assert "tests: expected a list" in message(lambda: jointid.identify(cantilever, "r.csv"))
+    t = np.arange(8.0)
+    r = jointid.Record(t, {"f@7:uy": t, "x@7:uy": t}, source="r.csv")
+    assert message(lambda: jointid.identify(cantilever, [r, r])) == (
+        "tests: r.csv is given twice (each test would count twice and the uncertainty come out "
+        "falsely small)")
     with pytest.raises(TypeError):
         jointid.identify(cantilever, [1.5])

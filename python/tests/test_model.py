@@ -8,7 +8,10 @@ import numpy as np
 import pytest
 
 import jointid
-from conftest import CANTILEVER, SAME_CODE, assert_same, cantilever_dict, read_json, run_cli
+from conftest import (CANTILEVER, SAME_CODE, SOURCE, assert_same, cantilever_dict, read_json,
+                      run_cli)
+
+MATRICES = SOURCE / "examples" / "matrices" / "cantilever_matrices.toml"
 
 
 def test_the_model_file(cantilever):
@@ -91,3 +94,34 @@ def test_a_model_from_dicts_is_the_model_of_the_file(cantilever):
     d = cantilever_dict(values={"k": np.float64(4800.0), "c": 20, "c2": 500.0, "k3": 1.6e8})
     d["mesh"]["elements"] = np.array(d["mesh"]["elements"])  # int64
     assert jointid.read_model(d).joints == cantilever.joints
+
+
+def test_a_substructure_given_by_its_matrices(cantilever, tmp_path):
+    # The cantilever's K and M as another program exports them: the modes as `jointid modes`
+    # gives them, and those of the finite element model (to the export's 17 digits).
+    model = jointid.read_model(MATRICES)
+    assert model.given_by == "its matrices ([matrices])"
+    run_cli("modes", MATRICES, "-o", tmp_path, "--count", 3, "--no-plot")
+    modes = model.modes(3)
+    assert_same(modes.to_dict()["modes"], read_json(tmp_path / "modes.json")["modes"])
+    np.testing.assert_allclose(modes.frequencies_hz, cantilever.modes(3).frequencies_hz, rtol=1e-9)
+
+
+def test_a_substructure_given_by_its_modes():
+    # Two modes at two DOFs, as a dict: H_ij(ω) = Σ_r φ_ri φ_rj / (ω_r² − ω² + 2iζ_r ω_r ω) + R_ij.
+    f, zeta = np.array([80.3, 212.0]), np.array([0.0012, 0.002])
+    phi = np.array([[0.91, -0.40], [0.35, 0.88]])  # one row per mode
+    R = np.array([[1e-7, 0.0], [0.0, 2e-7]])
+    model = jointid.read_model({
+        "model": {"dimension": 2},
+        "modal": {"dofs": ["1:uy", "4:uy"], "frequencies_hz": f, "damping": zeta, "shapes": phi,
+                  "residual_flexibility": R},
+    })
+    modes = model.modes(5)
+    np.testing.assert_array_equal(modes.frequencies_hz, f)
+    np.testing.assert_array_equal(modes.shapes, phi.T)  # n_dof x n_modes
+    freq = np.array([10.0, 80.3, 150.0])
+    w, wr = 2 * np.pi * freq[:, None], 2 * np.pi * f[None, :]
+    expected = np.einsum("ri,rj,fr->fij", phi, phi, 1 / (wr**2 - w**2 + 2j * zeta * wr * w)) + R
+    np.testing.assert_allclose(model.receptance(freq, ["1:uy", "4:uy"], ["1:uy", "4:uy"]),
+                               expected, rtol=1e-12)
