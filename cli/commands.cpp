@@ -305,6 +305,7 @@ void simulate_signal(const SimulateOptions& o) {
     throw io::Error(o.model.string() + ": " + e.what());
   }
   progress.clear();
+  if (!test.status.ok()) throw std::runtime_error(test.status.reason);
   test.record.source = name;
   test.comments.insert(test.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
   if (o.noise > 0.0) {
@@ -410,6 +411,8 @@ void simulate(const SimulateOptions& o) {
     throw;
   }
   progress.clear();
+  for (const auto& t : tests)
+    if (!t.status.ok()) throw std::runtime_error(t.status.reason);
   for (std::size_t i = 0; i < tests.size(); ++i) {
     auto& t = tests[i];
     t.comments.insert(t.comments.begin(), {"jointid simulate", "model: " + o.model.string()});
@@ -485,7 +488,7 @@ void identify(const IdentifyOptions& o) {
   const identify::FitResult result =
       o.output_error ? identify::output_error(sub, file.joints, measured, options, oe)
                      : identify::fit(sub, file.joints, measured, options);
-  if (result.status != identify::FitStatus::ok) throw io::Error("identify: " + result.reason);
+  if (!result.status.ok()) throw io::Error("identify: " + result.status.reason);
   if (!output_rank()) return;
   io::write_json(o.output, io::identify_result_json(result, {}, &measured));
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
@@ -673,8 +676,7 @@ void modes(const ModesOptions& o) {
   options.max_iterations = o.max_restarts;
   const fem::Modes modes =
       compute_modes(file.model, sub ? sub->system() : nullptr, options, engine);
-  if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error("modal analysis failed: " + modes.reason);
+  if (!modes.status.ok()) throw std::runtime_error("modal analysis failed: " + modes.status.reason);
   if (!output_rank()) return;
   if (!sub) sub.emplace(file.substructure());
   const fem::Assembled& system = *sub->system();
@@ -772,6 +774,7 @@ void response(const ResponseOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw io::Error(o.model.string() + ": " + e.what());
   }
+  if (!curves.status.ok()) throw std::runtime_error(curves.status.reason);
   if (terminal) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
   if (!output_rank()) return;
 
@@ -851,6 +854,7 @@ void frf(const FrfOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw io::Error(o.model.string() + ": " + e.what());
   }
+  if (!sweep.status.ok()) throw std::runtime_error(sweep.status.reason);
   if (!output_rank()) return;
   if (!file.joints.empty())
     fmt::print("note: the FRFs are the linear substructure's; the {} joint{} of {} {} not in "
@@ -1103,6 +1107,7 @@ void compare(const CompareOptions& o) {
     throw io::Error(fmt::format("{} (model {})", e.what(), o.model.string()));
   }
   progress.clear();
+  if (!result.status.ok()) throw std::runtime_error(result.status.reason);
 
   // 4. Write.
   make_output_dir(o.output_dir);

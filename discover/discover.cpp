@@ -494,8 +494,7 @@ private:
     fo.harmonics = o_.harmonics;
     identify::FitResult fit = identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
     // Terms the tests cannot separate: this model cannot be identified (a refused candidate).
-    if (fit.status != identify::FitStatus::ok)
-      throw std::invalid_argument("identify: " + fit.reason);
+    if (!fit.status.ok()) throw std::invalid_argument("identify: " + fit.status.reason);
     return fit;
   }
 
@@ -528,7 +527,7 @@ private:
       const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
       const frf::HarmonicBalanceResult r =
           solve(sim, static_cast<int>(i), per_test.empty() ? joints : per_test[i], start);
-      s.converged = s.converged && r.converged && r.X.allFinite();
+      s.converged = s.converged && r.status.ok() && r.X.allFinite();
       s.X[i] = r.X.topRows(K_ + 1);
       s.Y[i] = r.Y;
     }
@@ -734,7 +733,7 @@ private:
           F(1, c) += std::sqrt(v) * unit;
           const frf::HarmonicBalanceResult r =
               sim.balance[i].solve(s.joints, F, s.Y[i].size() > 0 ? &s.Y[i] : nullptr);
-          if (!r.converged) continue;
+          if (!r.status.ok()) continue;
           for (auto& e : entries_)
             if (e.test == static_cast<int>(i))
               e.force +=
@@ -766,8 +765,8 @@ private:
         Eigen::MatrixXcd start = Eigen::MatrixXcd::Zero(fine.harmonics + 1, layout_.size());
         start.topRows(measured_start_[i].rows()) = measured_start_[i];
         frf::HarmonicBalanceResult r = fine.balance[i].solve(s.joints, drive_[i], &start);
-        if (!r.converged) r = fine.balance[i].solve(s.joints, drive_[i]);
-        if (r.converged) reference = r.X;
+        if (!r.status.ok()) r = fine.balance[i].solve(s.joints, drive_[i]);
+        if (r.status.ok()) reference = r.X;
         factor = 4.0; // twice the difference
       }
       for (auto& e : entries_)
@@ -813,7 +812,9 @@ private:
     if (!system) return out;
     fem::SparseMatrix C;
     try {
-      C = sub_.damping_matrix() * s.damping_scale;
+      const fem::Outcome<fem::SparseMatrix> damping = sub_.damping_matrix();
+      if (!damping.status.ok()) return out;
+      C = damping.value * s.damping_scale;
     } catch (const std::exception&) {
       return out;
     }
@@ -836,7 +837,7 @@ private:
         const fem::SteadyState ss =
             fem::steady_state(*system, C, &forces, {force_eq_[i][0], std::abs(F1), m.frequency_hz},
                               response_eq_[i], o);
-        if (ss.status != fem::SteadyStateStatus::converged) return {};
+        if (!ss.status.ok()) return {};
         Eigen::MatrixXcd X =
             identify::fit_harmonics(ss.t, ss.u, 2.0 * std::numbers::pi * m.frequency_hz, K_);
         const Complex turn = F1 / Complex(0.0, -std::abs(F1)); // sin → the measured phase
@@ -860,13 +861,13 @@ private:
     frf::HarmonicBalanceResult r;
     if (warm && warm->rows() == sim.harmonics + 1) {
       r = sim.balance[i].solve(joints, drive_[i], warm);
-      if (r.converged) return r;
+      if (r.status.ok()) return r;
     }
     r = sim.balance[i].solve(joints, drive_[i], &measured_start_[i]);
-    if (!r.converged) {
+    if (!r.status.ok()) {
       frf::HarmonicBalanceResult again = sim.balance[i].solve(joints, drive_[i]);
       again.iterations += r.iterations;
-      if (again.converged || again.residual < r.residual) r = std::move(again);
+      if (again.status.ok() || again.residual < r.residual) r = std::move(again);
     }
     return r;
   }
@@ -1233,8 +1234,8 @@ private:
           const frf::HarmonicBalanceResult r = solve(sim, i, fitted);
           for (const auto& e : entries_) // a failed prediction counts as predicting nothing
             if (e.test == i)
-              S += r.converged ? std::norm(e.measured - r.X(e.harmonic, e.response))
-                               : std::norm(e.measured);
+              S += r.status.ok() ? std::norm(e.measured - r.X(e.harmonic, e.response))
+                                 : std::norm(e.measured);
         }
         return S;
       });
@@ -1324,14 +1325,14 @@ private:
           const Eigen::MatrixXcd F = frf::sine_force(amplitude);
           if (friction_problem(state.joints).empty()) {
             r = hb.solve(state.joints, F, previous ? &*previous : nullptr);
-            if (!r.converged && previous) r = hb.solve(state.joints, F);
+            if (!r.status.ok() && previous) r = hb.solve(state.joints, F);
           }
           c.x.push_back(x);
-          c.converged.push_back(r.converged);
+          c.converged.push_back(r.status.ok());
           for (std::size_t j = 0; j < c.channels.size(); ++j)
-            c.X1[j].push_back(r.converged ? r.X(1, static_cast<Eigen::Index>(j))
-                                          : std::complex<double>(nan, nan));
-          if (r.converged) previous = r.Y;
+            c.X1[j].push_back(r.status.ok() ? r.X(1, static_cast<Eigen::Index>(j))
+                                            : std::complex<double>(nan, nan));
+          if (r.status.ok()) previous = r.Y;
         }
         if (down) { // ascending order, as the sweep up
           std::reverse(c.x.begin(), c.x.end());

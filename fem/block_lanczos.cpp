@@ -218,17 +218,28 @@ public:
     start();
     // A block at a time, with Rayleigh–Ritz and the convergence test after each (they cost
     // O(cap³), nothing next to a solve): no solve is spent once the wanted pairs converged.
+    bool converged = false;
     for (int restarts = 0;; ++restarts) {
       out.restarts = restarts;
       do {
         absorb();
-        if (m_ >= nev_ && ritz(out)) break;
+        converged = m_ >= nev_ && ritz(out);
+        if (converged) break;
       } while (q_ > 0 && m_ + q_ <= cap_);
-      if (out.converged || restarts == o_.max_restarts) break;
+      if (converged || restarts == o_.max_restarts) break;
       restart();
     }
     out.theta = theta_.head(nev_);
-    if (out.converged) refine(out);
+    if (converged) {
+      refine(out);
+    } else {
+      out.status = Status::failure(
+          Status::Code::not_converging,
+          "block Lanczos: " + std::to_string(out.converged_count) + " of " + std::to_string(nev_) +
+              " wanted eigenpairs met the tolerance " + std::to_string(o_.tolerance) + " in " +
+              std::to_string(o_.max_restarts) + " restarts (largest relative residual " +
+              std::to_string(out.max_residual) + ")");
+    }
     out.solves = solves_;
     out.right_hand_sides = rhs_;
     return out;
@@ -339,8 +350,7 @@ private:
       if (residual <= o_.tolerance * scale) ++out.converged_count;
       out.max_residual = std::max(out.max_residual, residual / std::abs(theta_(i)));
     }
-    out.converged = out.converged_count == nev_;
-    return out.converged;
+    return out.converged_count == nev_;
   }
 
   // Keeps the k leading Ritz vectors and the next block: V ← [V S_k, Q], H ← diag(θ_k), and Q
