@@ -1,5 +1,7 @@
 #include "fem/block_lanczos.hpp"
 
+#include "fem/assert.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <cblas.h>
 
@@ -83,6 +85,14 @@ MatrixXd svqb(const ShiftInvertPencil& P, MatrixXd& Z, MatrixXd& MZ, double floo
     floor = 0.0;
   }
   return R;
+}
+
+// Whether ZᵀMZ = I to well within rounding's reach (1e-8): an orthonormalised block, checked
+// by debug asserts (n q² flops, a fraction of the orthonormalisation's own).
+[[maybe_unused]] bool m_orthonormal(const MatrixXd& Z, const MatrixXd& MZ) {
+  if (Z.cols() == 0) return true;
+  const MatrixXd G = Z.transpose() * MZ;
+  return (G - MatrixXd::Identity(G.rows(), G.cols())).cwiseAbs().maxCoeff() <= 1e-8;
 }
 
 // The products with the basis, n × m by m × b for n up to 10⁶, are the largest dense work
@@ -308,6 +318,8 @@ private:
     const MatrixXd D = local.bottomRows(q) + p.C.bottomRows(q); // Q_jᵀ M Op Q_j
     H_.block(j, j, q, q) = 0.5 * (D + D.transpose());
     Index kept = W.cols();
+    JOINTID_ASSERT(m_ + kept <= V_.cols(), "the next block fits in the basis storage");
+    JOINTID_ASSERT(m_orthonormal(W, MW), "the next Lanczos block is M-orthonormal");
     MatrixXd R = MatrixXd::Zero(q, q);
     R.topRows(kept) = p.R;
     V_.middleCols(m_, kept) = W;

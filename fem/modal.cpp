@@ -1,5 +1,6 @@
 #include "fem/modal.hpp"
 
+#include "fem/assert.hpp"
 #include "fem/block_lanczos.hpp"
 
 #include <Eigen/Cholesky>
@@ -374,6 +375,16 @@ Modes spectra_modes(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
   return out;
 }
 
+// What every engine guarantees of modes it reports as ok (debug asserts): one shape per
+// frequency, the frequencies ascending.
+Modes checked(Modes m) {
+  JOINTID_ASSERT(!m.status.ok() || m.phi.cols() == m.omega.size(),
+                 "one mode shape per natural frequency");
+  for (int r = 1; m.status.ok() && r < m.num_modes(); ++r)
+    JOINTID_ASSERT(m.omega(r - 1) <= m.omega(r), "natural frequencies in ascending order");
+  return m;
+}
+
 // The nev lowest modes with the factorisation held by `op`, by the method asked for.
 Modes sparse_modes_count(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
                          SparseModalStats& stats, int nev) {
@@ -424,9 +435,9 @@ Modes modal_analysis(const Assembled& s, const ModalOptions& o) {
       throw std::invalid_argument("the sparse engine finds fewer modes than DOFs (" +
                                   std::to_string(n) +
                                   "); ask for fewer modes or use the dense engine");
-    return sparse_modes(s, o);
+    return checked(sparse_modes(s, o));
   }
-  return dense_modes(s, o);
+  return checked(dense_modes(s, o));
 }
 
 } // namespace jointid::fem

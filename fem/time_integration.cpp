@@ -89,6 +89,8 @@ void Newmark::hold_stuck(Eigen::VectorXd& a_next) {
 void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                         const Eigen::VectorXd& f) {
   JOINTID_ASSERT(status_.ok(), "Newmark::set_state after a failed factorisation");
+  JOINTID_ASSERT(u.size() == u_.size() && v.size() == u_.size() && f.size() == u_.size(),
+                 "Newmark::set_state: one entry per equation");
   u_ = u;
   v_ = v;
   Eigen::VectorXd rhs = f - system_.K * u;
@@ -165,6 +167,7 @@ bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& 
 
 Status Newmark::step(const Eigen::VectorXd& f_next) {
   JOINTID_ASSERT(status_.ok(), "Newmark::step after a failed factorisation");
+  JOINTID_ASSERT(f_next.size() == u_.size(), "Newmark::step: one load per equation");
   Eigen::VectorXd rhs = f_next + system_.M * (a0_ * u_ + a2_ * v_ + a3_ * a_);
   if (C_.nonZeros() > 0) rhs += C_ * (a1_ * u_ + a4_ * v_ + a5_ * a_);
   Eigen::VectorXd u_next = keff_.solve(rhs);

@@ -14,6 +14,7 @@
 /// semi-smooth Newton. With `exact_friction = false` friction is regularised instead:
 /// sign(ẏ) ≈ tanh(ẏ/width). Complex amplitudes are peak values with
 /// x(t) = Re Σ_k X_k e^{ikωt}; units SI.
+#include "fem/assert.hpp"
 #include "fem/status.hpp"
 #include "frf/receptance.hpp"
 #include "joints/joint.hpp"
@@ -35,8 +36,14 @@ struct HarmonicBlocks {
   void resize(Eigen::Index rows, Eigen::Index columns, int K) {
     data.resize(rows, columns * (K + 1)), cols = columns;
   }
-  auto operator[](int k) { return data.middleCols(k * cols, cols); }
-  auto operator[](int k) const { return data.middleCols(k * cols, cols); }
+  auto operator[](int k) {
+    JOINTID_ASSERT(k >= 0 && (k + 1) * cols <= data.cols(), "harmonic k is one of 0 … K");
+    return data.middleCols(k * cols, cols);
+  }
+  auto operator[](int k) const {
+    JOINTID_ASSERT(k >= 0 && (k + 1) * cols <= data.cols(), "harmonic k is one of 0 … K");
+    return data.middleCols(k * cols, cols);
+  }
 };
 } // namespace detail
 

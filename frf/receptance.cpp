@@ -210,6 +210,11 @@ CMatrix ModalSynthesis::receptances(std::span<const double> omegas, std::span<co
                                     std::span<const int> cols) const {
   require_ok();
   const int m = static_cast<int>(omega_.size());
+  JOINTID_ASSERT(phi_.rows() == static_cast<Eigen::Index>(dofs_.size()) && phi_.cols() == m &&
+                     modal_damping_.size() == m,
+                 "one shape row per DOF served, one frequency and damping per mode");
+  JOINTID_ASSERT(residual_.rows() == phi_.rows() && residual_.cols() == phi_.rows(),
+                 "the residual flexibility is |dofs| × |dofs|");
   const auto nr = static_cast<Eigen::Index>(rows.size()),
              nc = static_cast<Eigen::Index>(cols.size());
   const auto nw = static_cast<Eigen::Index>(omegas.size());

@@ -1,5 +1,7 @@
 #include "identify/fit.hpp"
 
+#include "fem/assert.hpp"
+
 #include "identify/harmonics.hpp"
 #include "identify/statistics.hpp"
 
@@ -529,6 +531,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   const Eigen::MatrixXd& Q = eq.Q;
   const Eigen::VectorXd& p = eq.p;
   const std::vector<Row>& rows = eq.rows;
+  JOINTID_ASSERT(Q.rows() == m && Q.cols() == nu && p.size() == m,
+                 "Q b = p: one row of Q and p per equation, one column of Q per unknown");
   for (int u = 0; u < nu; ++u)
     if (!(Q.col(u).norm() > 0.0))
       throw std::invalid_argument("identify: term " + name_of(u) +
