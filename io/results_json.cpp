@@ -51,8 +51,8 @@ std::string identify_result_json(const identify::FitResult& result,
     warnings.push_back(w);
 
   Json out;
-  out["status"] = result.status == identify::FitStatus::ok ? "ok" : "not_separable";
-  out["reason"] = result.reason;
+  out["status"] = std::string(fem::code_name(result.status.code));
+  out["reason"] = result.status.reason;
   out["joints"] = std::move(joints);
   out["equations"] = result.equations;
   out["unknowns"] = result.unknowns;

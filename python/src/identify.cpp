@@ -57,8 +57,7 @@ IdentifyResult identify_joints(const ModelPtr& model, const py::object& tests_gi
     out.result = output_error ? identify::output_error(model->sub, model->file.joints, out.measured,
                                                        fit, refined)
                               : identify::fit(model->sub, model->file.joints, out.measured, fit);
-    if (out.result.status != identify::FitStatus::ok)
-      throw io::Error("identify: " + out.result.reason);
+    if (!out.result.status.ok()) throw io::Error("identify: " + out.result.status.reason);
     out.joints = out.result.identified(model->file.joints);
     return out;
   });

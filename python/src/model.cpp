@@ -150,8 +150,8 @@ Modes modes_of(const Model& model, int count, const std::string& engine, double 
   options.tolerance = tolerance;
   options.max_iterations = max_restarts;
   out.modes = fem::modal_analysis(system, options);
-  if (out.modes.status != fem::ModalStatus::success)
-    throw std::runtime_error("modal analysis failed: " + out.modes.reason);
+  if (!out.modes.status.ok())
+    throw std::runtime_error("modal analysis failed: " + out.modes.status.reason);
   if (!file.matrices)
     if (const fem::ZeroModes z = fem::zero_modes(file.model, system, out.modes); z.count > 0)
       out.warnings.push_back(z.describe());
@@ -218,6 +218,8 @@ py::array receptance(const Model& model, const py::object& freq_hz, const py::ob
     const frf::ModalSynthesis H = for_model(model, [&] {
       return model.sub.synthesis(dofs, frf::synthesis_band_hz(std::max(f_max, 1e-3), 1), &notes);
     });
+    // A modal analysis that failed: its reason, as `jointid frf` fails with it.
+    if (!H.status().ok()) throw std::runtime_error(H.status().reason);
     for (py::ssize_t i = 0; i < n_freq; ++i) {
       if (i % 64 == 0) check();
       const double w = 2.0 * std::numbers::pi * f[i];

@@ -186,6 +186,8 @@ py::list simulate_sine(const ModelPtr& model, const SimulateArguments& a) {
       return identify::simulate_sine_tests(model->sub, model->file.joints, force_at, plans,
                                            options);
     });
+    for (const auto& t : out) // a numerical failure ends the call, as it ends the command
+      if (!t.status.ok()) throw std::runtime_error(t.status.reason);
     identify::add_noise(out, a.noise, a.seed);
     return out;
   });

@@ -86,10 +86,13 @@ ResponseCurves response(const ModelPtr& model, const std::string& force,
     const std::function<void(std::size_t, double)> each = [&check](std::size_t, double) {
       check();
     };
-    return ResponseCurves{for_model(*model, [&] {
+    ResponseCurves out{for_model(*model, [&] {
       return frf::response_curves(model->sub, model->file.joints, force_at, amplitudes, f0, f1,
                                   options, each);
     })};
+    // A modal analysis that failed: its reason, as `jointid response` fails with it.
+    if (!out.curves.status.ok()) throw std::runtime_error(out.curves.status.reason);
+    return out;
   });
 }
 
