@@ -136,10 +136,10 @@ Modes modes_of(const Model& model, int count, const std::string& engine, double 
                     "joints alone connect: run `jointid modes` on each substructure's file");
   Modes out;
   out.dofs = model.dof_labels();
-  if (file.modal) { // given by its modes: those
-    out.modes.omega = 2.0 * std::numbers::pi * file.modal->frequencies_hz;
-    out.modes.phi = file.modal->shapes.transpose();
-    out.count = std::min(count, out.modes.num_modes());
+  if (file.modal) { // given by its modes: the first `count` of them, as listed
+    out.count = std::min(count, file.modal->num_modes());
+    out.modes.omega = 2.0 * std::numbers::pi * file.modal->frequencies_hz.head(out.count);
+    out.modes.phi = file.modal->shapes.topRows(out.count).transpose();
     return out;
   }
 

@@ -120,6 +120,7 @@ def test_a_substructure_given_by_its_modes():
     modes = model.modes(5)
     np.testing.assert_array_equal(modes.frequencies_hz, f)
     np.testing.assert_array_equal(modes.shapes, phi.T)  # n_dof x n_modes
+    assert len(model.modes(1)) == 1 and model.modes(1).shapes.shape == (2, 1)
     freq = np.array([10.0, 80.3, 150.0])
     w, wr = 2 * np.pi * freq[:, None], 2 * np.pi * f[None, :]
     expected = np.einsum("ri,rj,fr->fij", phi, phi, 1 / (wr**2 - w**2 + 2j * zeta * wr * w)) + R
