@@ -3,17 +3,23 @@ KeyboardInterrupt, leaving the model usable.
 
 An interrupt is what Ctrl-C does: _thread.interrupt_main() sets SIGINT as pending, as the signal
 arriving would, and Python's handler raises KeyboardInterrupt in the main thread when the library
-next looks (every 50 ms at most, between its steps). The bounds on time are loose by design:
+next looks (every 50 ms at most, between its steps); a script run as a child process gets a real
+SIGINT. The bounds on time are loose by design:
 each compares the interrupted call with the same work in full, measured in the same test.
 """
 
 import _thread
+import os
+import signal
+import subprocess
+import sys
 import threading
 import time
 
 import pytest
 
 import jointid
+from conftest import CANTILEVER
 
 AMPLITUDES = [10.0 * i for i in range(1, 41)]  # 40 curves: 40 times one curve's work
 
@@ -89,3 +95,56 @@ def test_long_calls_release_the_gil(cantilever):
     # keeps it (10 in a run with the release taken out on purpose).
     middle = [t for t in ticks if start + 0.2 * (end - start) < t < end - 0.2 * (end - start)]
     assert len(middle) > 50, (len(middle), end - start)
+
+
+# A script that runs a long call, as a user's would: it times one unit of the work, says "go"
+# and starts forty, and says how it ended. The parent sends it a real SIGINT (what Ctrl-C in a
+# terminal sends to the foreground process), which may land on any of its threads.
+SCRIPT = """
+import sys, time
+import jointid
+
+model = jointid.read_model(sys.argv[1])
+if sys.argv[2] == "response":
+    def work(n):
+        return jointid.response(model, force="7:uy", amplitude=[10.0 * (i + 1) for i in range(n)],
+                                freq_range=(1.0, 8.0), balance_harmonics=9)
+else:  # time integration: tests in parallel on two threads
+    def work(n):
+        return jointid.simulate_sine(model, force="7:uy", freq_hz=[3.0 + 0.01 * i for i in range(2 * n)],
+                                     amplitude=50.0, method="time", periods=2, steps_per_period=512)
+start = time.monotonic()
+work(1)
+print("go", time.monotonic() - start, flush=True)
+try:
+    work(40)
+    print("finished", flush=True)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+    work(1)  # the model is usable again
+    print("usable", flush=True)
+"""
+
+
+@pytest.mark.parametrize("call", ["response", "time"])
+def test_a_sigint_stops_a_script(call):
+    child = subprocess.Popen([sys.executable, "-c", SCRIPT, str(CANTILEVER), call],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        go = child.stdout.readline().split()
+        assert go and go[0] == "go", (go, child.stderr.read() if child.poll() is not None else "")
+        t_one = float(go[1])
+        time.sleep(max(0.2, 1.5 * t_one))
+        sent = time.monotonic()
+        os.kill(child.pid, signal.SIGINT)
+        out, err = child.communicate(timeout=60 * t_one + 30)
+        stopped = time.monotonic() - sent
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    assert child.returncode == 0, err
+    assert out.split() == ["interrupted", "usable"], (out, err)
+    # After the interrupt: at most the unit in progress and the one more run to show the model
+    # usable (with room for a loaded machine), where the whole call is forty units.
+    assert stopped < 10 * t_one + 1.0, (stopped, t_one)
