@@ -40,6 +40,8 @@ def test_mode_shapes_are_views_with_their_dof_labels(cantilever):
     assert shapes.shape == (12, 3) and modes.dofs == cantilever.dofs
     # The library's memory, not a copy: every access views the same doubles, read-only.
     assert np.shares_memory(shapes, modes.shapes)
+    assert shapes.base is modes and not shapes.flags.owndata and shapes.flags.f_contiguous
+    assert modes.omega.base is modes and not modes.omega.flags.owndata
     assert not shapes.flags.writeable
     with pytest.raises(ValueError):
         shapes[0, 0] = 1.0

@@ -55,6 +55,7 @@ def test_record_arrays_are_views_of_the_record(cantilever):
     x = r["x@7:uy"]
     assert np.shares_memory(x, r["x@7:uy"]) and np.shares_memory(x, r.channels["x@7:uy"])
     assert np.shares_memory(r.t, r.t) and x.flags.writeable
+    assert x.base is r and r.t.base is r and not x.flags.owndata and not r.t.flags.owndata
     before, x0 = r.to_csv(), x[0]
     x[0] = 0.125  # in place: the record itself changes
     assert r["x@7:uy"][0] == 0.125 and r.to_csv() != before
