@@ -810,8 +810,16 @@ TEST_F(Uff58Test, FunctionsThatAreNotTimeResponsesSayWhatTheyAreAndWhatToFix) {
   const std::string& g = hand_written;
   const std::string id = "ID line 1 \"Tip displacement, sine test at 3 Hz\"";
   const std::string type0 = test::replaced(g, "    1         2    3", "    0         2    3");
-  // Type 0 with a time abscissa is read; the same without a time abscissa is refused.
+  // Type 0 with a time abscissa (data type 17, or a unit of time) is read; the same without a
+  // time abscissa is refused.
   EXPECT_NO_THROW(uff58_tests(read_uff58(write(type0)), "t.uff"));
+  EXPECT_NO_THROW(uff58_tests(read_uff58(write(test::replaced(type0, "Time                 s  ",
+                                                              "Time                 NONE"))),
+                              "t.uff"));
+  EXPECT_NO_THROW(uff58_tests(
+      read_uff58(write(test::replaced(type0, "        17    0    0    0 Time                 s  ",
+                                      "         1    0    0    0 Time                 ms "))),
+      "t.uff"));
   expect_test_error(test::replaced(type0, "        17    0    0    0 Time                 s  ",
                                    "         0    0    0    0 NONE                 NONE"),
                     {id, "record 6 field 1 (function type) is 0 (general or unknown)",
