@@ -220,6 +220,7 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
 frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,
                                           const std::vector<joints::Joint>& joints,
                                           const Eigen::MatrixXcd* warm) const {
+  if (o_.checkpoint) o_.checkpoint();
   if (!friction_problem(joints).empty()) { // fc < 0: no steady state to speak of
     frf::HarmonicBalanceResult none;
     none.X = Eigen::MatrixXcd::Constant(sim.harmonics + 1, response_eq_[i].size(), nan);
