@@ -38,6 +38,17 @@ ForceInput force_input(const Record& record) {
     in.at.push_back(forces[j]->at);
     in.samples.col(static_cast<Eigen::Index>(j)) = forces[j]->samples;
   }
+  // A force zero in every sample drives nothing: the response would be zero, and a comparison
+  // with it a comparison with the arithmetic's floor.
+  if (in.samples.size() > 0 && in.samples.cwiseAbs().maxCoeff() == 0.0)
+    throw std::invalid_argument(fmt::format(
+        "{}: every force channel is zero in every sample ({}): no force to drive the model",
+        record.source, [&] {
+          std::string names;
+          for (const Channel* c : forces)
+            names += (names.empty() ? "" : ", ") + c->name();
+          return names;
+        }()));
   in.description = fmt::format(
       "force: the channels {} of {}",
       [&] {

@@ -1654,6 +1654,47 @@ TEST_F(CliTest, HarmonicBalanceWithoutASolutionIsNamedBySimulateDesignAndRespons
   EXPECT_FALSE(r["curves"][0]["complete"].get<bool>());
 }
 
+// Degenerate excitation (issue 31): a stepped-sine row with zero force is refused like a record
+// with zero force, naming the file's line and channel; `simulate --excitation record` and
+// `compare` refuse a record whose force is zero in every sample, naming it and its channel.
+TEST_F(CliTest, ZeroForceTablesAndRecordsAreRefusedByEveryCommand) {
+  const fs::path table = dir() / "zero_row.csv";
+  test::write_text(table, "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im\n"
+                          "3,0,-10,-1e-4,-1e-3\n"
+                          "4,0,0,-2e-4,-2e-3\n"
+                          "5,0,-10,-3e-4,-1e-3\n");
+  expect_one_line_error(
+      jointid({"identify", model().string(), table.string(), "-o", (dir() / "z.json").string()},
+              dir()),
+      "zero_row.csv:3: every force channel is zero (f@7:uy): no force was measured; a sine test "
+      "needs its force");
+  EXPECT_FALSE(fs::exists(dir() / "z.json"));
+
+  // A record at 256 Hz, 8 s: its force zero in every sample, its response a 5 Hz sine.
+  identify::Record zero;
+  zero.t = Eigen::VectorXd::LinSpaced(2048, 0.0, 2047.0 / 256.0);
+  zero.channels.push_back(
+      {identify::Quantity::force, {7, fem::Dof::uy}, Eigen::VectorXd::Zero(2048)});
+  zero.channels.push_back({identify::Quantity::displacement,
+                           {7, fem::Dof::uy},
+                           (2.0 * std::numbers::pi * 5.0 * zero.t).array().sin().matrix() * 1e-3});
+  const fs::path record = dir() / "no_force.csv";
+  io::write_record(record, zero);
+  expect_one_line_error(
+      jointid({"simulate", model().string(), "--excitation", "record", "--force-from",
+               record.string(), "-o", (dir() / "zero_sim").string()},
+              dir()),
+      "no_force.csv: every force channel is zero in every sample (f@7:uy): no "
+      "force to drive the model");
+  EXPECT_FALSE(fs::exists(dir() / "zero_sim"));
+  expect_one_line_error(jointid({"compare", model().string(), record.string(), "--no-plot", "-o",
+                                 (dir() / "zero_cmp").string()},
+                                dir()),
+                        "no_force.csv: every force channel is zero in every sample (f@7:uy): no "
+                        "force to drive the model");
+  EXPECT_FALSE(fs::exists(dir() / "zero_cmp"));
+}
+
 TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
   ASSERT_EQ(simulate_.status, 0) << simulate_.err;
   // A second joint at the tip with a stiffness of its own: the two k act alike in every test.

@@ -193,6 +193,18 @@ TEST(RandomTests, ErrorsNameWhatIsWrong) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("empty.csv: no force channel"), std::string::npos);
   }
+  // Force channels zero in every sample: nothing drives the model; refused, naming them.
+  Record zero = none;
+  zero.source = "zero.csv";
+  zero.channels.push_back({Quantity::force, tip, Eigen::VectorXd::Zero(10)});
+  zero.channels.push_back({Quantity::force, mid, Eigen::VectorXd::Zero(10)});
+  try {
+    force_input(zero);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "zero.csv: every force channel is zero in every sample "
+                                     "(f@7:uy, f@4:uy): no force to drive the model");
+  }
   ForceInput in = random_input();
   ForcedOptions o;
   o.substeps = 0;
