@@ -1695,6 +1695,25 @@ TEST_F(CliTest, ZeroForceTablesAndRecordsAreRefusedByEveryCommand) {
   EXPECT_FALSE(fs::exists(dir() / "zero_cmp"));
 }
 
+// A [modal] substructure with a 0 Hz mode, identified with harmonic 0 (issue 31): the mode is
+// named, not "term k has no effect".
+TEST_F(CliTest, AZeroHertzModeOfAModalModelIsNamedAtHarmonicZero) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  const fs::path modal = dir() / "free_modal.toml";
+  test::write_text(modal, "[model]\ndimension = 2\n\n[modal]\ndofs = [\"7:uy\"]\n"
+                          "frequencies_hz = [0.0, 30.0]\ndamping = [0.0, 0.02]\n"
+                          "shapes = [[1.0], [0.5]]\n\n[[joints]]\nname = \"tip\"\nnode = 7\n"
+                          "dof = \"uy\"\nterms = [\"k\", \"c\"]\n");
+  const fs::path result = dir() / "free_modal.json";
+  expect_one_line_error(
+      jointid({"identify", modal.string(), record_files()[0], record_files()[1], record_files()[2],
+               "--harmonics", "0,1", "-o", result.string()},
+              dir()),
+      "receptance: mode 1 is at 0 Hz (a rigid-body motion), so the receptance at 0 Hz (harmonic "
+      "0, the static mean) is infinite: support the substructure, or leave harmonic 0 out");
+  EXPECT_FALSE(fs::exists(result));
+}
+
 TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
   ASSERT_EQ(simulate_.status, 0) << simulate_.err;
   // A second joint at the tip with a stiffness of its own: the two k act alike in every test.
