@@ -537,6 +537,39 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
       throw std::invalid_argument("identify: term " + name_of(u) +
                                   " has no effect in these tests (its basis function is zero)");
 
+  // The terms that cannot be told apart, all of them: the near-null space of the column-scaled
+  // Q (right singular vectors whose singular value is below 1e-13 of the largest) holds the
+  // combinations that have no effect; a term takes part when its share of them (the norm of its
+  // row there) is at least a tenth of the largest share. An unrelated term's share is of the
+  // order of the rounding (1e-10 at most), a twin's 1/sqrt(2): the set does not depend on it.
+  auto inseparable_reason = [&](const Eigen::VectorXd& sv, const Eigen::MatrixXd& V,
+                                double condition) {
+    Eigen::Index null = 0;
+    while (null < nu && !(sv(nu - 1 - null) > 1e-13 * sv(0)))
+      ++null;
+    null = std::max<Eigen::Index>(null, 1);
+    const Eigen::VectorXd share = V.rightCols(null).rowwise().norm();
+    std::vector<std::string> names;
+    for (int u = 0; u < nu; ++u)
+      if (share(u) >= 0.1 * share.maxCoeff()) names.push_back(name_of(u));
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i)
+      list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+    if (names.size() < 2)
+      return fmt::format("the unknowns cannot be separated by these tests (condition number "
+                         "{:.3g}): term {} has almost no effect of its own: vary frequency and "
+                         "force level, or drop it",
+                         condition, list);
+    const std::string combinations =
+        null == 1 ? std::string("a combination of them has")
+                  : fmt::format("{} independent combinations of them have", null);
+    return fmt::format("the unknowns cannot be separated by these tests (condition number "
+                       "{:.3g}): terms {} act alike ({} no effect in these tests), so none of "
+                       "them can be told from the others: vary frequency and force level, or "
+                       "drop one of them",
+                       condition, list, combinations);
+  };
+
   // 2. Least squares of the column-scaled (and, with the noise, whitened) equations by SVD.
   struct Solution {
     Eigen::VectorXd b, scale, sv;
@@ -556,12 +589,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     sol.condition =
         sol.sv(nu - 1) > 0.0 ? sol.sv(0) / sol.sv(nu - 1) : std::numeric_limits<double>::infinity();
     if (!(sol.condition < 1e13)) {
-      Eigen::Index worst;
-      svd.matrixV().col(nu - 1).cwiseAbs().maxCoeff(&worst);
-      sol.inseparable = fmt::format(
-          "the unknowns cannot be separated by these tests (condition number {:.3g}); term {} is "
-          "a combination of the others: vary frequency and force level, or drop a term",
-          sol.condition, name_of(static_cast<int>(worst)));
+      sol.inseparable = inseparable_reason(sol.sv, sol.V, sol.condition);
       sol.b = Eigen::VectorXd::Constant(nu, nan);
       return sol;
     }

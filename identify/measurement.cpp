@@ -333,6 +333,19 @@ Measurement measure_phasors(const Phasors& row, const MeasureOptions& o) {
   }
   if (forces.empty()) fail("no force channel (expected columns such as f@7:uy.re, f@7:uy.im)");
   if (responses.empty()) fail("no response channel (expected x, v or a columns)");
+  // A zero force phasor measured no force, as a record's force channel zero in every sample:
+  // one of several is said, every one is refused (the row would identify from nothing).
+  std::string zero_forces;
+  for (std::size_t i = 0; i < forces.size(); ++i)
+    if (forces[i] == Complex(0.0, 0.0)) {
+      const std::string name = "f@" + fem::to_string(m.force_at[i]);
+      m.warnings.push_back(row.source + ": channel " + name +
+                           ": zero (no force was measured there)");
+      if (zero_forces.empty()) zero_forces = name;
+    }
+  if (std::all_of(forces.begin(), forces.end(), [](Complex f) { return f == Complex(0.0, 0.0); }))
+    fail("every force channel is zero (" + zero_forces +
+         "): no force was measured; a sine test needs its force");
   const auto nf = static_cast<Eigen::Index>(forces.size()),
              nr = static_cast<Eigen::Index>(responses.size());
   m.F = Eigen::MatrixXcd::Zero(K + 1, nf);

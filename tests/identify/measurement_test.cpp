@@ -400,6 +400,23 @@ TEST(Measure, ErrorsNameTheSource) {
   EXPECT_NE(e.find("no response channel"), std::string::npos) << e;
 }
 
+// A stepped-sine row with zero force measured no force, as a record whose force channel is zero
+// in every sample: every force zero is refused naming the row and channel; one of two is said.
+TEST(Measure, ZeroForceInASteppedSineRowIsRefusedLikeARecords) {
+  Phasors row;
+  row.source = "table.csv:4";
+  row.frequency_hz = 3.0;
+  row.channels = {{Quantity::force, tip, cd(0.0, 0.0)}, {Quantity::displacement, tip, cd(1e-3)}};
+  const std::string e = error_of(row);
+  EXPECT_EQ(e, "table.csv:4: every force channel is zero (f@7:uy): no force was measured; a sine "
+               "test needs its force");
+  row.channels.push_back({Quantity::force, mid, cd(0.0, -10.0)});
+  const Measurement m = measure(row, {});
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_EQ(m.warnings[0], "table.csv:4: channel f@7:uy: zero (no force was measured there)");
+  EXPECT_DOUBLE_EQ(force_level(m), 10.0);
+}
+
 TEST(Measure, RecordsTooShortForThePeriodOrTheHarmonicsAreNamed) {
   // 200 samples of a period of 256: 0.3125 s of a 0.4 s period.
   Record part = make_record(256, 1, {Quantity::displacement});
