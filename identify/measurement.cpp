@@ -117,32 +117,8 @@ int transient_periods(const Record& r, double frequency_hz, const MeasureOptions
   std::vector<const Channel*> all;
   for (const auto& c : r.channels)
     all.push_back(&c);
-  const SteadyPeriods steady = steady_periods(all, per, periods, o.steady_tolerance);
-  if (!steady.unsteady.empty()) {
-    std::string list;
-    for (int p : steady.unsteady)
-      list += (list.empty() ? "" : ", ") + std::to_string(p + 1) + " and " + std::to_string(p + 2);
-    m.warnings.push_back(r.source + ": periods " + list +
-                         " differ beyond the noise (not steady; kept): drift, or a response "
-                         "that does not repeat");
-  }
-  if (steady.first == 0) return 0;
-  for (int p = 0; p < steady.first; ++p)
-    m.dropped_periods.push_back(p + 1);
-  const std::string what = r.source + ": " + period_span(1, steady.first, periods) +
-                           " not steady: a transient (" + steady.channel + " changes by " +
-                           percent(steady.change) +
-                           " from one period to the next, beyond its noise and the steady "
-                           "tolerance " +
-                           percent(o.steady_tolerance) + ")";
-  if (periods - steady.first < 2) {
-    m.left_out = what + "; fewer than two steady periods are left: the record is left out "
-                        "(record more periods, or start recording once the response is steady)";
-    m.warnings.push_back(m.left_out);
-    return -1;
-  }
-  m.warnings.push_back(what + "; dropped, " + std::to_string(periods - steady.first) +
-                       " periods averaged");
+  const SteadyPeriods steady = steady_periods(all, per, periods, o.period_tolerance);
+  if (!judge_periods(steady, r.source, o.period_tolerance, m)) return -1;
   return steady.first * per;
 }
 

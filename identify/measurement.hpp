@@ -58,6 +58,11 @@ struct MeasureOptions {
   /// number of samples): the noise variance the non-linear basis functions turn into bias is
   /// divided by the number of periods.
   bool average_periods = true;
+  /// A record's periods (where they hold a whole number of samples) are steady when they differ
+  /// by no more than their noise allows, or by this fraction (RMS) of the period: the floor for
+  /// noise-free (simulated) records, whose transient must have died away far below the accuracy
+  /// asked of them (identify/periodic.hpp).
+  double period_tolerance = 1e-6;
   /// Periodic tests: the excited lines used lie in this band (Hz); the lines where only the
   /// response stands out of its noise (the joints' harmonics and combinations) lie above its
   /// lower end and up to `harmonics` times the highest excited line. Default: every line.

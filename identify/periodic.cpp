@@ -126,13 +126,26 @@ double off_line_noise_variance(const Eigen::Ref<const Eigen::VectorXd>& x, int p
   const auto N = x.size() / periods;
   const auto n = N * periods;
   if (N < 2) return nan;
+  // With four periods or more the record is Hann-windowed, so that a transient's spectrum falls
+  // off fast away from its frequency (the rectangular window's tails, 1/f², would lift every
+  // band's median); a line at bin kP then spills onto kP ± 1 only, left out with it.
+  const bool hann = periods >= 4;
+  const int guard = hann ? 1 : 0;
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(n);
+  if (hann)
+    for (Eigen::Index i = 0; i < n; ++i)
+      w(i) = 0.5 * (1.0 - std::cos(two_pi * static_cast<double>(i) / static_cast<double>(n)));
   fem::RealFft fft(static_cast<int>(n));
-  const Eigen::VectorXd power = fft.forward(x.head(n)).cwiseAbs2();
+  const Eigen::VectorXd power = fft.forward(x.head(n).cwiseProduct(w)).cwiseAbs2();
+  auto off_line = [&](Eigen::Index k) {
+    const Eigen::Index r = k % periods;
+    return r > guard && r < periods - guard;
+  };
   // Bins 1 … n/2 − 1 (DC and Nyquist are lines or half-weighted: left out).
   const auto top = n / 2 - (n % 2 == 0 ? 1 : 0);
   Eigen::Index off_lines = 0;
   for (Eigen::Index k = 1; k <= top; ++k)
-    off_lines += k % periods != 0 ? 1 : 0;
+    off_lines += off_line(k) ? 1 : 0;
   if (off_lines < 4) return nan;
   const auto bands = std::clamp<Eigen::Index>(off_lines / 16, 1, 32);
   double total = 0.0;
@@ -141,15 +154,15 @@ double off_line_noise_variance(const Eigen::Ref<const Eigen::VectorXd>& x, int p
     const Eigen::Index lo = 1 + b * top / bands, hi = (b + 1) * top / bands; // inclusive
     values.clear();
     for (Eigen::Index k = lo; k <= hi; ++k)
-      if (k % periods != 0) values.push_back(power(k));
+      if (off_line(k)) values.push_back(power(k));
     if (values.empty()) continue;
     auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
     std::nth_element(values.begin(), middle, values.end());
     total += *middle / std::numbers::ln2 * static_cast<double>(hi - lo + 1);
   }
-  // E|S_k|² = n σ² for white noise of variance σ²: σ² = 2 Σ_k E|S_k|² / n² over the one-sided
-  // bins.
-  return 2.0 * total / (static_cast<double>(n) * static_cast<double>(n));
+  // White noise of variance σ² gives E|S_k|² = σ² Σ w²: σ² = 2 Σ_k E|S_k|² / (n Σ w²) over the
+  // one-sided bins.
+  return 2.0 * total / (static_cast<double>(n) * w.squaredNorm());
 }
 
 SteadyPeriods steady_periods(const std::vector<const Channel*>& channels, int N, int periods,
@@ -161,32 +174,48 @@ SteadyPeriods steady_periods(const std::vector<const Channel*>& channels, int N,
     return out;
   }
   std::vector<bool> flagged(static_cast<std::size_t>(periods - 1), false);
+  // Per pair of periods: the largest difference over its allowance of any channel.
+  std::vector<double> largest(static_cast<std::size_t>(periods - 1), 0.0);
   double worst = 0.0; // the largest D over its allowance
   const double spread = 1.0 + 8.0 * std::sqrt(2.0 / N);
   for (const Channel* c : channels) {
     const Eigen::VectorXd& x = c->samples;
-    const double sigma2 =
+    std::vector<double> D(static_cast<std::size_t>(periods - 1));
+    for (int p = 0; p + 1 < periods; ++p)
+      D[static_cast<std::size_t>(p)] = (x.segment(static_cast<Eigen::Index>(p + 1) * N, N) -
+                                        x.segment(static_cast<Eigen::Index>(p) * N, N))
+                                           .squaredNorm();
+    // The noise off the lines, but never more than the steadiest pair of periods shows: where
+    // there is hardly any noise (a simulated record) a transient fills the bins off the lines.
+    double sigma2 =
         off_line_noise_variance(x.head(static_cast<Eigen::Index>(N) * periods), periods);
+    const double steadiest = *std::min_element(D.begin(), D.end()) / (2.0 * N);
+    if (!(sigma2 <= steadiest)) sigma2 = steadiest;
     out.noise_variance.push_back(sigma2);
     const auto last = x.segment(static_cast<Eigen::Index>(periods - 1) * N, N);
     const double energy = (last.array() - last.mean()).matrix().squaredNorm();
     if (!(energy > 0.0)) continue;
-    const double noise_allowance = std::isfinite(sigma2) ? 2.0 * N * sigma2 * spread : 0.0;
+    const double noise_allowance = 2.0 * N * sigma2 * spread;
     const double allowance = std::max(noise_allowance, tolerance * tolerance * energy);
     for (int p = 0; p + 1 < periods; ++p) {
-      const double D = (x.segment(static_cast<Eigen::Index>(p + 1) * N, N) -
-                        x.segment(static_cast<Eigen::Index>(p) * N, N))
-                           .squaredNorm();
-      if (!(D > allowance)) continue;
+      const double D_p = D[static_cast<std::size_t>(p)];
+      largest[static_cast<std::size_t>(p)] =
+          std::max(largest[static_cast<std::size_t>(p)], D_p / allowance);
+      if (!(D_p > allowance)) continue;
       flagged[static_cast<std::size_t>(p)] = true;
-      if (D / allowance > worst) {
-        worst = D / allowance;
+      if (D_p / allowance > worst) {
+        worst = D_p / allowance;
         out.channel = c->name();
-        out.change = std::sqrt(D / energy);
+        out.change = std::sqrt(D_p / energy);
       }
     }
   }
-  while (out.first < periods - 1 && flagged[static_cast<std::size_t>(out.first)])
+  // A transient decays: the leading periods that differ beyond the allowance are dropped. When
+  // the differences do not fall (the largest within 4 times the smallest: drift, a response
+  // that does not repeat) nothing is a transient: every such period is kept and named.
+  const bool decays = *std::max_element(largest.begin(), largest.end()) >
+                      4.0 * *std::min_element(largest.begin(), largest.end());
+  while (decays && out.first < periods - 1 && flagged[static_cast<std::size_t>(out.first)])
     ++out.first;
   for (int p = out.first; p + 1 < periods; ++p)
     if (flagged[static_cast<std::size_t>(p)]) out.unsteady.push_back(p);
@@ -196,6 +225,44 @@ SteadyPeriods steady_periods(const std::vector<const Channel*>& channels, int N,
 std::string period_span(int from, int to, int of) {
   return from == to ? fmt::format("period {} of {}", from, of)
                     : fmt::format("periods {} to {} of {}", from, to, of);
+}
+
+bool judge_periods(const SteadyPeriods& steady, const std::string& source, double tolerance,
+                   Measurement& m) {
+  const int first = steady.first, P = steady.periods - first;
+  auto leave_out = [&](const std::string& why) {
+    m.left_out = why;
+    m.warnings.push_back(why);
+    return false;
+  };
+  if (first > 0) {
+    for (int p = 0; p < first; ++p)
+      m.dropped_periods.push_back(p + 1);
+    const std::string what =
+        fmt::format("{}: {} not steady: a transient ({} changes by {} from one period to the "
+                    "next, beyond its noise and the steady tolerance {})",
+                    source, period_span(1, first, steady.periods), steady.channel,
+                    percent(steady.change), percent(tolerance));
+    if (P < 2)
+      return leave_out(what + "; fewer than two steady periods are left: the record is left out "
+                              "(record more periods, or start recording once the response is "
+                              "steady)");
+    m.warnings.push_back(what + fmt::format("; dropped, {} periods averaged", P));
+  }
+  if (steady.unsteady.empty()) return true;
+  std::string list;
+  for (int p : steady.unsteady)
+    list += fmt::format("{}{} and {}", list.empty() ? "" : ", ", p + 1, p + 2);
+  // More than half of the pairs kept differ: the response does not repeat (a drift, or a
+  // non-linear response that is not periodic at all), and its lines would mean nothing.
+  if (2 * static_cast<int>(steady.unsteady.size()) > P - 1)
+    return leave_out(fmt::format(
+        "{}: periods {} differ beyond the noise: the response does not repeat (not periodic, or "
+        "drifting); the record is left out",
+        source, list));
+  m.warnings.push_back(fmt::format("{}: periods {} differ beyond the noise (not steady; kept)",
+                                   source, list));
+  return true;
 }
 
 Measurement measure_periodic(const Record& r, const RecordClass& kind, const MeasureOptions& o) {
@@ -240,36 +307,12 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
   std::vector<const Channel*> all;
   for (const auto& c : r.channels)
     all.push_back(&c);
-  const SteadyPeriods steady = steady_periods(all, N, periods, o.steady_tolerance);
+  const SteadyPeriods steady = steady_periods(all, N, periods, o.period_tolerance);
   const int first = steady.first, P = periods - first;
   if (periods == 1)
     m.warnings.push_back(r.source + ": one period recorded: its steady state and its noise cannot "
                                     "be checked (record at least 2 periods)");
-  if (first > 0) {
-    for (int p = 0; p < first; ++p)
-      m.dropped_periods.push_back(p + 1);
-    const std::string what =
-        fmt::format("{}: {} not steady: a transient ({} changes by {} from one period to the "
-                    "next, beyond its noise and the steady tolerance {})",
-                    r.source, period_span(1, first, periods), steady.channel,
-                    percent(steady.change), percent(o.steady_tolerance));
-    if (P < 2) {
-      m.left_out = what + "; fewer than two steady periods are left: the record is left out "
-                          "(record more periods, or start recording once the response is steady)";
-      m.warnings.push_back(m.left_out);
-      return m;
-    }
-    m.warnings.push_back(what + fmt::format("; dropped, {} periods averaged", P));
-  }
-  if (!steady.unsteady.empty()) {
-    std::string list;
-    for (int p : steady.unsteady)
-      list += fmt::format("{}{} and {}", list.empty() ? "" : ", ", p + 1, p + 2);
-    m.warnings.push_back(fmt::format(
-        "{}: periods {} differ beyond the noise (not steady; kept): drift, or a response that "
-        "does not repeat",
-        r.source, list));
-  }
+  if (!judge_periods(steady, r.source, o.period_tolerance, m)) return m;
   m.periods_averaged = P;
   m.averaging = P;
   const Eigen::Index start = static_cast<Eigen::Index>(first) * N;
@@ -417,10 +460,12 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
         period.X(static_cast<Eigen::Index>(l), j) = displacement(Sp, m.lines[l]);
     }
     if (power != 0)
-      m.warnings.push_back(r.source + ": no displacement channel x@" + fem::to_string(c.at) +
-                           "; displacement derived from " +
-                           (power == 1 ? "velocity" : "acceleration") +
-                           " line by line (its mean is unknown and taken as 0)");
+      m.warnings.push_back(
+          r.source + ": no displacement channel x@" + fem::to_string(c.at) +
+          "; displacement derived from " + (power == 1 ? "velocity" : "acceleration") +
+          " line by line (its mean is unknown and taken as 0: under a broadband force an odd "
+          "non-linear joint, k3 or c2, has a mean response too, which biases its terms by about "
+          "that mean over the amplitude; measure displacement at the joints where it matters)");
     else if (!velocity)
       m.warnings.push_back(r.source + ": no velocity channel v@" + fem::to_string(c.at) +
                            "; velocity derived from displacement");

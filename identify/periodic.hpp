@@ -53,8 +53,16 @@ SteadyPeriods steady_periods(const std::vector<const Channel*>& channels, int sa
 /// there are too few samples off the lines.
 double off_line_noise_variance(const Eigen::Ref<const Eigen::VectorXd>& x, int periods);
 
-/// The warning for dropped transient periods, or for a record left out: "periods 1 to 3 of 9".
+/// "periods 1 to 3 of 9", "period 1 of 9".
 std::string period_span(int from, int to, int of);
+
+/// What the steady periods mean for a record (its source): the transient periods are dropped
+/// (Measurement::dropped_periods, a warning naming them), the record is left out
+/// (Measurement::left_out, returns false) when fewer than two steady periods are left or more
+/// than half of the pairs kept still differ (a response that does not repeat); later unsteady
+/// periods are named in a warning.
+bool judge_periods(const SteadyPeriods& steady, const std::string& source, double tolerance,
+                   Measurement& m);
 
 /// A periodic test reduced to its lines (Measurement::kind periodic; frequency_hz = 1/T, the
 /// lines are its harmonics). Throws std::invalid_argument naming the record: no response

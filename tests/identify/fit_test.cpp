@@ -300,8 +300,8 @@ TEST_F(FitTest, WarnsAboutUnsteadyAndClippedRecordsAndDerivedVelocity) {
       if (w.find(source) != std::string::npos && w.find(what) != std::string::npos) return true;
     return false;
   };
-  // Its two periods differ by 1 %: not steady, and with one steady period left it is left out.
-  EXPECT_TRUE(warned(growing.source, "not steady"));
+  // Its two periods differ by 1 %: the response does not repeat, and the record is left out.
+  EXPECT_TRUE(warned(growing.source, "periods 1 and 2 differ beyond the noise"));
   EXPECT_TRUE(warned(growing.source, "left out"));
   EXPECT_TRUE(warned(clipped.source, "clipped"));
   EXPECT_TRUE(warned(no_velocity.source, "velocity derived"));
