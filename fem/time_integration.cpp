@@ -201,6 +201,7 @@ SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const L
   Eigen::MatrixXd u_hist(keep * N, nout), v_hist(keep * N, nout);
   SteadyState out;
   int calm = 0;
+  const int needed = std::max(2, o.output_periods);
   for (int p = 0; p < o.max_periods; ++p) {
     const int slot = p % keep;
     for (int k = 0; k < N; ++k) {
@@ -222,9 +223,11 @@ SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const L
     const double size = std::max(now_u.cwiseAbs().maxCoeff(), 1e-300);
     out.period_change = (now_u - before_u).cwiseAbs().maxCoeff() / size;
     calm = out.period_change < o.tolerance ? calm + 1 : 0;
-    if (calm >= 2 && p + 1 >= keep) break;
+    // Every period given out must agree with the one before it (not only the last two: the
+    // first of a record of many periods would still hold the transient).
+    if (calm >= needed && p + 1 >= keep) break;
   }
-  if (calm < 2) out.status = SteadyStateStatus::not_periodic;
+  if (calm < needed) out.status = SteadyStateStatus::not_periodic;
   // Assemble the last output_periods periods in time order.
   const int last = (out.periods_run - 1) % keep;
   const int total = o.output_periods * N;
