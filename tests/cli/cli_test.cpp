@@ -1238,6 +1238,26 @@ TEST_F(CliTest, IdentifyTakesAMultisineRecordAsPeriodicAndRefusesARandomOne) {
   EXPECT_FALSE(fs::exists(dir() / "random_result.json"));
 }
 
+// Issue 30: --harmonics was capped at 50. No cap now: the record's sampling sets the highest
+// harmonic (the suite's records hold 512 samples a period: harmonic 60 is there, 300 is above
+// their Nyquist frequency and refused naming the record).
+TEST_F(CliTest, IdentifyHarmonicsAreCappedOnlyByTheSampling) {
+  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  std::vector<std::string> args{"identify", model().string()};
+  for (const auto& f : record_files())
+    args.push_back(f);
+  const fs::path result = dir() / "h60.json";
+  args.insert(args.end(), {"--no-plot", "-o", result.string(), "--harmonics", "1,60"});
+  const Outcome run = jointid(args, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(json::parse(test::read_text(result))["equations"], 12); // 3 tests × 2 × (re, im)
+  args.back() = "1,300";
+  const Outcome refused = jointid(args, dir());
+  expect_one_line_error(refused, "harmonic 300");
+  EXPECT_NE(refused.err.find("sine_f3.4Hz_F10N.csv"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("Nyquist"), std::string::npos) << refused.err;
+}
+
 TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
   const fs::path out = dir() / "random_bad";
   auto simulate = [&](const std::vector<std::string>& extra) {
