@@ -119,8 +119,8 @@ int main() {
   std::printf("identify (measure + fit) on ten such records: median %.3f s (of 5: %.3f to %.3f)\n",
               median(ten), *std::min_element(ten.begin(), ten.end()),
               *std::max_element(ten.begin(), ten.end()));
-  if (result.status != identify::FitStatus::ok) {
-    std::printf("identification failed: %s\n", result.reason.c_str());
+  if (!result.status.ok()) {
+    std::printf("identification failed: %s\n", result.status.reason.c_str());
     return 1;
   }
   std::printf("identified k = %.6g (truth %g, std %.3g), c = %.6g (truth %g, std %.3g); %d "
