@@ -1222,6 +1222,14 @@ TEST_F(CliTest, IdentifyTakesAMultisineRecordAsPeriodicAndRefusesARandomOne) {
         << truth[i].first;
   }
 
+  // discover re-simulates tests by harmonic balance at one frequency: it refuses the record,
+  // naming it (identify takes it).
+  const Outcome discovered = jointid({"discover", model().string(), files[0], files[1], "--no-plot",
+                                      "-o", (dir() / "multisine_discover").string()},
+                                     dir());
+  expect_one_line_error(discovered, "a periodic broadband test");
+  EXPECT_NE(discovered.err.find("bare_10N.csv"), std::string::npos) << discovered.err;
+
   const fs::path random_dir = dir() / "random_for_identify";
   const Outcome random = jointid({"simulate", model().string(), "--force", "7:uy", "--excitation",
                                   "random", "--band", "2:40", "--rms", "40", "--duration", "8",

@@ -5,6 +5,7 @@
 
 #include "fem/excitation.hpp"
 #include "identify/fit.hpp"
+#include "identify/output_error.hpp"
 #include "identify/random_tests.hpp"
 #include "support/cantilever.hpp"
 
@@ -26,8 +27,8 @@ const fem::NodeDof tip{7, fem::Dof::uy};
 
 joints::Joint joint(std::string name, int node, int node_b, std::vector<joints::Term> terms,
                     std::vector<double> values) {
-  joints::Joint j{std::move(name), node, node_b, fem::Dof::uy, std::move(terms), std::move(values),
-                  {},              {}};
+  joints::Joint j{std::move(name),   node, node_b, fem::Dof::uy, std::move(terms),
+                  std::move(values), {},   {}};
   j.fixed.assign(j.terms.size(), false);
   return j;
 }
@@ -56,8 +57,8 @@ Record multisine_test(const std::vector<joints::Joint>& joints, const fem::NodeD
                       std::vector<Quantity> quantities = {Quantity::displacement,
                                                           Quantity::velocity},
                       const Band& band = {}) {
-  ExcitationSpec spec{Excitation::multisine, band.from, band.to, rms, seed, 4.0 * periods,
-                      band.rate, 4.0};
+  ExcitationSpec spec{Excitation::multisine, band.from, band.to, rms, seed,
+                      4.0 * periods,         band.rate, 4.0};
   const ForceInput input = generated_force(spec, at);
   ForcedOptions o;
   o.fade_in_s = default_fade_in_s(spec); // 5 % of the duration, as jointid simulate does
@@ -238,9 +239,10 @@ TEST(MeasurePeriodic, ATransientIsDroppedAndNamed) {
   EXPECT_EQ(m.periods_averaged, s.P - static_cast<int>(m.dropped_periods.size()));
   bool named = false;
   for (const auto& w : m.warnings)
-    named = named || (w.find("synthetic.csv") != std::string::npos &&
-                      w.find("not steady") != std::string::npos &&
-                      w.find("of 12") != std::string::npos && w.find("dropped") != std::string::npos);
+    named =
+        named || (w.find("synthetic.csv") != std::string::npos &&
+                  w.find("not steady") != std::string::npos &&
+                  w.find("of 12") != std::string::npos && w.find("dropped") != std::string::npos);
   EXPECT_TRUE(named);
   // A record whose transient lasts through all its periods is left out: four periods of 4 s,
   // a transient of half the response dying with τ = 6 s changes them by 24, 12 and 6 %.
@@ -335,8 +337,22 @@ TEST(PeriodicIdentification, TwoJointsFromMultisineTests) {
   for (std::size_t j = 0; j < truth.size(); ++j)
     for (std::size_t t = 0; t < truth[j].terms.size(); ++t) {
       const double tolerance = j == 1 && t == 1 ? 1e-2 : 1e-3;
-      EXPECT_NEAR(r.joints[j].terms[t].value, truth[j].values[t],
-                  tolerance * truth[j].values[t])
+      EXPECT_NEAR(r.joints[j].terms[t].value, truth[j].values[t], tolerance * truth[j].values[t])
           << truth[j].name << "." << joints::term_name(truth[j].terms[t]);
     }
+}
+
+// Output error re-simulates each test by the harmonic balance of one excitation frequency: a
+// periodic broadband test is refused, naming it and saying what to do instead.
+TEST(PeriodicIdentification, OutputErrorRefusesAPeriodicTestNamingIt) {
+  const std::vector<Measurement> measured{measure(Synthetic{}.record())};
+  ASSERT_EQ(measured[0].kind, RecordKind::periodic);
+  try {
+    output_error(cantilever(), {model_one()}, measured, FitOptions{.harmonics = {1}});
+    FAIL() << "expected a refusal";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("synthetic.csv: a periodic broadband test", 0), 0u) << what;
+    EXPECT_NE(what.find("without --output-error"), std::string::npos) << what;
+  }
 }
