@@ -1,6 +1,7 @@
 #include "identify/periodic.hpp"
 
 #include "fem/fft.hpp"
+#include "identify/record_messages.hpp"
 
 #include <fmt/format.h>
 
@@ -67,8 +68,7 @@ PeriodSpectra period_spectra(const Eigen::VectorXd& samples, int first, int peri
     double ss = 0.0;
     for (int p = first; p < periods; ++p) {
       out.line_variance += (out.S[static_cast<std::size_t>(p - first)] - out.mean).cwiseAbs2();
-      ss += (samples.segment(static_cast<Eigen::Index>(p) * N, N) - out.mean_samples)
-                .squaredNorm();
+      ss += (samples.segment(static_cast<Eigen::Index>(p) * N, N) - out.mean_samples).squaredNorm();
     }
     out.line_variance /= static_cast<double>(P) * (P - 1);
     out.sample_variance = ss / (static_cast<double>(N) * (P - 1));
@@ -260,8 +260,8 @@ bool judge_periods(const SteadyPeriods& steady, const std::string& source, doubl
         "{}: periods {} differ beyond the noise: the response does not repeat (not periodic, or "
         "drifting); the record is left out",
         source, list));
-  m.warnings.push_back(fmt::format("{}: periods {} differ beyond the noise (not steady; kept)",
-                                   source, list));
+  m.warnings.push_back(
+      fmt::format("{}: periods {} differ beyond the noise (not steady; kept)", source, list));
   return true;
 }
 
@@ -278,7 +278,7 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
   m.frequency_hz = 1.0 / (N * dt);
   const double omega = two_pi * m.frequency_hz;
   const auto forces = r.all(Quantity::force);
-  if (forces.empty()) fail("no force channel (expected a column such as f@7:uy)");
+  if (forces.empty()) fail(no_force_channel(r));
 
   // Response DOFs in order of first appearance, each with its best channel (x, then v, then a).
   std::vector<const Channel*> best;
@@ -294,8 +294,7 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
       best[i] = &c;
     }
   }
-  if (best.empty())
-    fail("no response channel (expected x, v or a columns such as x@7:uy next to the force)");
+  if (best.empty()) fail(no_response_channel(r));
   for (const Channel* c : forces)
     if (c->samples.cwiseAbs().maxCoeff() == 0.0)
       m.warnings.push_back(r.source + ": channel " + c->name() +
@@ -322,7 +321,7 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
   // 2. Every period's spectrum; their mean and scatter.
   fem::RealFft fft(N);
   const int top = (N - 1) / 2; // the highest line strictly below Nyquist
-  auto scale = [&](int k) { // FFT units → a harmonic of x(t) = Re(X e^{ikωt}), absolute time
+  auto scale = [&](int k) {    // FFT units → a harmonic of x(t) = Re(X e^{ikωt}), absolute time
     return (k == 0 ? 1.0 / N : 2.0 / N) * std::polar(1.0, -k * omega * t0);
   };
   std::vector<PeriodSpectra> force_spectra, response_spectra;
@@ -356,8 +355,8 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
   // 4. The response lines: every excited one, and up to `harmonics` times the highest of them
   //    (from the band's lower end) those where a response stands out of its noise.
   const bool noise_known = P >= 2;
-  const int reach = std::min<long long>(
-      top, static_cast<long long>(std::max(1, o.harmonics)) * m.excited_lines.back());
+  const int reach = std::min<long long>(top, static_cast<long long>(std::max(1, o.harmonics)) *
+                                                 m.excited_lines.back());
   std::vector<bool> used = excited;
   if (noise_known) {
     for (const auto& s : response_spectra) {
@@ -448,12 +447,10 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
             m.v.col(j));
     for (int p = 0; p < P; ++p) {
       auto& period = m.periods[static_cast<std::size_t>(p)];
-      const Eigen::VectorXd raw =
-          c.samples.segment(start + static_cast<Eigen::Index>(p) * N, N);
-      const Eigen::VectorXd raw_v =
-          velocity ? Eigen::VectorXd(velocity->samples.segment(
-                         start + static_cast<Eigen::Index>(p) * N, N))
-                   : Eigen::VectorXd();
+      const Eigen::VectorXd raw = c.samples.segment(start + static_cast<Eigen::Index>(p) * N, N);
+      const Eigen::VectorXd raw_v = velocity ? Eigen::VectorXd(velocity->samples.segment(
+                                                   start + static_cast<Eigen::Index>(p) * N, N))
+                                             : Eigen::VectorXd();
       const auto& Sp = s.S[static_cast<std::size_t>(p)];
       samples(Sp, raw, velocity ? &raw_v : nullptr, period.x.col(j), period.v.col(j));
       for (std::size_t l = 0; l < m.lines.size(); ++l)

@@ -2,6 +2,7 @@
 
 #include "fem/fft.hpp"
 #include "identify/harmonics.hpp"
+#include "identify/record_messages.hpp"
 
 #include <fmt/format.h>
 
@@ -19,10 +20,10 @@ constexpr double two_pi = 2.0 * std::numbers::pi;
 
 // What the force's spectrum and autocorrelation say, kept for the refusal's message.
 struct Evidence {
-  double line_share = 0.0;    // of the whole record's power, in the largest line + harmonics
-  double repeat = 0.0;        // the largest normalised autocorrelation past the first zero
+  double line_share = 0.0; // of the whole record's power, in the largest line + harmonics
+  double repeat = 0.0;     // the largest normalised autocorrelation past the first zero
   double lag_from = 0.0, lag_to = 0.0; // s, the lags searched
-  std::string sweep;          // why it is not a sweep
+  std::string sweep;                   // why it is not a sweep
 };
 
 Eigen::VectorXd hann_windowed(const Eigen::VectorXd& x) {
@@ -60,8 +61,10 @@ double line_share(const Eigen::VectorXd& power, double bin, double width) {
   const auto top = power.size() - 1;
   std::vector<bool> in(static_cast<std::size_t>(top + 1), false);
   for (int h = 1; h * bin - width <= static_cast<double>(top); ++h) {
-    const auto lo = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::floor(h * bin - width)));
-    const auto hi = std::min<Eigen::Index>(top, static_cast<Eigen::Index>(std::ceil(h * bin + width)));
+    const auto lo =
+        std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::floor(h * bin - width)));
+    const auto hi =
+        std::min<Eigen::Index>(top, static_cast<Eigen::Index>(std::ceil(h * bin + width)));
     for (Eigen::Index k = lo; k <= hi; ++k)
       in[static_cast<std::size_t>(k)] = true;
   }
@@ -205,10 +208,31 @@ const char* to_string(RecordKind kind) {
   return "";
 }
 
+namespace {
+std::string channel_list(const Record& r) {
+  std::string names;
+  for (const auto& c : r.channels)
+    names += (names.empty() ? "" : ", ") + c.name();
+  return names.empty() ? std::string("none") : names;
+}
+} // namespace
+
+std::string no_force_channel(const Record& r) {
+  return "no force channel among its channels (" + channel_list(r) +
+         "): a test needs its excitation force (a channel f@NODE:DOF) recorded with the "
+         "responses";
+}
+
+std::string no_response_channel(const Record& r) {
+  const auto forces = r.all(Quantity::force);
+  return "no response channel among its channels (" + channel_list(r) +
+         "): a test needs a displacement, velocity or acceleration recorded with its force" +
+         (forces.empty() ? std::string() : ", e.g. x@" + fem::to_string(forces.front()->at));
+}
+
 const Channel& driving_force(const Record& r) {
   const auto forces = r.all(Quantity::force);
-  if (forces.empty())
-    throw std::invalid_argument(r.source + ": no force channel (expected a column such as f@7:uy)");
+  if (forces.empty()) throw std::invalid_argument(r.source + ": " + no_force_channel(r));
   for (const Channel* c : forces)
     if (c->samples.size() > 0 && c->samples.cwiseAbs().maxCoeff() > 0.0) return *c;
   throw std::invalid_argument(r.source + ": every force channel is zero in every sample (" +

@@ -1,6 +1,7 @@
 #include "identify/sweep.hpp"
 
 #include "fem/fft.hpp"
+#include "identify/record_messages.hpp"
 
 #include <fmt/format.h>
 
@@ -103,8 +104,7 @@ std::vector<Measurement> reduce_sweep(const Record& r, const RecordClass& kind,
       if (static_cast<int>(c.quantity) < static_cast<int>(best[i]->quantity)) best[i] = &c;
     }
   }
-  if (best.empty())
-    fail("no response channel (expected x, v or a columns such as x@7:uy next to the force)");
+  if (best.empty()) fail(no_response_channel(r));
   const auto n = r.t.size();
   const double dt = r.dt(), nyquist = 0.5 / dt;
 
@@ -302,7 +302,8 @@ std::vector<Measurement> reduce_sweep(const Record& r, const RecordClass& kind,
     const double curvature = 2.0 * std::hypot(re(2), im(2)); // |H''|
     const double H = std::abs(frf(q));
     if (!(H > 0.0)) continue;
-    const double rate = two_pi * std::abs(row.sweep_rate_hz_per_s), L = window_s[static_cast<std::size_t>(q)];
+    const double rate = two_pi * std::abs(row.sweep_rate_hz_per_s),
+                 L = window_s[static_cast<std::size_t>(q)];
     row.sweep_bias = (0.5 * rate + rate * rate * L * L / 24.0) * curvature / H;
     if (row.sweep_bias > worst) worst = row.sweep_bias, worst_f = row.frequency_hz;
   }
@@ -314,19 +315,18 @@ std::vector<Measurement> reduce_sweep(const Record& r, const RecordClass& kind,
       r.source, rows.size(), rows.front().frequency_hz, rows.back().frequency_hz, kind.evidence,
       100.0 * worst, worst_f));
   if (skipped_above_nyquist > 0)
-    first.warnings.push_back(fmt::format(
-        "{}: {} windows left out: harmonic {} above the Nyquist frequency ({} Hz)", r.source,
-        skipped_above_nyquist, K, nyquist));
+    first.warnings.push_back(
+        fmt::format("{}: {} windows left out: harmonic {} above the Nyquist frequency ({} Hz)",
+                    r.source, skipped_above_nyquist, K, nyquist));
   for (std::size_t j = 0; j < best.size(); ++j) {
     if (best[j]->quantity != Quantity::displacement)
-      first.warnings.push_back(r.source + ": no displacement channel x@" +
-                               fem::to_string(best[j]->at) + "; displacement derived from " +
-                               (best[j]->quantity == Quantity::velocity ? "velocity"
-                                                                        : "acceleration") +
-                               " (its mean is unknown and taken as 0)");
+      first.warnings.push_back(
+          r.source + ": no displacement channel x@" + fem::to_string(best[j]->at) +
+          "; displacement derived from " +
+          (best[j]->quantity == Quantity::velocity ? "velocity" : "acceleration") +
+          " (its mean is unknown and taken as 0)");
     else if (velocity_of[j] < 0)
-      first.warnings.push_back(r.source + ": no velocity channel v@" +
-                               fem::to_string(best[j]->at) +
+      first.warnings.push_back(r.source + ": no velocity channel v@" + fem::to_string(best[j]->at) +
                                "; velocity derived from displacement");
   }
   return rows;
