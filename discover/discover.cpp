@@ -265,8 +265,24 @@ private:
 
 Result discover(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,
                 const std::vector<identify::Measurement>& tests, const Options& options) {
-  detail::Problem problem(substructure, start, tests, options);
-  return detail::Loop(problem).run();
+  // A periodic broadband test would need a harmonic balance over every line of its period (or a
+  // time integration per candidate): not supported, said with the test's name.
+  for (const auto& m : tests)
+    if (m.kind == identify::RecordKind::periodic)
+      throw std::invalid_argument(
+          m.source + ": a periodic broadband test (lines every " + fmt::format("{:.6g}", m.frequency_hz) +
+          " Hz): discover re-simulates each test by the harmonic balance of one excitation "
+          "frequency, which this test is not; give discover sine tests, stepped-sine tables or "
+          "sweeps (jointid identify takes periodic records)");
+  // Tests left out (too few steady periods) are passed over, with their reason.
+  std::vector<std::string> left_out;
+  const std::vector<identify::Measurement> kept = identify::usable(tests, left_out);
+  if (kept.empty())
+    throw std::invalid_argument("discover: every test is left out: " + left_out.front());
+  detail::Problem problem(substructure, start, kept, options);
+  Result result = detail::Loop(problem).run();
+  result.warnings.insert(result.warnings.begin(), left_out.begin(), left_out.end());
+  return result;
 }
 
 } // namespace jointid::discover

@@ -112,9 +112,22 @@ Eigen::VectorXd sine_sweep(const SineSweep& spec, const Sampling& sampling) {
 }
 
 Eigen::VectorXd multisine(const Multisine& spec, const Sampling& sampling) {
-  const int n = sample_count(sampling, "multisine");
+  const int total = sample_count(sampling, "multisine");
   check_band(spec.f0_hz, spec.f1_hz, sampling, "multisine", false);
   check_rms(spec.rms, "multisine");
+  int n = total; // samples of a period
+  if (spec.period_s != 0.0) {
+    const double per = spec.period_s * sampling.sample_rate_hz;
+    if (!(std::isfinite(per) && per >= 4.0 && std::abs(per - std::round(per)) <= 1e-6 * per))
+      throw std::invalid_argument("multisine: a period of " + str(spec.period_s) + " s holds " +
+                                  str(per) + " samples at " + str(sampling.sample_rate_hz) +
+                                  " Hz; expected a whole number of samples, at least 4");
+    n = static_cast<int>(std::lround(per));
+    if (total % n != 0)
+      throw std::invalid_argument("multisine: the duration (" + str(total) +
+                                  " samples) is not a whole number of periods of " + str(n) +
+                                  " samples");
+  }
   const double T = n / sampling.sample_rate_hz;
   const auto first = static_cast<long>(std::ceil(spec.f0_hz * T - 1e-9));
   const auto last = static_cast<long>(std::floor(spec.f1_hz * T + 1e-9));
@@ -128,9 +141,9 @@ Eigen::VectorXd multisine(const Multisine& spec, const Sampling& sampling) {
     X(k) = std::polar(1.0, -std::numbers::pi * static_cast<double>(j * (j + 1)) /
                                static_cast<double>(K));
   RealFft fft(n);
-  Eigen::VectorXd x = fft.inverse(X);
-  scale_to_rms(x, spec.rms);
-  return x;
+  Eigen::VectorXd period = fft.inverse(X);
+  scale_to_rms(period, spec.rms);
+  return period.replicate(total / n, 1);
 }
 
 } // namespace jointid::fem

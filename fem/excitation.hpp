@@ -32,12 +32,16 @@ struct SineSweep {
 };
 Eigen::VectorXd sine_sweep(const SineSweep& spec, const Sampling& sampling);
 
-/// Σ_k cos(2π k t / T + φ_k) over the lines k/T in [f0, f1] (T the duration: periodic over the
-/// record), equal amplitudes, Schroeder phases φ_k = −π k'(k'+1)/K (k' = 0 … K−1; a low crest
-/// factor), scaled to the given RMS.
+/// Σ_k cos(2π k t / T + φ_k) over the lines k/T in [f0, f1] (T the period: the duration unless
+/// given, so periodic over the record), equal amplitudes, Schroeder phases
+/// φ_k = −π k'(k'+1)/K (k' = 0 … K−1; a low crest factor), scaled to the given RMS; a period
+/// shorter than the duration is repeated.
 struct Multisine {
   double f0_hz = 0.0, f1_hz = 0.0; ///< band, at least one line k/T in it
   double rms = 1.0;                ///< N or N·m
+  /// s; 0: the duration. Must hold a whole number of samples and divide the duration into a
+  /// whole number of periods.
+  double period_s = 0.0;
 };
 Eigen::VectorXd multisine(const Multisine& spec, const Sampling& sampling);
 

@@ -219,6 +219,7 @@ SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const L
   const int keep = o.output_periods + 1;
   Eigen::MatrixXd u_hist(keep * N, nout), v_hist(keep * N, nout);
   int calm = 0;
+  const int needed = std::max(2, o.output_periods);
   for (int p = 0; p < o.max_periods; ++p) {
     const int slot = p % keep;
     for (int k = 0; k < N; ++k) {
@@ -244,9 +245,11 @@ SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const L
     const double size = std::max(now_u.cwiseAbs().maxCoeff(), 1e-300);
     out.period_change = (now_u - before_u).cwiseAbs().maxCoeff() / size;
     calm = out.period_change < o.tolerance ? calm + 1 : 0;
-    if (calm >= 2 && p + 1 >= keep) break;
+    // Every period given out must agree with the one before it (not only the last two: the
+    // first of a record of many periods would still hold the transient).
+    if (calm >= needed && p + 1 >= keep) break;
   }
-  if (calm < 2) {
+  if (calm < needed) {
     std::ostringstream reason;
     reason << "not a periodic steady state after " << out.periods_run
            << " periods (last period-to-period change " << out.period_change << ", tolerance "

@@ -102,7 +102,8 @@ struct SteadyStateOptions {
   int output_periods = 4;
   int max_periods = 4000;
   /// Converged when two consecutive periods differ by less than this, relative to the
-  /// largest output amplitude, twice in a row.
+  /// largest output amplitude, twice in a row and for every period given out (each of the
+  /// output_periods agrees with the one before it).
   double tolerance = 1e-10;
   NewmarkOptions newmark;
 };

@@ -86,13 +86,33 @@ integrate(const Assembled& system, const SparseMatrix& C, const LocalForces* for
   auto fade = [&](double t) {
     return t >= o.fade_in_s ? 1.0 : 0.5 * (1.0 - std::cos(std::numbers::pi * t / o.fade_in_s));
   };
-  // The linear interpolant, at a fractional sample index, of the samples (faded in).
+  // The force between samples, at a fractional sample index: the cubic through the four
+  // nearest samples (faded in; the linear interpolant with fewer than four). A sampled force
+  // stands for a band-limited one: the linear interpolant would apply its line at f scaled by
+  // sinc²(f/fs), 1 − (π f/fs)²/3 — 4.5e-4 at 3 Hz sampled at 256 Hz, which a resonance turns
+  // into a per-cent error of the response; the cubic's error falls as (f/fs)⁴.
   auto applied = [&](double sample) {
-    const auto i = std::min(static_cast<Eigen::Index>(sample), n - 2);
-    const double tau = sample - static_cast<double>(i);
-    const double t = static_cast<double>(i) * history.dt;
-    const Eigen::VectorXd f = (1.0 - tau) * fade(t) * history.samples.row(i).transpose() +
-                              tau * fade(t + history.dt) * history.samples.row(i + 1).transpose();
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(history.samples.cols());
+    if (n < 4) {
+      const auto i = std::min(static_cast<Eigen::Index>(sample), n - 2);
+      const double tau = sample - static_cast<double>(i);
+      const double t = static_cast<double>(i) * history.dt;
+      f = (1.0 - tau) * fade(t) * history.samples.row(i).transpose() +
+          tau * fade(t + history.dt) * history.samples.row(i + 1).transpose();
+      return Eigen::VectorXd(load(f));
+    }
+    const Eigen::Index first =
+        std::clamp<Eigen::Index>(static_cast<Eigen::Index>(sample) - 1, 0, n - 4);
+    const double x = sample - static_cast<double>(first); // in [0, 3]
+    for (int j = 0; j < 4; ++j) {
+      double w = 1.0; // Lagrange weight of node j of the nodes 0, 1, 2, 3
+      for (int m = 0; m < 4; ++m)
+        if (m != j) w *= (x - m) / static_cast<double>(j - m);
+      if (w == 0.0) continue;
+      const Eigen::Index node = first + j;
+      f += w * fade(static_cast<double>(node) * history.dt) *
+           history.samples.row(node).transpose();
+    }
     return Eigen::VectorXd(load(f));
   };
 

@@ -179,6 +179,7 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
     // The noise expected: a fraction of each channel's RMS, on every sample of `periods`
     // periods, averaged.
     m.periods_averaged = o.periods;
+    m.averaging = o.periods;
     for (std::size_t r = 0; r < m.response_at.size(); ++r) {
       m.channel_noise[r] = o.noise * rms_of(test.record, m.measured_as[r], m.response_at[r]);
       if (std::isfinite(m.velocity_noise[r]))

@@ -1,7 +1,7 @@
 #include "identify/fit.hpp"
 
 #include "fem/assert.hpp"
-
+#include "fem/fft.hpp"
 #include "identify/harmonics.hpp"
 #include "identify/statistics.hpp"
 
@@ -27,6 +27,32 @@ std::string percent(double fraction) {
   s.precision(3);
   s << 100.0 * fraction << " %";
   return s.str();
+}
+
+// Lines 0 … K of a joint's basis functions on one period of its deformation y and rate ẏ (N
+// samples each). A broadband deformation makes basis functions with kinks (ẏ|ẏ|, sign ẏ) rich
+// far above the band, and sampled at the record's rate their content above its Nyquist
+// frequency would fold onto the lines (by 1e-4 of a term's force for ẏ|ẏ| of a 1–8 Hz multisine
+// at 256 Hz): y and ẏ are interpolated to four times the samples (their spectra zero-padded,
+// exact for a band-limited signal) before the basis functions see them.
+Eigen::MatrixXcd basis_lines(const joints::Joint& joint, const Eigen::VectorXd& y,
+                             const Eigen::VectorXd& ydot, double t0, double omega, int K) {
+  constexpr int oversampling = 4;
+  const auto N = static_cast<int>(y.size()), M = oversampling * N;
+  fem::RealFft coarse(N), fine(M);
+  auto interpolate = [&](const Eigen::VectorXd& x) {
+    const Eigen::VectorXcd S = coarse.forward(x);
+    Eigen::VectorXcd padded = Eigen::VectorXcd::Zero(M / 2 + 1);
+    const Eigen::Index keep = (N - 1) / 2; // below Nyquist (its bin is ambiguous: left out)
+    padded.head(keep + 1) = S.head(keep + 1);
+    return Eigen::VectorXd(fine.inverse(padded) / N);
+  };
+  const Eigen::VectorXd yu = interpolate(y), vu = interpolate(ydot);
+  Eigen::MatrixXd g(M, static_cast<Eigen::Index>(joint.terms.size()));
+  for (std::size_t term = 0; term < joint.terms.size(); ++term)
+    for (Eigen::Index r = 0; r < M; ++r)
+      g(r, static_cast<Eigen::Index>(term)) = joints::basis(joint.terms[term], yu(r), vu(r));
+  return period_harmonics(g, t0, omega, K);
 }
 
 } // namespace
@@ -79,6 +105,8 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   }
   const double omega = two_pi * m.frequency_hz;
   const int K = m.harmonics;
+  const bool periodic = m.kind == RecordKind::periodic;
+  s.lines = m.lines;
 
   // Basis functions on the measured deformation y = x(node) − x(node_b), i.e. Y = X2 B.
   const Eigen::MatrixXd B = joints::joint_coordinates_on(joints, dofs, set2);
@@ -103,11 +131,15 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
             m.source + ": joint '" + j.name + "' sticks for " + percent(stuck) +
             " of the record; the Coulomb basis sign(ydot) does not describe the force while stuck");
     }
-    Eigen::MatrixXd g(n, static_cast<Eigen::Index>(j.terms.size()));
-    for (std::size_t term = 0; term < j.terms.size(); ++term)
-      for (Eigen::Index r = 0; r < n; ++r)
-        g(r, static_cast<Eigen::Index>(term)) = joints::basis(j.terms[term], y(r), ydot(r));
-    s.G.push_back(fit_harmonics(m.t, g, omega, K));
+    if (periodic) {
+      s.G.push_back(basis_lines(j, y, ydot, m.t(0), omega, K));
+    } else {
+      Eigen::MatrixXd g(n, static_cast<Eigen::Index>(j.terms.size()));
+      for (std::size_t term = 0; term < j.terms.size(); ++term)
+        for (Eigen::Index r = 0; r < n; ++r)
+          g(r, static_cast<Eigen::Index>(term)) = joints::basis(j.terms[term], y(r), ydot(r));
+      s.G.push_back(fit_harmonics(m.t, g, omega, K));
+    }
     s.y.col(static_cast<Eigen::Index>(i)) = y;
     s.ydot.col(static_cast<Eigen::Index>(i)) = ydot;
   }
@@ -115,12 +147,21 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   // The noise, per analysed sample (averaging P periods divides a sample's variance by P). A
   // scatter below 1e-8 of a channel's amplitude is not measurement noise (a simulated record's
   // periods agree to 1e-10): the noise is then taken as unknown.
-  const double P = m.periods_averaged;
+  const double P = m.averaging;
   s.t = m.t;
   s.derived_harmonics = m.derived_harmonics;
   s.noise_known = !m.fundamental_only;
   auto meaningful = [](double sigma, double amplitude) {
     return sigma > 1e-8 * amplitude && std::isfinite(sigma);
+  };
+  // A channel's own amplitude: its displacement's fundamental (a periodic test: its largest
+  // line) times (kω)^power.
+  auto largest = [&](const Eigen::MatrixXcd& A, Eigen::Index column, int power) {
+    if (!periodic) return std::abs(A(1, column)) * std::pow(omega, power);
+    double a = 0.0;
+    for (int k : m.lines)
+      a = std::max(a, std::abs(A(k, column)) * std::pow(k * omega, power));
+    return a;
   };
   for (std::size_t i = 0; i < set2.size(); ++i) {
     const int r = m.response_index(dofs.node_dof(set2[i]));
@@ -129,14 +170,42 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
     s.x_power.push_back(power);
     s.x_variance.push_back(std::pow(m.channel_noise[r], 2) / P);
     s.v_variance.push_back(std::pow(m.velocity_noise[r], 2) / P);
-    // The channel's own amplitude: its displacement's fundamental times (ω)^power.
-    const double amplitude = std::abs(m.X(1, r)) * std::pow(omega, power);
-    s.noise_known = s.noise_known && meaningful(m.channel_noise[r], amplitude);
+    s.noise_known = s.noise_known && meaningful(m.channel_noise[r], largest(m.X, r, power));
   }
   for (std::size_t f = 0; f < m.force_noise.size(); ++f) {
     s.f_variance.push_back(m.force_noise[f] * m.force_noise[f] / P);
-    s.noise_known = s.noise_known &&
-                    meaningful(m.force_noise[f], std::abs(m.F(1, static_cast<Eigen::Index>(f))));
+    s.noise_known =
+        s.noise_known && meaningful(m.force_noise[f], largest(m.F, static_cast<Eigen::Index>(f), 0));
+  }
+  if (periodic) {
+    // The noise of a periodic test is the scatter of its periods: each one's equations.
+    s.noise_known = s.noise_known && m.periods.size() >= 2;
+    if (s.noise_known) {
+      const auto L = static_cast<Eigen::Index>(m.lines.size());
+      for (const auto& period : m.periods) {
+        TestSpectrum::Period q;
+        q.F = period.F;
+        q.X2.resize(L, static_cast<Eigen::Index>(set2.size()));
+        Eigen::MatrixXd px(n, set2.size()), pv(n, set2.size());
+        for (std::size_t i = 0; i < set2.size(); ++i) {
+          const int r = m.response_index(dofs.node_dof(set2[i]));
+          q.X2.col(static_cast<Eigen::Index>(i)) = period.X.col(r);
+          px.col(static_cast<Eigen::Index>(i)) = period.x.col(r);
+          pv.col(static_cast<Eigen::Index>(i)) = period.v.col(r);
+        }
+        const Eigen::MatrixXd PY = px * B, PYdot = pv * B;
+        for (std::size_t i = 0; i < joints.size(); ++i) {
+          const Eigen::MatrixXcd all =
+              basis_lines(joints[i], PY.col(static_cast<Eigen::Index>(i)),
+                          PYdot.col(static_cast<Eigen::Index>(i)), m.t(0), omega, K);
+          Eigen::MatrixXcd at_lines(L, all.cols());
+          for (Eigen::Index l = 0; l < L; ++l)
+            at_lines.row(l) = all.row(m.lines[static_cast<std::size_t>(l)]);
+          q.G.push_back(std::move(at_lines));
+        }
+        s.periods.push_back(std::move(q));
+      }
+    }
   }
   return s;
 }
@@ -341,21 +410,33 @@ std::vector<std::string> explain_identifiability(const FitResult& result,
     const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
     return result.joints[i].terms[t];
   };
-  // Per joint and test: the fundamental of the deformation and of each term's force b_t g_t.
+  // A test's main line for a joint: the fundamental, or a periodic test's line where the
+  // joint's deformation is largest.
+  auto deformation = [&](const TestSpectrum& test, int joint, int k) {
+    return (test.X2.row(k) * B.col(joint).cast<std::complex<double>>())(0);
+  };
+  auto main_line = [&](const TestSpectrum& test, int joint) {
+    int best = 1;
+    for (int k : test.lines)
+      if (std::abs(deformation(test, joint, k)) > std::abs(deformation(test, joint, best))) best = k;
+    return best;
+  };
+  // Per joint and test: the main line of the deformation and of each term's force b_t g_t.
   auto force_share = [&](Eigen::Index u, std::string& where) {
     const auto [i, t] = unknowns[static_cast<std::size_t>(u)];
     double best = 0.0;
     for (const auto& test : tests) {
       if (test.G[i].rows() < 2) continue;
+      const int k = main_line(test, i);
       std::complex<double> total = 0.0;
       for (std::size_t tt = 0; tt < joints[i].terms.size(); ++tt) {
         const double value = joints[i].fixed[tt] ? joints[i].values[tt] : 0.0;
-        total += test.G[i](1, static_cast<Eigen::Index>(tt)) * value;
+        total += test.G[i](k, static_cast<Eigen::Index>(tt)) * value;
       }
       for (Eigen::Index v = 0; v < nu; ++v)
         if (unknowns[static_cast<std::size_t>(v)].first == i)
-          total += test.G[i](1, unknowns[static_cast<std::size_t>(v)].second) * b(v);
-      const double share = std::abs(test.G[i](1, t) * b(u)) / std::max(std::abs(total), 1e-300);
+          total += test.G[i](k, unknowns[static_cast<std::size_t>(v)].second) * b(v);
+      const double share = std::abs(test.G[i](k, t) * b(u)) / std::max(std::abs(total), 1e-300);
       if (share > best) best = share, where = test.source;
     }
     return best;
@@ -363,9 +444,9 @@ std::vector<std::string> explain_identifiability(const FitResult& result,
   auto amplitude_range = [&](int joint, bool rate) {
     double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
     for (const auto& test : tests) {
-      const std::complex<double> Y1 =
-          (test.X2.row(1) * B.col(joint).cast<std::complex<double>>())(0);
-      const double a = std::abs(Y1) * (rate ? two_pi * test.frequency_hz : 1.0);
+      const int k = main_line(test, joint);
+      const double a =
+          std::abs(deformation(test, joint, k)) * (rate ? two_pi * k * test.frequency_hz : 1.0);
       lo = std::min(lo, a), hi = std::max(hi, a);
     }
     return std::pair{lo, hi};
@@ -444,7 +525,7 @@ Equations equations(const ReceptanceFn& H, const std::vector<int>& set2, const E
   eq.receptances.resize(tests.size());
   for (std::size_t ti = 0; ti < tests.size(); ++ti) {
     const auto& test = tests[ti];
-    for (int k : harmonics) {
+    for (int k : test.lines.empty() ? harmonics : test.lines) {
       if (test.fundamental_only && k != 1) continue;
       if (k < 0 || k >= test.F.rows())
         throw std::invalid_argument("identify: harmonic " + std::to_string(k) + " not extracted");
@@ -493,6 +574,99 @@ Eigen::MatrixXd test_covariance(const Equations& eq, const std::vector<int>& idx
   Eigen::MatrixXd C = equation_covariance(test, these, eq.receptances[ti], at, B);
   C.diagonal().array() += 1e-12 * C.diagonal().mean() + 1e-300;
   return C;
+}
+
+// The covariance of the rows `block` (one line k of a periodic test, in order) from the scatter
+// of its periods' equations Q b − p at the joints' values `at`. With P periods the sample
+// covariance S has P − 1 degrees of freedom: the rows' full covariance is used where P − 1 is
+// at least twice their number q, else only its diagonal (q = 1); S is scaled by
+// (P − 1)/(P − q − 2) where that is defined, so that E[C⁻¹] is the true inverse (a Wishart
+// matrix's inverse is biased by that factor): χ² is then not inflated by the estimate's own
+// scatter.
+Eigen::MatrixXd scatter_covariance(const Equations& eq, const std::vector<int>& block,
+                                   const TestSpectrum& test, std::size_t ti,
+                                   const std::vector<joints::Joint>& at,
+                                   const Eigen::MatrixXd& B) {
+  const int k = eq.rows[static_cast<std::size_t>(block.front())].k;
+  const auto line = static_cast<Eigen::Index>(
+      std::lower_bound(test.lines.begin(), test.lines.end(), k) - test.lines.begin());
+  const Receptances& R = eq.receptances[ti].at(k);
+  const auto P = static_cast<Eigen::Index>(test.periods.size());
+  const auto q = static_cast<Eigen::Index>(block.size());
+  Eigen::MatrixXd E(q, P); // each period's rows
+  for (Eigen::Index p = 0; p < P; ++p) {
+    const TestSpectrum::Period& period = test.periods[static_cast<std::size_t>(p)];
+    // − H22 B g − X2 + H2f F, with g each joint's force at this line.
+    Eigen::VectorXcd g(B.cols());
+    for (Eigen::Index j = 0; j < B.cols(); ++j) {
+      const auto& J = at[static_cast<std::size_t>(j)];
+      Complex sum = 0.0;
+      for (std::size_t t = 0; t < J.terms.size(); ++t)
+        sum += J.values[t] *
+               period.G[static_cast<std::size_t>(j)](line, static_cast<Eigen::Index>(t));
+      g(j) = sum;
+    }
+    const Eigen::VectorXcd r = -R.H22B * g - period.X2.row(line).transpose() +
+                               R.H2f * period.F.row(line).transpose();
+    for (Eigen::Index i = 0; i < q; ++i) {
+      const Row& row = eq.rows[static_cast<std::size_t>(block[static_cast<std::size_t>(i)])];
+      E(i, p) = row.imaginary ? r(row.d).imag() : r(row.d).real();
+    }
+  }
+  const Eigen::MatrixXd centred = E.colwise() - E.rowwise().mean();
+  Eigen::MatrixXd C = centred * centred.transpose() / static_cast<double>(P - 1) / P;
+  const bool full = P - 1 >= 2 * q;
+  if (!full) C = Eigen::MatrixXd(C.diagonal().asDiagonal());
+  const Eigen::Index dims = full ? q : 1;
+  if (P - dims - 2 >= 1) C *= static_cast<double>(P - 1) / static_cast<double>(P - dims - 2);
+  C.diagonal().array() += 1e-12 * C.diagonal().mean() + 1e-300;
+  return C;
+}
+
+// How one test's rows `idx` are whitened: blocks of them (positions in idx) with the Cholesky
+// factor of their covariance. A sine test is one block; a periodic test one per line.
+struct Whitening {
+  std::vector<std::vector<int>> blocks;
+  std::vector<Eigen::LLT<Eigen::MatrixXd>> factors;
+
+  // C^{-1/2} applied to the test's rows (in idx order).
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& rows) const {
+    Eigen::MatrixXd out(rows.rows(), rows.cols());
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      Eigen::MatrixXd part(static_cast<Eigen::Index>(blocks[b].size()), rows.cols());
+      for (std::size_t i = 0; i < blocks[b].size(); ++i)
+        part.row(static_cast<Eigen::Index>(i)) = rows.row(blocks[b][i]);
+      part = factors[b].matrixL().solve(part);
+      for (std::size_t i = 0; i < blocks[b].size(); ++i)
+        out.row(blocks[b][i]) = part.row(static_cast<Eigen::Index>(i));
+    }
+    return out;
+  }
+};
+
+Whitening test_whitening(const Equations& eq, const std::vector<int>& idx,
+                         const TestSpectrum& test, std::size_t ti,
+                         const std::vector<joints::Joint>& at, const Eigen::MatrixXd& B) {
+  Whitening w;
+  if (test.periods.empty()) {
+    w.blocks.emplace_back(idx.size());
+    for (std::size_t i = 0; i < idx.size(); ++i)
+      w.blocks[0][i] = static_cast<int>(i);
+    w.factors.emplace_back(test_covariance(eq, idx, test, ti, at, B));
+    return w;
+  }
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    const int k = eq.rows[static_cast<std::size_t>(idx[i])].k;
+    if (i == 0 || eq.rows[static_cast<std::size_t>(idx[i - 1])].k != k) w.blocks.emplace_back();
+    w.blocks.back().push_back(static_cast<int>(i));
+  }
+  for (const auto& block : w.blocks) {
+    std::vector<int> rows;
+    for (int i : block)
+      rows.push_back(idx[static_cast<std::size_t>(i)]);
+    w.factors.emplace_back(scatter_covariance(eq, rows, test, ti, at, B));
+  }
+  return w;
 }
 } // namespace
 
@@ -641,7 +815,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   const bool propagated =
       o.propagate_noise &&
       std::all_of(tests.begin(), tests.end(), [](const TestSpectrum& t) { return t.noise_known; });
-  std::vector<Eigen::LLT<Eigen::MatrixXd>> whiten(tests.size());
+  std::vector<Whitening> whiten(tests.size());
   std::vector<std::vector<int>> test_rows(tests.size());
   for (int r = 0; r < m; ++r)
     test_rows[static_cast<std::size_t>(rows[static_cast<std::size_t>(r)].test)].push_back(r);
@@ -653,14 +827,14 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
       for (std::size_t ti = 0; ti < tests.size(); ++ti) {
         const auto& idx = test_rows[ti];
         if (idx.empty()) continue;
-        whiten[ti].compute(test_covariance(eq, idx, tests[ti], ti, at, B));
+        whiten[ti] = test_whitening(eq, idx, tests[ti], ti, at, B);
         Eigen::MatrixXd Qi(static_cast<Eigen::Index>(idx.size()), nu);
         Eigen::VectorXd pi(static_cast<Eigen::Index>(idx.size()));
         for (std::size_t r = 0; r < idx.size(); ++r)
           Qi.row(static_cast<Eigen::Index>(r)) = Q.row(idx[r]),
           pi(static_cast<Eigen::Index>(r)) = p(idx[r]);
-        Qi = whiten[ti].matrixL().solve(Qi);
-        pi = whiten[ti].matrixL().solve(pi);
+        Qi = whiten[ti].apply(Qi);
+        pi = whiten[ti].apply(pi);
         for (std::size_t r = 0; r < idx.size(); ++r)
           Qw.row(idx[r]) = Qi.row(static_cast<Eigen::Index>(r)),
           pw(idx[r]) = pi(static_cast<Eigen::Index>(r));
@@ -754,9 +928,9 @@ TestInformation information(const ReceptanceFn& H, const fem::DofMap& dofs,
   for (std::size_t u = 0; u < unknowns.size(); ++u)
     b(static_cast<Eigen::Index>(u)) = joints[static_cast<std::size_t>(unknowns[u].first)]
                                           .values[static_cast<std::size_t>(unknowns[u].second)];
-  const Eigen::LLT<Eigen::MatrixXd> C(test_covariance(eq, idx, test, 0, joints, B));
-  const Eigen::MatrixXd W = C.matrixL().solve(eq.Q);                             // C^-1/2 Q
-  const Eigen::VectorXd w = C.matrixL().solve(Eigen::VectorXd(eq.p - eq.Q * b)); // C^-1/2 r
+  const Whitening C = test_whitening(eq, idx, test, 0, joints, B);
+  const Eigen::MatrixXd W = C.apply(eq.Q);                                            // C^-1/2 Q
+  const Eigen::VectorXd w = C.apply(Eigen::VectorXd(eq.p - eq.Q * b)); // C^-1/2 r
   TestInformation out;
   out.information = W.transpose() * W;
   out.score = W.transpose() * w;
@@ -771,19 +945,20 @@ FitResult fit(const frf::Substructure& sub, const std::vector<joints::Joint>& jo
   if (o.harmonics.empty()) throw std::invalid_argument("identify: no harmonics asked");
   // DOFs the model lacks are left out here: spectrum() names them with their test.
   std::vector<int> dofs = joint_dof_set(joints, sub.dofs());
-  double f_max = 0.0;
+  const int K = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
+  double f_max = 0.0; // the highest frequency an equation uses
   for (const auto& m : measurements) {
-    f_max = std::max(f_max, m.frequency_hz);
+    if (!m.left_out.empty()) continue;
+    f_max = std::max(f_max, m.frequency_hz * (m.lines.empty() ? K : m.lines.back()));
     for (const auto& at : m.force_at)
       if (sub.dofs().state(at) == fem::DofMap::State::free) {
         const int e = sub.dofs().equation(at);
         if (std::find(dofs.begin(), dofs.end(), e) == dofs.end()) dofs.push_back(e);
       }
   }
-  const int K = std::max(1, *std::max_element(o.harmonics.begin(), o.harmonics.end()));
   std::vector<std::string> notes;
   const frf::ModalSynthesis synthesis =
-      sub.synthesis(dofs, frf::synthesis_band_hz(f_max, K), &notes);
+      sub.synthesis(dofs, frf::synthesis_band_hz(f_max, 1), &notes);
   if (!synthesis.status().ok()) {
     FitResult failed;
     failed.status = synthesis.status();
@@ -817,6 +992,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   int tables = 0;
   for (const auto& m : measurements) {
     warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());
+    if (!m.left_out.empty()) continue; // its warning says why
     // Response channels on DOFs the model does not have, or holds fixed, are not used: said.
     for (std::size_t r = 0; r < m.response_at.size(); ++r) {
       const std::string why = dofs.why_not_free(m.response_at[r]);
@@ -828,6 +1004,9 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     tests.push_back(spectrum(m, dofs, joints, warnings));
     tables += m.fundamental_only ? 1 : 0;
   }
+  if (tests.empty())
+    throw std::invalid_argument("identify: every test is left out (" + std::to_string(measurements.size()) +
+                                "; the warnings say why)");
   if (tables > 0 && (o.harmonics.size() != 1 || o.harmonics[0] != 1))
     warnings.push_back(std::to_string(tables) +
                        " test(s) from stepped-sine tables give harmonic 1 only; their other "

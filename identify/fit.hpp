@@ -87,7 +87,8 @@ struct FitResult {
   std::vector<joints::Joint> identified(const std::vector<joints::Joint>& model_joints) const;
 };
 
-/// One test reduced, for these joints, to harmonics 0 … K at its excitation frequency.
+/// One test reduced, for these joints, to harmonics 0 … K at its excitation frequency (a
+/// periodic test: to its lines, the harmonics of 1/T).
 struct TestSpectrum {
   std::string source;
   double frequency_hz = 0.0;
@@ -109,6 +110,20 @@ struct TestSpectrum {
   std::vector<int> x_power;
   std::vector<double> x_variance, v_variance;
   std::vector<double> f_variance; ///< per force channel, of one analysed sample
+
+  /// A periodic test (Measurement::lines): the lines whose equations are used, in place of
+  /// FitOptions::harmonics (empty for sine tests).
+  std::vector<int> lines;
+  /// A periodic test with two or more periods averaged: each period's X2, F and G at `lines`
+  /// (rows in the order of `lines`). The covariance of a line's equations is the scatter of
+  /// the periods' equations about their mean, divided by the periods (errors in variables
+  /// included: the basis functions are evaluated on each period's deformation); the lines are
+  /// taken as independent.
+  struct Period {
+    Eigen::MatrixXcd F, X2;
+    std::vector<Eigen::MatrixXcd> G;
+  };
+  std::vector<Period> periods;
 };
 
 /// The joints' DOFs (set 2), in the order used by TestSpectrum::X2.

@@ -1,8 +1,10 @@
 #include "identify/harmonics.hpp"
 
+#include "fem/fft.hpp"
 #include "fem/minimise.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -47,36 +49,57 @@ double estimate_frequency(const Eigen::VectorXd& t, const Eigen::VectorXd& x) {
   if (n < 4) throw std::invalid_argument("estimate_frequency: need at least 4 samples");
   const double span = t(n - 1) - t(0), dt = span / (n - 1);
   if (!(span > 0.0)) throw std::invalid_argument("estimate_frequency: time does not increase");
+  // The peak of the Hann-windowed spectrum (bins of 1/(n dt) Hz), then the parabola through the
+  // logarithms of its magnitude and its neighbours' (a window whose main lobe is nearly
+  // Gaussian: good to a few hundredths of a bin).
   const double mean = x.mean();
-  auto power = [&](double f) {
-    const double w = 2.0 * std::numbers::pi * f;
-    double c = 0.0, s = 0.0;
-    for (int i = 0; i < n; ++i) {
-      c += (x(i) - mean) * std::cos(w * t(i));
-      s += (x(i) - mean) * std::sin(w * t(i));
-    }
-    return c * c + s * s;
-  };
-  // Coarse grid at a quarter of the DFT resolution, up to Nyquist.
-  const double df = 1.0 / (4.0 * span), f_max = 0.5 / dt;
-  double best_f = df, best_p = -1.0;
-  for (double f = df; f < f_max; f += df) {
-    const double p = power(f);
-    if (p > best_p) best_p = p, best_f = f;
+  Eigen::VectorXd w(n);
+  for (int i = 0; i < n; ++i)
+    w(i) = (x(i) - mean) * 0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * i / n));
+  fem::RealFft fft(n);
+  const Eigen::VectorXd magnitude = fft.forward(w).cwiseAbs();
+  Eigen::Index peak = 1;
+  magnitude.tail(magnitude.size() - 1).maxCoeff(&peak);
+  peak += 1;
+  double offset = 0.0;
+  if (peak + 1 < magnitude.size()) {
+    const double a = std::log(std::max(magnitude(peak - 1), 1e-300)),
+                 b = std::log(std::max(magnitude(peak), 1e-300)),
+                 c = std::log(std::max(magnitude(peak + 1), 1e-300));
+    const double curvature = a - 2.0 * b + c;
+    if (curvature < 0.0) offset = std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
   }
-  // Golden-section refinement around the peak: minimise the residual of a mean + sine fit
-  // (zero at the true frequency of a pure sinusoid; the fitted amplitude is not a safe
-  // criterion, it can exceed the true one off-frequency on a non-whole number of periods).
+  const double bin = 1.0 / (n * dt), estimate = (static_cast<double>(peak) + offset) * bin;
+  // Refinement: minimise the residual of a mean + sine fit (zero at the true frequency of a pure
+  // sinusoid; the fitted amplitude is not a safe criterion, it can exceed the true one
+  // off-frequency on a non-whole number of periods). O(n) per evaluation.
   auto misfit = [&](double f) {
-    const double w = 2.0 * std::numbers::pi * f;
-    const Eigen::VectorXcd X = fit_harmonics(t, x, w, 1);
+    const double omega = 2.0 * std::numbers::pi * f;
+    const Eigen::VectorXcd X = fit_harmonics(t, x, omega, 1);
     double ss = 0.0;
     for (int i = 0; i < n; ++i)
-      ss += std::pow(x(i) - X(0).real() - (X(1) * std::polar(1.0, w * t(i))).real(), 2);
+      ss += std::pow(x(i) - X(0).real() - (X(1) * std::polar(1.0, omega * t(i))).real(), 2);
     return ss;
   };
-  return fem::golden_section_minimum(misfit, std::max(best_f - df, 1e-12), best_f + df, 80,
-                                     1e-12 * best_f);
+  return fem::golden_section_minimum(misfit, std::max(estimate - bin, 0.25 * bin),
+                                     std::min(estimate + bin, 0.5 / dt), 80, 1e-12 * estimate);
+}
+
+Eigen::MatrixXcd period_harmonics(const Eigen::MatrixXd& x, double t0, double omega, int K) {
+  const auto N = static_cast<int>(x.rows());
+  if (K < 0 || 2 * K >= N)
+    throw std::invalid_argument("period_harmonics: harmonic " + std::to_string(K) +
+                                " is not below half the " + std::to_string(N) +
+                                " samples of the period");
+  fem::RealFft fft(N);
+  Eigen::MatrixXcd X(K + 1, x.cols());
+  for (Eigen::Index j = 0; j < x.cols(); ++j) {
+    const Eigen::VectorXcd S = fft.forward(x.col(j));
+    X(0, j) = S(0).real() / N;
+    for (int k = 1; k <= K; ++k) // x(t) = Re(X_k e^{ikω(t − t0)}) · …: shift to absolute time
+      X(k, j) = (2.0 / N) * S(k) * std::polar(1.0, -k * omega * t0);
+  }
+  return X;
 }
 
 int whole_period_samples(const Eigen::VectorXd& t, double frequency_hz) {

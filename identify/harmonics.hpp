@@ -16,9 +16,17 @@ Eigen::VectorXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::VectorXd& 
 Eigen::MatrixXcd fit_harmonics(const Eigen::VectorXd& t, const Eigen::MatrixXd& x, double omega,
                                int K);
 
-/// Frequency (Hz) of the dominant sinusoid in x: a DFT peak search refined by maximising the
-/// least-squares sine-fit amplitude. Throws if the record is shorter than 4 samples.
+/// Frequency (Hz) of the dominant sinusoid in x, in O(N log N): the peak of the Hann-windowed
+/// spectrum (FFT), interpolated between its bins, then refined by minimising the residual of a
+/// least-squares mean + sine fit within one bin of it. Throws if the record is shorter than 4
+/// samples.
 double estimate_frequency(const Eigen::VectorXd& t, const Eigen::VectorXd& x);
+
+/// Harmonics 0 … K of signals sampled uniformly over exactly one period (rows: the N samples of
+/// the period, the first at time t0; columns: signals), by FFT: the same X_k as fit_harmonics
+/// (on one whole period the least-squares fit is the DFT), in O(N log N). Throws unless
+/// 0 <= K < N/2.
+Eigen::MatrixXcd period_harmonics(const Eigen::MatrixXd& x, double t0, double omega, int K);
 
 /// Number of leading samples spanning the largest whole number of periods (at least one
 /// period), or 0 if the record is shorter than one period.

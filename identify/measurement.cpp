@@ -1,6 +1,8 @@
 #include "identify/measurement.hpp"
 
 #include "identify/harmonics.hpp"
+#include "identify/periodic.hpp"
+#include "identify/sweep.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -101,7 +103,26 @@ double noise_variance(const Eigen::VectorXd& raw, const Span& span, double omega
   return (raw - synthesise(span.t, X, omega)).squaredNorm() / dof;
 }
 
-Measurement measure_record(const Record& r, const MeasureOptions& o) {
+// Leading periods of a sine record that are a transient (periodic.hpp's steady_periods), where
+// its periods hold a whole number of samples; -1 when the record is left out (its reason in
+// m.left_out and m.warnings).
+int transient_periods(const Record& r, double frequency_hz, const MeasureOptions& o,
+                      Measurement& m) {
+  const double dt = r.dt(), per_period = 1.0 / (frequency_hz * dt);
+  const auto per = static_cast<int>(std::lround(per_period));
+  if (!o.average_periods || per < 2 || !(std::abs(per_period - per) <= 1e-6 * per_period))
+    return 0;
+  const int periods = whole_period_samples(r.t, frequency_hz) / per;
+  if (periods < 2) return 0;
+  std::vector<const Channel*> all;
+  for (const auto& c : r.channels)
+    all.push_back(&c);
+  const SteadyPeriods steady = steady_periods(all, per, periods, o.period_tolerance);
+  if (!judge_periods(steady, r.source, o.period_tolerance, m)) return -1;
+  return steady.first * per;
+}
+
+Measurement measure_sine(const Record& r, double frequency_hz, const MeasureOptions& o) {
   auto fail = [&](const std::string& what) { throw std::invalid_argument(r.source + ": " + what); };
   const int K = o.harmonics;
   if (K < 1) throw std::invalid_argument("measure: need at least harmonic 1");
@@ -151,8 +172,7 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   if (loaded.empty())
     fail("every force channel is zero in every sample (" + forces.front()->name() +
          "): no force was measured; a sine test needs its force");
-  m.frequency_hz =
-      r.excitation_hz ? *r.excitation_hz : estimate_frequency(r.t, loaded.front()->samples);
+  m.frequency_hz = frequency_hz;
   if (!(m.frequency_hz > 0.0)) fail("excitation frequency must be > 0 Hz");
   const double omega = two_pi * m.frequency_hz, dt = r.dt();
   const int n = whole_period_samples(r.t, m.frequency_hz);
@@ -184,6 +204,7 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   if (span.averaged) {
     span.t = r.t.head(per);
     m.periods_averaged = span.periods;
+    m.averaging = span.periods;
   } else {
     span.t = r.t.head(n);
     span.periods = 1;
@@ -298,6 +319,40 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   return m;
 }
 
+// A sine record: its transient periods dropped (the record analysed from the first steady one)
+// or the whole record left out, then measure_sine.
+Measurement measure_record(const Record& original, double frequency_hz, const MeasureOptions& o) {
+  Measurement transient;
+  transient.source = original.source;
+  int skip = 0;
+  // A record without a force or a response is refused (by measure_sine), never left out.
+  const bool measurable =
+      !original.all(Quantity::force).empty() &&
+      std::any_of(original.channels.begin(), original.channels.end(),
+                  [](const Channel& c) { return c.quantity != Quantity::force; });
+  if (measurable && frequency_hz > 0.0 && whole_period_samples(original.t, frequency_hz) > 0)
+    skip = transient_periods(original, frequency_hz, o, transient);
+  if (skip < 0) {
+    transient.frequency_hz = frequency_hz;
+    return transient;
+  }
+  Measurement m;
+  if (skip == 0) {
+    m = measure_sine(original, frequency_hz, o);
+  } else {
+    Record trimmed;
+    trimmed.source = original.source;
+    trimmed.excitation_hz = original.excitation_hz;
+    trimmed.t = original.t.tail(original.t.size() - skip);
+    for (const auto& c : original.channels)
+      trimmed.channels.push_back({c.quantity, c.at, c.samples.tail(c.samples.size() - skip)});
+    m = measure_sine(trimmed, frequency_hz, o);
+  }
+  m.warnings.insert(m.warnings.begin(), transient.warnings.begin(), transient.warnings.end());
+  m.dropped_periods = transient.dropped_periods;
+  return m;
+}
+
 Measurement measure_phasors(const Phasors& row, const MeasureOptions& o) {
   auto fail = [&](const std::string& what) {
     throw std::invalid_argument(row.source + ": " + what);
@@ -397,22 +452,70 @@ int Measurement::force_index(const fem::NodeDof& at) const {
   return -1;
 }
 
+namespace {
+Measurement measure_classified(const Record* record, const RecordClass& kind,
+                               const MeasureOptions& options) {
+  switch (kind.kind) {
+  case RecordKind::sine:
+    return measure_record(*record, kind.frequency_hz, options);
+  case RecordKind::periodic:
+    return measure_periodic(*record, kind, options);
+  case RecordKind::sweep:
+    break;
+  }
+  throw std::invalid_argument(record->source +
+                              ": a sweep gives a stepped-sine row per window: measure the list of "
+                              "tests (or identify::reduce_sweep) to get them");
+}
+} // namespace
+
 Measurement measure(const SineTest& test, const MeasureOptions& options) {
-  if (const auto* record = std::get_if<Record>(&test)) return measure_record(*record, options);
-  return measure_phasors(std::get<Phasors>(test), options);
+  const auto* record = std::get_if<Record>(&test);
+  if (!record) return measure_phasors(std::get<Phasors>(test), options);
+  return measure_classified(record, classify(*record), options);
 }
 
 std::vector<Measurement> measure(const std::vector<SineTest>& tests,
                                  const MeasureOptions& options) {
   std::vector<Measurement> out;
   out.reserve(tests.size());
-  for (const auto& t : tests)
+  for (const auto& t : tests) {
+    const auto* record = std::get_if<Record>(&t);
+    if (record) {
+      const RecordClass kind = classify(*record);
+      if (kind.kind == RecordKind::sweep) {
+        for (auto& row : reduce_sweep(*record, kind, options))
+          out.push_back(std::move(row));
+      } else {
+        out.push_back(measure_classified(record, kind, options));
+      }
+      continue;
+    }
     out.push_back(measure(t, options));
+  }
+  return out;
+}
+
+std::vector<Measurement> usable(const std::vector<Measurement>& measurements,
+                                std::vector<std::string>& notes) {
+  std::vector<Measurement> out;
+  for (const auto& m : measurements) {
+    if (m.left_out.empty())
+      out.push_back(m);
+    else
+      notes.push_back(m.left_out);
+  }
   return out;
 }
 
 double force_level(const Measurement& m) {
-  return m.F.cols() > 0 && m.F.rows() > 1 ? m.F.row(1).cwiseAbs().maxCoeff() : 0.0;
+  if (m.F.cols() == 0 || m.F.rows() < 2) return 0.0;
+  if (m.kind != RecordKind::periodic) return m.F.row(1).cwiseAbs().maxCoeff();
+  // A periodic test: the RMS of its largest force channel over its lines.
+  double level = 0.0;
+  for (Eigen::Index c = 0; c < m.F.cols(); ++c)
+    level = std::max(level, std::sqrt(0.5 * m.F.col(c).tail(m.F.rows() - 1).squaredNorm()));
+  return level;
 }
 
 } // namespace jointid::identify

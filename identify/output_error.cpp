@@ -126,7 +126,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
         const double omega = 2.0 * std::numbers::pi * m.frequency_hz;
         const Eigen::VectorXcd V = fit_harmonics(m.t, Eigen::VectorXd(m.v.col(rc)), omega, K);
         const double var =
-            4.0 * sv * sv / (static_cast<double>(m.t.size()) * std::max(m.periods_averaged, 1));
+            4.0 * sv * sv / (static_cast<double>(m.t.size()) * std::max(m.averaging, 1e-300));
         for (const int k : o.harmonics)
           if (k >= 1 && k <= m.harmonics) {
             entries.push_back({static_cast<int>(i), k, out, true, V(k), std::sqrt(var / 2.0)});
@@ -424,11 +424,19 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
 FitResult output_error(const frf::Substructure& sub, const std::vector<joints::Joint>& joints,
                        const std::vector<Measurement>& tests, const FitOptions& fit_options,
                        const OutputErrorOptions& o) {
+  for (const Measurement& m : tests)
+    if (m.kind == RecordKind::periodic)
+      throw std::invalid_argument(
+          m.source + ": a periodic broadband test: output error re-simulates each test by the "
+                     "harmonic balance of one excitation frequency, which this test is not; "
+                     "identify it by equation error (without --output-error)");
   const FitResult start = fit(sub, joints, tests, fit_options);
   if (!start.status.ok()) return start;
+  std::vector<std::string> left_out; // their warnings are in the fit's already
+  const std::vector<Measurement> usable_tests = usable(tests, left_out);
   std::vector<int> equations = joint_dof_set(joints, sub.dofs());
   double f_max = 0.0;
-  for (const Measurement& m : tests) {
+  for (const Measurement& m : usable_tests) {
     f_max = std::max(f_max, m.frequency_hz);
     for (const auto* list : {&m.force_at, &m.response_at})
       for (const fem::NodeDof& at : *list)
@@ -447,7 +455,7 @@ FitResult output_error(const frf::Substructure& sub, const std::vector<joints::J
     failed.warnings = std::move(notes);
     return failed;
   }
-  FitResult out = output_error(H, sub.dofs(), joints, tests, start, o);
+  FitResult out = output_error(H, sub.dofs(), joints, usable_tests, start, o);
   for (const std::string& note : notes) // those of the fit's own synthesis are there already
     if (std::find(out.warnings.begin(), out.warnings.end(), note) == out.warnings.end())
       out.warnings.push_back(note);

@@ -50,6 +50,8 @@ ForceInput force_input(const Record& record) {
             names += (names.empty() ? "" : ", ") + c->name();
           return names;
         }()));
+  in.period_s = record.period_s;
+  in.sweep = record.sweep;
   in.description = fmt::format(
       "force: the channels {} of {}",
       [&] {
@@ -210,6 +212,8 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
   // 4. The record.
   Record& rec = test.record;
   rec.t = r.t;
+  rec.period_s = in.period_s;
+  rec.sweep = in.sweep;
   for (std::size_t j = 0; j < in.at.size(); ++j) {
     Eigen::VectorXd applied = in.samples.col(static_cast<Eigen::Index>(j));
     for (Eigen::Index i = 0; i < applied.size(); ++i) {
@@ -268,11 +272,16 @@ ForceInput generated_force(const ExcitationSpec& s, const fem::NodeDof& at) {
     break;
   case Excitation::sweep:
     input.samples = fem::sine_sweep({s.f0_hz, s.f1_hz, s.level, false}, sampling);
+    input.sweep = true;
     input.description = fmt::format("excitation: linear sine sweep {}-{} Hz, amplitude {} N (peak)",
                                     s.f0_hz, s.f1_hz, s.level);
     break;
   case Excitation::multisine:
-    input.samples = fem::multisine({s.f0_hz, s.f1_hz, s.level}, sampling);
+    input.samples = fem::multisine({s.f0_hz, s.f1_hz, s.level, s.period_s}, sampling);
+    // The period as sampled: a whole number of samples (the record's comment says it).
+    input.period_s = (s.period_s > 0.0 ? std::round(s.period_s * s.sample_rate_hz)
+                                       : static_cast<double>(input.samples.rows())) /
+                     s.sample_rate_hz;
     input.description =
         fmt::format("excitation: multisine, lines k/T in {}-{} Hz, Schroeder phases, RMS {} N",
                     s.f0_hz, s.f1_hz, s.level);

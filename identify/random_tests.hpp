@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,9 @@ struct ForceInput {
   Eigen::MatrixXd samples; ///< n_samples × |at|, N or N·m
   double sample_rate_hz = 0.0;
   std::string description; ///< how it was made, for the record's comments
+  /// What the force is, for the record's comments: a periodic force's period (s), a sweep.
+  std::optional<double> period_s;
+  bool sweep = false;
 };
 
 struct ForcedTest {
@@ -55,7 +59,9 @@ struct ForcedTest {
   /// (not_converging, the reason says when; the record holds nothing), the modal analysis or
   /// the effective stiffness failed.
   fem::Status status;
-  Record record; ///< the force channels as applied (faded in), then x/v/a at every output
+  /// The force channels as applied (faded in), then x/v/a at every output; the input's
+  /// period_s or sweep.
+  Record record;
   std::vector<std::string> comments; ///< how it was made, for the CSV's comment lines
   std::vector<std::string> warnings;
   int modes_kept = 0;     ///< modal route: modes integrated
@@ -79,6 +85,7 @@ struct ExcitationSpec {
   double f0_hz = 0.0, f1_hz = 0.0, level = 0.0; ///< Hz, N or N·m
   std::uint64_t seed = 1;                       ///< random only
   double duration_s = 0.0, sample_rate_hz = 0.0;
+  double period_s = 0.0; ///< multisine only: its period, repeated (0: the duration)
 };
 
 /// The force history of the spec at `at`, with its description for the record's comments.
@@ -88,8 +95,9 @@ ForceInput generated_force(const ExcitationSpec& spec, const fem::NodeDof& at);
 /// The record's file name: "random_2-40Hz_40N_seed1.csv", "sweep_2-40Hz_10N.csv", …
 std::string excitation_record_name(const ExcitationSpec& spec);
 
-/// The force channels of a record as a ForceInput (every `f@` channel; std::invalid_argument
-/// naming the record when it has none or its sampling is not uniform).
+/// The force channels of a record as a ForceInput (every `f@` channel, and its period_s or
+/// sweep; std::invalid_argument naming the record when it has none or its sampling is not
+/// uniform).
 ForceInput force_input(const Record& record);
 
 /// The fade-in (ForcedOptions::fade_in_s) of a generated force unless told otherwise: 5 % of

@@ -27,7 +27,11 @@ struct Record {
   std::string source; ///< file name, for messages
   Eigen::VectorXd t;  ///< s, uniform
   std::vector<Channel> channels;
-  std::optional<double> excitation_hz;
+  /// What the record's comments declare it to be (DESIGN.md's contract); unset: told from the
+  /// force channel (identify/record_kind.hpp).
+  std::optional<double> excitation_hz; ///< `# excitation_hz = F`: a sine test at F Hz
+  std::optional<double> period_s;      ///< `# period_s = T`: a periodic broadband test
+  bool sweep = false;                  ///< `# excitation = sweep`: a sine sweep
   /// The channel of this quantity at this DOF, or nullptr.
   const Channel* find(Quantity q, const fem::NodeDof& at) const;
   std::vector<const Channel*> all(Quantity q) const;

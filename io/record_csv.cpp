@@ -136,6 +136,14 @@ std::vector<std::vector<double>> parse_rows(const CsvText& csv,
   return data;
 }
 
+// `key = value` (spaces around '=' optional): the value, else nothing.
+std::optional<std::string_view> declared_value(std::string_view text, std::string_view key) {
+  if (!text.starts_with(key)) return std::nullopt;
+  const std::string_view after = trim(text.substr(key.size()));
+  if (after.empty() || after.front() != '=') return std::nullopt; // some other comment
+  return trim(after.substr(1));
+}
+
 std::string shortest(double value) {
   return fmt::format("{}", value);
 }
@@ -147,20 +155,54 @@ identify::Record read_record(const std::filesystem::path& path) {
   identify::Record record;
   record.source = path.string();
 
+  // The comments that declare what the record is: `key = value`, other comments ignored.
+  auto declared = [](const Line& c, std::string_view key) { return declared_value(c.text, key); };
+  int sine_line = 0, period_line = 0, sweep_line = 0;
   for (const Line& c : csv.comments) {
-    if (!c.text.starts_with("excitation_hz")) continue;
-    const std::string_view after = trim(c.text.substr(std::string_view("excitation_hz").size()));
-    if (after.empty() || after.front() != '=') continue; // some other comment
-    const std::string_view value_text = trim(after.substr(1));
-    const auto value = parse_double(value_text);
-    if (!value || !std::isfinite(*value) || !(*value > 0.0))
-      csv.fail(c.number,
-               fmt::format("excitation_hz: expected a frequency > 0 Hz, got \"{}\"", value_text));
-    if (record.excitation_hz && *record.excitation_hz != *value)
-      csv.fail(c.number, fmt::format("excitation_hz given twice ({} and {} Hz)",
-                                     *record.excitation_hz, *value));
-    record.excitation_hz = *value;
+    if (const auto value_text = declared(c, "excitation_hz")) {
+      const auto value = parse_double(*value_text);
+      if (!value || !std::isfinite(*value) || !(*value > 0.0))
+        csv.fail(c.number, fmt::format("excitation_hz: expected a frequency > 0 Hz, got \"{}\"",
+                                       *value_text));
+      if (record.excitation_hz && *record.excitation_hz != *value)
+        csv.fail(c.number, fmt::format("excitation_hz given twice ({} and {} Hz)",
+                                       *record.excitation_hz, *value));
+      record.excitation_hz = *value;
+      sine_line = c.number;
+    } else if (const auto period_text = declared(c, "period_s")) {
+      const auto value = parse_double(*period_text);
+      if (!value || !std::isfinite(*value) || !(*value > 0.0))
+        csv.fail(c.number,
+                 fmt::format("period_s: expected the period of a periodic test, a time > 0 s, "
+                             "got \"{}\"",
+                             *period_text));
+      if (record.period_s && *record.period_s != *value)
+        csv.fail(c.number,
+                 fmt::format("period_s given twice ({} and {} s)", *record.period_s, *value));
+      record.period_s = *value;
+      period_line = c.number;
+    } else if (const auto kind = declared(c, "excitation")) {
+      if (*kind != "sweep")
+        csv.fail(c.number,
+                 fmt::format("excitation: expected \"sweep\" (a sine sweep), got \"{}\" (a sine "
+                             "test is declared by excitation_hz = F, a periodic test by "
+                             "period_s = T)",
+                             *kind));
+      record.sweep = true;
+      sweep_line = c.number;
+    }
   }
+  // One record is one kind of test.
+  const std::pair<int, const char*> kinds[] = {{sine_line, "excitation_hz (a sine test)"},
+                                               {period_line, "period_s (a periodic test)"},
+                                               {sweep_line, "excitation = sweep (a sweep)"}};
+  for (std::size_t a = 0; a < 3; ++a)
+    for (std::size_t b = a + 1; b < 3; ++b)
+      if (kinds[a].first > 0 && kinds[b].first > 0)
+        csv.fail(std::max(kinds[a].first, kinds[b].first),
+                 fmt::format("{} and {} both declared (lines {} and {}): a record is one kind "
+                             "of test",
+                             kinds[a].second, kinds[b].second, kinds[a].first, kinds[b].first));
 
   // Header: t, then channels.
   const auto names = split_fields(csv.header.text);
@@ -248,6 +290,12 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
   if (!record.t.allFinite()) throw Error(name + ": t has NaN or infinite values");
   if (record.excitation_hz && !std::isfinite(*record.excitation_hz))
     throw Error(name + ": excitation_hz is not a finite number");
+  if (record.period_s && !(std::isfinite(*record.period_s) && *record.period_s > 0.0))
+    throw Error(name + ": period_s is not a time > 0 s");
+  if (static_cast<int>(record.excitation_hz.has_value()) +
+          static_cast<int>(record.period_s.has_value()) + static_cast<int>(record.sweep) >
+      1)
+    throw Error(name + ": excitation_hz, period_s and sweep: a record is one kind of test");
 
   std::string out;
   out.reserve(static_cast<std::size_t>(n) * (record.channels.size() + 1) * 24 + 256);
@@ -257,10 +305,10 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
     while (true) { // one "# " line per line of the comment
       const auto newline = rest.find('\n');
       const std::string_view line = trim(rest.substr(0, newline));
-      if (line.starts_with("excitation_hz"))
-        throw Error(
-            name +
-            ": a comment may not start with 'excitation_hz' (it is written from the record)");
+      for (const char* key : {"excitation_hz", "period_s", "excitation"})
+        if (declared_value(line, key))
+          throw Error(name + ": a comment may not be '" + key +
+                      " = ...' (it is written from the record)");
       out += line.empty() ? std::string("#\n") : fmt::format("# {}\n", line);
       if (newline == std::string_view::npos) break;
       rest = rest.substr(newline + 1);
@@ -268,6 +316,8 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
   }
   if (record.excitation_hz)
     fmt::format_to(inserter, "# excitation_hz = {}\n", shortest(*record.excitation_hz));
+  if (record.period_s) fmt::format_to(inserter, "# period_s = {}\n", shortest(*record.period_s));
+  if (record.sweep) out += "# excitation = sweep\n";
   out += "t";
   for (const auto& c : record.channels)
     fmt::format_to(inserter, ",{}", c.name());

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace jointid::cli {
 
@@ -32,7 +33,13 @@ public:
         .add_option("TESTS", records_, "Measurement records or stepped-sine tables (CSV)")
         ->required();
     app().add_option("-o,--output", output_, "Result file (JSON)")->required();
-    add_harmonics(fit_.harmonics, "Harmonics whose equations are used, e.g. 1,2,3");
+    add_harmonics(fit_.harmonics,
+                  "Harmonics whose equations are used, e.g. 1,2,3 (a periodic test: its lines "
+                  "where a response stands out of the noise, up to the largest of these times the "
+                  "highest excited line)");
+    app().add_option("--band", band_,
+                     "F0:F1 in Hz: a periodic test's excited lines used (default: all); its other "
+                     "lines from F0 up");
     app().add_option("--fit-png", fit_png_,
                      "Picture (PNG) of each test's joint displacements with their harmonic fits");
     app().add_option("--params-png", params_png_,
@@ -61,6 +68,7 @@ private:
   identify::OutputErrorOptions refined_; ///< its harmonic balance; the library's defaults
   fs::path fit_png_, params_png_;        ///< not empty: the pictures
   bool output_error_ = false;
+  std::string band_; ///< F0:F1, Hz; empty: every line
 };
 
 void Identify::run() {
@@ -72,6 +80,8 @@ void Identify::run() {
     check_balance_harmonics(refined_.balance.harmonics, std::max(K, 1),
                             "the largest of --harmonics");
   }
+  identify::MeasureOptions measure = identify::measure_options(fit_);
+  if (!band_.empty()) std::tie(measure.band_from_hz, measure.band_to_hz) = parse_band("--band", band_);
   check_output_file(output_);
   for (const fs::path& png : {fit_png_, params_png_})
     if (!png.empty()) check_output_file(png);
@@ -85,8 +95,7 @@ void Identify::run() {
   io::check_not_an_input(output_);
   for (const fs::path& png : {fit_png_, params_png_})
     if (!png.empty()) io::check_not_an_input(png);
-  const std::vector<identify::Measurement> measured =
-      identify::measure(tests, identify::measure_options(fit_));
+  const std::vector<identify::Measurement> measured = identify::measure(tests, measure);
 
   // 3. Identify. A status other than ok is the reason, passed up whole.
   identify::OutputErrorOptions refined = refined_;

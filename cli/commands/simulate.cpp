@@ -49,6 +49,7 @@ private:
   double rms_ = 0.0;         ///< N or N·m
   double duration_ = 0.0;    ///< s
   double sample_rate_ = 0.0; ///< Hz
+  double period_ = 0.0;      ///< s, multisine: its period (0: the duration)
   TransientOptions transient_;
   std::optional<double> fade_in_; ///< s; not given: the library's default
   fs::path force_from_;
@@ -114,6 +115,10 @@ Simulate::Simulate(CLI::App& parent)
   app.add_option("--duration", duration_, "Record length, s (random, sweep, multisine)");
   app.add_option("--sample-rate", sample_rate_,
                  "Samples per second of the record, Hz (random, sweep, multisine)");
+  app.add_option("--period", period_,
+                 "Multisine: its period, s, repeated over --duration (a whole number of samples "
+                 "and of periods; default: the duration, one period). The record says it in a "
+                 "'# period_s' comment");
   transient_.add_to(app, " (random, sweep, multisine, record)");
   app.add_option("--force-from", force_from_,
                  "--excitation record: a record (CSV) whose f@NODE:DOF channels drive the model");
@@ -137,6 +142,7 @@ void Simulate::run_sine() {
       !force_from_.empty())
     throw io::Error("--band, --rms, --duration, --sample-rate, --force-from: only with "
                     "--excitation random, sweep, multisine or record");
+  if (period_ != 0.0) throw io::Error("--period: only with --excitation multisine");
   if (force_.empty()) throw io::Error("--force: expected NODE:DOF of the sine force, e.g. 7:uy");
   if (frequencies_.empty()) throw io::Error("--freq: expected at least one frequency (Hz)");
   for (double f : frequencies_)
@@ -224,6 +230,10 @@ void Simulate::run_sine() {
 
 std::tuple<double, double, double> Simulate::check_signal_options() const {
   const std::string& kind = excitation_;
+  if (period_ != 0.0 && kind != "multisine")
+    throw io::Error(fmt::format("--period: only with --excitation multisine, not {}", kind));
+  if (!(std::isfinite(period_) && period_ >= 0.0))
+    throw io::Error(fmt::format("--period: expected a period > 0 s, got {}", period_));
   if (!frequencies_.empty())
     throw io::Error(fmt::format("--freq: only for sine tests, not --excitation {}", kind));
   if (method_ != "time")
@@ -305,11 +315,12 @@ void Simulate::run_signal() {
                                         level,
                                         seed_,
                                         duration_,
-                                        sample_rate_};
+                                        sample_rate_,
+                                        period_};
     try {
       input = identify::generated_force(spec, {}); // the DOF is resolved with the model
     } catch (const std::invalid_argument& e) {
-      throw io::Error(std::string("--band, --duration, --sample-rate: ") + e.what());
+      throw io::Error(std::string("--band, --duration, --sample-rate, --period: ") + e.what());
     }
     fade = fade_in_.value_or(identify::default_fade_in_s(spec));
     name = identify::excitation_record_name(spec);
