@@ -27,7 +27,9 @@ struct Record {
   std::string source; ///< file name, for messages
   Eigen::VectorXd t;  ///< s, uniform
   std::vector<Channel> channels;
-  std::optional<double> excitation_hz;
+  std::optional<double> excitation_hz; ///< Hz: a sine test (`# excitation_hz = F`)
+  /// s: a periodic broadband test, e.g. a multisine (`# period_s = T`)
+  std::optional<double> period_s;
   /// The channel of this quantity at this DOF, or nullptr.
   const Channel* find(Quantity q, const fem::NodeDof& at) const;
   std::vector<const Channel*> all(Quantity q) const;

@@ -147,20 +147,24 @@ identify::Record read_record(const std::filesystem::path& path) {
   identify::Record record;
   record.source = path.string();
 
-  for (const Line& c : csv.comments) {
-    if (!c.text.starts_with("excitation_hz")) continue;
-    const std::string_view after = trim(c.text.substr(std::string_view("excitation_hz").size()));
-    if (after.empty() || after.front() != '=') continue; // some other comment
-    const std::string_view value_text = trim(after.substr(1));
-    const auto value = parse_double(value_text);
-    if (!value || !std::isfinite(*value) || !(*value > 0.0))
-      csv.fail(c.number,
-               fmt::format("excitation_hz: expected a frequency > 0 Hz, got \"{}\"", value_text));
-    if (record.excitation_hz && *record.excitation_hz != *value)
-      csv.fail(c.number, fmt::format("excitation_hz given twice ({} and {} Hz)",
-                                     *record.excitation_hz, *value));
-    record.excitation_hz = *value;
-  }
+  // `# excitation_hz = F` (a sine test) and `# period_s = T` (a periodic broadband test).
+  auto read_comment = [&](std::string_view key, std::string_view what, std::string_view unit,
+                          std::optional<double>& into) {
+    for (const Line& c : csv.comments) {
+      if (!c.text.starts_with(key)) continue;
+      const std::string_view after = trim(c.text.substr(key.size()));
+      if (after.empty() || after.front() != '=') continue; // some other comment
+      const std::string_view value_text = trim(after.substr(1));
+      const auto value = parse_double(value_text);
+      if (!value || !std::isfinite(*value) || !(*value > 0.0))
+        csv.fail(c.number, fmt::format("{}: expected {}, got \"{}\"", key, what, value_text));
+      if (into && *into != *value)
+        csv.fail(c.number, fmt::format("{} given twice ({} and {} {})", key, *into, *value, unit));
+      into = *value;
+    }
+  };
+  read_comment("excitation_hz", "a frequency > 0 Hz", "Hz", record.excitation_hz);
+  read_comment("period_s", "a period > 0 s", "s", record.period_s);
 
   // Header: t, then channels.
   const auto names = split_fields(csv.header.text);
@@ -248,6 +252,8 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
   if (!record.t.allFinite()) throw Error(name + ": t has NaN or infinite values");
   if (record.excitation_hz && !std::isfinite(*record.excitation_hz))
     throw Error(name + ": excitation_hz is not a finite number");
+  if (record.period_s && !(std::isfinite(*record.period_s) && *record.period_s > 0.0))
+    throw Error(name + ": period_s is not a finite number > 0");
 
   std::string out;
   out.reserve(static_cast<std::size_t>(n) * (record.channels.size() + 1) * 24 + 256);
@@ -257,10 +263,10 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
     while (true) { // one "# " line per line of the comment
       const auto newline = rest.find('\n');
       const std::string_view line = trim(rest.substr(0, newline));
-      if (line.starts_with("excitation_hz"))
-        throw Error(
-            name +
-            ": a comment may not start with 'excitation_hz' (it is written from the record)");
+      for (const char* key : {"excitation_hz", "period_s"})
+        if (line.starts_with(key))
+          throw Error(fmt::format(
+              "{}: a comment may not start with '{}' (it is written from the record)", name, key));
       out += line.empty() ? std::string("#\n") : fmt::format("# {}\n", line);
       if (newline == std::string_view::npos) break;
       rest = rest.substr(newline + 1);
@@ -268,6 +274,7 @@ std::string record_csv(const identify::Record& record, const std::vector<std::st
   }
   if (record.excitation_hz)
     fmt::format_to(inserter, "# excitation_hz = {}\n", shortest(*record.excitation_hz));
+  if (record.period_s) fmt::format_to(inserter, "# period_s = {}\n", shortest(*record.period_s));
   out += "t";
   for (const auto& c : record.channels)
     fmt::format_to(inserter, ",{}", c.name());
