@@ -424,8 +424,29 @@ ModalFit modal_fit(const MeasuredFrfs& data, const ModalFitOptions& o) {
                     max_order, data.frequency_hz(0), f_top, threshold);
   }
 
-  // 4. Residues, shapes and the model.
+  // 4. Residues, shapes and the model. Chosen by the diagram alone (no number of modes asked), a
+  //    pole whose driving-point residue is not > 0 is no mode of a passive structure (φ_d² > 0):
+  //    it is dropped and the residues fitted again without it.
   fit_residues(data, o, fit);
+  if (o.modes == 0) {
+    const int d = data.drive_column();
+    std::vector<FittedMode> kept;
+    for (const FittedMode& m : fit.modes) {
+      if (m.residues(d) > 0.0) {
+        kept.push_back(m);
+        continue;
+      }
+      fit.warnings.push_back(fmt::format(
+          "a pole at {:.6g} Hz (ζ = {:.3g}), stable at {} orders of the diagram, has a residue "
+          "{:.3g} at the driving point {}, not > 0: not taken as a mode (a computational pole, "
+          "or a mode with a node at the driving point: give the number of modes to keep it)",
+          m.frequency_hz, m.damping, m.stable_orders, m.residues(d), data.drive_name));
+    }
+    if (kept.size() < fit.modes.size()) {
+      fit.modes = std::move(kept);
+      fit_residues(data, o, fit);
+    }
+  }
   build_model(data, o, fit);
   if (fit.status == ModalFitStatus::ok && fit.substructure.num_modes() == 0) {
     fit.status = ModalFitStatus::too_few_modes;

@@ -19,7 +19,8 @@
 ///    most orders (each order giving at most its pole nearest the group's centre, within
 ///    frequency_tolerance of it) is a mode, its frequency and damping the medians of its poles;
 ///    then the next group among the poles left. With `modes` = N the N best-supported groups;
-///    without, every group with poles at 40 % of the orders or more (at least 3).
+///    without, every group with poles at 40 % of the orders or more (at least 3) whose residue
+///    at the driving point (step 4) is > 0, as a mode of a passive structure has (φ_d² > 0).
 /// 4. Residues (least-squares frequency domain, LSFD) with the selected poles fixed, per
 ///    response o, real normal modes:
 ///        H_o(ω) ≈ Σ_r a_or / (ω_r² − ω² + 2iζ_r ω_r ω) − L_o/ω² + U_o
