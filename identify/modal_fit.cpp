@@ -302,8 +302,10 @@ void build_model(const MeasuredFrfs& data, const ModalFitOptions& o, ModalFit& f
   } else if (o.upper_residual) {
     model.residual_flexibility.resize(0, 0);
     fit.warnings.push_back(fmt::format(
-        "the upper residual at the driving point {} is {:.3g} m/N, not > 0 (the modes above the "
-        "band add flexibility there): no residual flexibility in the model",
+        "the upper residual at the driving point {} is {:.3g} m/N, not > 0 as the modes above the "
+        "band would make it: the residual terms took up what the modes fitted leave unexplained "
+        "(often a mode just below the band), so no residual flexibility is in the model; a band "
+        "that starts below every mode gives one",
         data.drive_name, Ud));
   }
   // The model's FRFs from the drive, as a `[modal]` model gives them.
@@ -471,9 +473,10 @@ ModalFit modal_fit(const MeasuredFrfs& data, const ModalFitOptions& o) {
                            std::max(std::abs(data.H(0, c)), 1e-300);
       if (share > 0.05) {
         fit.warnings.push_back(fmt::format(
-            "the modes below the band (the lower residual) make {:.0f} % of {} at {:.6g} Hz; a "
-            "[modal] model has no lower residual, so the model leaves them out: start the band "
-            "below them to fit them as modes",
+            "the lower residual (the modes below the band, or what the modes fitted leave "
+            "unexplained at its bottom) makes {:.0f} % of {} at {:.6g} Hz; a [modal] model has no "
+            "lower residual, so the model leaves it out: start the band below those modes to fit "
+            "them as modes",
             100.0 * share, data.response_names[static_cast<std::size_t>(c)], data.frequency_hz(0)));
         break;
       }

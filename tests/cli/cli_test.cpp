@@ -2088,6 +2088,18 @@ TEST_F(ModalFitCli, BadInputsAreRefusedAndNothingIsWritten) {
   const fs::path table = dir() / "table.csv";
   test::write_text(table, "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im\n3,1,0,1e-3,0\n");
   expect_one_line_error(fit(table, {"--band", "5:30"}), "a stepped-sine table");
+  // Records and FRF files together; a file given twice.
+  const fs::path frf_file = dir() / "h.csv";
+  test::write_text(frf_file, "# drive = 7:uy\nfreq_hz,7:uy.re,7:uy.im\n1,1e-3,0\n2,2e-3,0\n");
+  const Outcome both = jointid({"modal-fit", good.string(), frf_file.string(), "--band", "5:30",
+                                "--no-plot", "-o", out.string()},
+                               dir());
+  expect_one_line_error(both, "is a time record but " + frf_file.string() +
+                                  " holds FRFs: give modal-fit one or the other");
+  expect_one_line_error(jointid({"modal-fit", good.string(), good.string(), "--band", "5:30",
+                                 "--no-plot", "-o", out.string()},
+                                dir()),
+                        good.string() + ": given twice");
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -241,6 +241,57 @@ TEST(ModalFit, RefusesWhatItCannotFit) {
             std::string::npos);
 }
 
+TEST(ModalFit, WarnsAboutWhatTheModelCannotHold) {
+  // Two DOFs, the drive at the first; FRFs made term by term: mode 1 (12 Hz) as a passive
+  // structure's, "mode" 2 (20 Hz) with a negative residue at the driving point (no mode of a
+  // passive structure has one), a negative constant (an upper residual ≤ 0).
+  MeasuredFrfs d;
+  d.drive = {1, fem::Dof::uy};
+  d.drive_name = "f@1:uy";
+  d.responses = {{1, fem::Dof::uy}, {2, fem::Dof::uy}};
+  d.response_names = {"a@1:uy", "a@2:uy"};
+  d.measured_as = {Quantity::acceleration, Quantity::acceleration};
+  d.frequency_hz = lines(5.0, 30.0, 0.02);
+  d.H.resize(d.frequency_hz.size(), 2);
+  const double a1[] = {0.09, 0.06}, a2[] = {-0.04, 0.05};
+  for (Eigen::Index j = 0; j < d.frequency_hz.size(); ++j) {
+    const double w = two_pi * d.frequency_hz(j), w1 = two_pi * 12.0, w2 = two_pi * 20.0;
+    for (int c = 0; c < 2; ++c)
+      d.H(j, c) = a1[c] / std::complex<double>(w1 * w1 - w * w, 2.0 * 0.01 * w1 * w) +
+                  a2[c] / std::complex<double>(w2 * w2 - w * w, 2.0 * 0.01 * w2 * w) - 1e-6;
+  }
+  d.coherence = Eigen::MatrixXd::Constant(d.H.rows(), 2, 0.95);
+  d.coherence.col(1).setConstant(0.5);
+  // As if from Welch's method with lines 0.1 Hz apart: mode 1's half-power band (0.24 Hz)
+  // spans fewer than 4 of them.
+  d.method = SpectraMethod::welch;
+  d.resolution_hz = 0.1;
+  auto has = [](const ModalFit& fit, const std::string& part) {
+    for (const auto& w : fit.warnings)
+      if (w.find(part) != std::string::npos) return true;
+    return false;
+  };
+  // Asked for two modes: the second kept in the fit, left out of the model.
+  const ModalFit two = modal_fit(d, {.modes = 2});
+  ASSERT_EQ(two.status, ModalFitStatus::ok) << two.reason;
+  ASSERT_EQ(two.modes.size(), 2u);
+  EXPECT_NEAR(two.modes[1].residues(0), -0.04, 1e-6);
+  EXPECT_FALSE(two.modes[1].in_model());
+  EXPECT_EQ(two.substructure.num_modes(), 1);
+  EXPECT_TRUE(has(two, "mode 2 (20 Hz): its residue at the driving point f@1:uy is -0.04, not > 0"));
+  EXPECT_TRUE(has(two, "the upper residual at the driving point f@1:uy is -1e-06 m/N, not > 0"));
+  EXPECT_EQ(two.substructure.residual_flexibility.size(), 0);
+  EXPECT_TRUE(has(two, "mode 1 (12 Hz): its half-power bandwidth, 0.24 Hz, spans fewer than 4"));
+  EXPECT_TRUE(has(two, "a@2:uy: mean coherence 0.500 in the band"));
+  EXPECT_FALSE(has(two, "a@1:uy: mean coherence"));
+  // Chosen by the diagram: the 20 Hz pole is no mode.
+  const ModalFit automatic = modal_fit(d);
+  ASSERT_EQ(automatic.status, ModalFitStatus::ok) << automatic.reason;
+  ASSERT_EQ(automatic.modes.size(), 1u);
+  EXPECT_NEAR(automatic.modes[0].frequency_hz, 12.0, 1e-6);
+  EXPECT_TRUE(has(automatic, "a pole at 20 Hz (ζ = 0.01), stable at"));
+}
+
 TEST(ModalFit, ModalAssurance) {
   EXPECT_DOUBLE_EQ(modal_assurance(Eigen::Vector2d(1.0, 2.0), Eigen::Vector2d(-2.0, -4.0)), 1.0);
   EXPECT_DOUBLE_EQ(modal_assurance(Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(0.0, 3.0)), 0.0);
