@@ -82,6 +82,11 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
   } catch (const std::invalid_argument& e) { // e.g. a channel at a DOF the model lacks
     throw std::invalid_argument(fmt::format("{}: {}", name, e.what()));
   }
+  if (!out.prediction.status.ok()) {
+    out.source = name;
+    out.status = out.prediction.status.within(name + ": ");
+    return out;
+  }
 
   // 3. Spectra of both over the kept part.
   out.source = name;

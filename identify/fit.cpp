@@ -1,5 +1,7 @@
 #include "identify/fit.hpp"
 
+#include "fem/assert.hpp"
+
 #include "identify/harmonics.hpp"
 #include "identify/statistics.hpp"
 
@@ -142,7 +144,7 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
 
 std::vector<joints::Joint>
 FitResult::identified(const std::vector<joints::Joint>& model_joints) const {
-  if (status != FitStatus::ok) throw std::invalid_argument("identify: " + reason);
+  if (!status.ok()) throw std::invalid_argument("identify: " + status.reason);
   std::vector<joints::Joint> out = model_joints;
   for (std::size_t i = 0; i < out.size() && i < joints.size(); ++i)
     for (std::size_t t = 0; t < out[i].terms.size(); ++t)
@@ -529,6 +531,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   const Eigen::MatrixXd& Q = eq.Q;
   const Eigen::VectorXd& p = eq.p;
   const std::vector<Row>& rows = eq.rows;
+  JOINTID_ASSERT(Q.rows() == m && Q.cols() == nu && p.size() == m,
+                 "Q b = p: one row of Q and p per equation, one column of Q per unknown");
   for (int u = 0; u < nu; ++u)
     if (!(Q.col(u).norm() > 0.0))
       throw std::invalid_argument("identify: term " + name_of(u) +
@@ -569,8 +573,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   // it were determined).
   auto inseparable = [&](const Solution& sol) {
     FitResult out;
-    out.status = FitStatus::not_separable;
-    out.reason = sol.inseparable;
+    out.status = fem::Status::failure(fem::Status::Code::not_separable, sol.inseparable);
     out.warnings = warnings;
     out.equations = m;
     out.unknowns = nu;
@@ -754,6 +757,12 @@ FitResult fit(const frf::Substructure& sub, const std::vector<joints::Joint>& jo
   std::vector<std::string> notes;
   const frf::ModalSynthesis synthesis =
       sub.synthesis(dofs, frf::synthesis_band_hz(f_max, K), &notes);
+  if (!synthesis.status().ok()) {
+    FitResult failed;
+    failed.status = synthesis.status();
+    failed.warnings = std::move(notes);
+    return failed;
+  }
   const ReceptanceFn H = [&synthesis](double omega, std::span<const int> rows,
                                       std::span<const int> cols) {
     return synthesis.receptance(omega, rows, cols);

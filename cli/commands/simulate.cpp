@@ -191,6 +191,8 @@ void Simulate::run_sine() {
                                                options);
         });
       });
+  for (const auto& t : tests)
+    require(t.status);
   identify::add_noise(tests, noise_, seed_);
   const std::vector<std::string> made_by{"jointid simulate", "model: " + model_.string()};
   for (auto& t : tests) {
@@ -330,6 +332,7 @@ void Simulate::run_signal() {
           return identify::simulate_forced(model.sub, model.file.joints, input, options);
         });
       });
+  require(test.status);
   test.record.source = name;
   test.comments.insert(test.comments.begin(), {"jointid simulate", "model: " + model_.string()});
   identify::add_noise(test, noise_, seed_);

@@ -1633,8 +1633,8 @@ TEST_F(CliTest, HarmonicBalanceWithoutASolutionIsNamedBySimulateDesignAndRespons
       EXPECT_EQ(c["freq_hz"], 3.0);
       EXPECT_EQ(c["amplitude"], 5000.0);
       EXPECT_EQ(c["reason"].get<std::string>().rfind(
-                    "sine_f3Hz_F5000N.csv: no periodic solution found (no convergence: relative "
-                    "residual ",
+                    "harmonic balance at 3 Hz, 5000 N: no periodic solution found (no "
+                    "convergence: relative residual ",
                     0),
                 0u)
           << c["reason"];
