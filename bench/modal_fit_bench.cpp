@@ -36,7 +36,7 @@ frf::ModalModel structure() {
   m.damping = Eigen::Vector3d(0.015, 0.02, 0.012);
   m.shapes.resize(3, 3);
   m.shapes << 0.02, 0.035, 0.045, //
-      -0.03, -0.01, 0.025,         //
+      -0.03, -0.01, 0.025,        //
       0.04, -0.03, 0.02;
   return m;
 }
@@ -105,8 +105,9 @@ int main(int argc, char** argv) {
   const frf::ModalModel model = structure();
   const identify::Record r = record(model);
   if (argc > 1) {
-    io::write_record(argv[1], r, {"bench_modal_fit: 3 modes (3.1, 7.3, 11.8 Hz), multisine "
-                                  "2-15 Hz, 1 % noise"});
+    io::write_record(argv[1], r,
+                     {"bench_modal_fit: 3 modes (3.1, 7.3, 11.8 Hz), multisine "
+                      "2-15 Hz, 1 % noise"});
     fmt::print("wrote {}\n", argv[1]);
   }
   identify::FrfEstimateOptions periodic{.f0_hz = 2.0, .f1_hz = 15.0};
@@ -114,7 +115,8 @@ int main(int argc, char** argv) {
   welch.method = identify::SpectraMethod::welch;
   identify::MeasuredFrfs by_periods, by_welch;
   identify::ModalFit fit, fit3;
-  const double t_periods = median_ms(5, [&] { by_periods = identify::frfs_from_records({r}, periodic); });
+  const double t_periods =
+      median_ms(5, [&] { by_periods = identify::frfs_from_records({r}, periodic); });
   const double t_welch = median_ms(5, [&] { by_welch = identify::frfs_from_records({r}, welch); });
   const double t_fit = median_ms(5, [&] { fit = identify::modal_fit(by_periods); });
   const double t_fit3 = median_ms(5, [&] { fit3 = identify::modal_fit(by_periods, {.modes = 3}); });

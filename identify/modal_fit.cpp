@@ -412,18 +412,19 @@ ModalFit modal_fit(const MeasuredFrfs& data, const ModalFitOptions& o) {
           : std::max(3, static_cast<int>(std::ceil(0.4 * static_cast<double>(stable_orders))));
   fit.modes = select_modes(fit.diagram, max_order, o.modes, threshold, o);
   if (o.modes > 0 && static_cast<int>(fit.modes.size()) < o.modes) {
-    fit.status = ModalFitStatus::too_few_modes;
-    fit.reason = fmt::format(
-        "the stabilisation diagram (orders up to {}) shows {} mode{} in the band {} to {} Hz, "
-        "not the {} asked: ask fewer modes, widen the band or raise the highest order",
-        max_order, fit.modes.size(), fit.modes.size() == 1 ? "" : "s", data.frequency_hz(0), f_top,
-        o.modes);
+    fit.status = fem::Status::failure(
+        fem::Status::Code::not_separable,
+        fmt::format(
+            "the stabilisation diagram (orders up to {}) shows {} mode{} in the band {} to {} Hz, "
+            "not the {} asked: ask fewer modes, widen the band or raise the highest order",
+            max_order, fit.modes.size(), fit.modes.size() == 1 ? "" : "s", data.frequency_hz(0),
+            f_top, o.modes));
   } else if (fit.modes.empty()) {
-    fit.status = ModalFitStatus::too_few_modes;
-    fit.reason =
+    fit.status = fem::Status::failure(
+        fem::Status::Code::not_separable,
         fmt::format("the stabilisation diagram (orders up to {}) shows no mode in the band "
                     "{} to {} Hz stable at {} orders or more",
-                    max_order, data.frequency_hz(0), f_top, threshold);
+                    max_order, data.frequency_hz(0), f_top, threshold));
   }
 
   // 4. Residues, shapes and the model. Chosen by the diagram alone (no number of modes asked), a
@@ -450,10 +451,10 @@ ModalFit modal_fit(const MeasuredFrfs& data, const ModalFitOptions& o) {
     }
   }
   build_model(data, o, fit);
-  if (fit.status == ModalFitStatus::ok && fit.substructure.num_modes() == 0) {
-    fit.status = ModalFitStatus::too_few_modes;
-    fit.reason = "no mode could be mass-normalised at the driving point " + data.drive_name;
-  }
+  if (fit.status.ok() && fit.substructure.num_modes() == 0)
+    fit.status = fem::Status::failure(fem::Status::Code::not_separable,
+                                      "no mode could be mass-normalised at the driving point " +
+                                          data.drive_name);
 
   // 5. What the user should know.
   for (std::size_t r = 0; r < fit.modes.size(); ++r) {

@@ -35,6 +35,7 @@
 ///    the rest is taken as of rank one, R_ij = U_i U_j / U_d (as if the modes above the band
 ///    acted as one), which reproduces the column d exactly and is symmetric. The lower residual
 ///    has no place in a `[modal]` model: it is reported, and left out.
+#include "fem/status.hpp"
 #include "frf/modal_model.hpp"
 #include "identify/measured_frfs.hpp"
 
@@ -76,14 +77,11 @@ struct FittedMode {
   bool in_model() const { return shape.size() > 0; }
 };
 
-enum class ModalFitStatus {
-  ok,
-  too_few_modes ///< `modes` asked more than the diagram shows (the modes found are kept)
-};
-
 struct ModalFit {
-  ModalFitStatus status = ModalFitStatus::ok;
-  std::string reason;      ///< why not ok
+  /// not_separable (with its reason) when the data do not determine the modes asked: the
+  /// diagram shows fewer than asked, or none (the modes found are kept), or no mode could be
+  /// mass-normalised.
+  fem::Status status;
   ModalFitOptions options; ///< as used (max_order as chosen)
 
   int max_order = 0;
@@ -106,7 +104,7 @@ struct ModalFit {
 /// bad input: the driving point not among the responses (its mass normalisation needs it;
 /// naming the force and the responses), too few lines for the modes asked or for a diagram
 /// (at least 2 N + 6 lines, or 10), max_order < 4, tolerances not > 0. A diagram without the
-/// modes asked is a status (too_few_modes), the modes it shows kept.
+/// modes asked is a status (not_separable), the modes it shows kept.
 ModalFit modal_fit(const MeasuredFrfs& data, const ModalFitOptions& options = {});
 
 /// The MAC of two real shapes: (aᵀb)² / (aᵀa · bᵀb), 1 for shapes that are multiples.

@@ -1,9 +1,9 @@
 #include "io/modal_fit_output.hpp"
 
 #include "io/files.hpp"
+#include "io/json_text.hpp"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -12,11 +12,8 @@ namespace jointid::io {
 
 namespace {
 
-using Json = nlohmann::ordered_json;
-
-Json number(double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
+using json::Json;
+using json::number;
 
 // A TOML float in its shortest exact form: "3", "1e-07" get ".0" or stay as they are where
 // TOML reads them as floats.
@@ -112,8 +109,8 @@ std::string modal_fit_json(const identify::ModalFit& fit, const identify::Measur
   const Eigen::Index L = data.num_lines();
   auto dof = [&](std::size_t c) { return fem::to_string(data.responses[c]); };
   Json j;
-  j["status"] = fit.status == identify::ModalFitStatus::ok ? "ok" : "too_few_modes";
-  j["reason"] = fit.reason;
+  j["status"] = std::string(fem::code_name(fit.status.code));
+  j["reason"] = fit.status.reason;
   j["inputs"] = run.inputs;
   j["substructure"] = run.substructure_file;
   j["driving_point"] = fem::to_string(data.drive);

@@ -24,7 +24,8 @@ struct ModalFitRun {
 std::string modal_fit_toml(const identify::ModalFit& fit, const identify::MeasuredFrfs& data,
                            const std::vector<std::string>& comments = {});
 
-/// {"status": "ok" | "too_few_modes", "reason", "inputs": [...], "substructure": file,
+/// {"status": "ok" | "not_separable" (fem::code_name), "reason", "inputs": [...], "substructure":
+/// file,
 ///  "driving_point": "7:uy", "force_channel": "f@7:uy", "band_hz": [F0, F1],
 ///  "lines": n, "lines_hz": [first, last], "fitted_as": "receptance (m/N) ...",
 ///  "spectra": {"method", "resolution_hz", "sample_rate_hz", "block_samples"},

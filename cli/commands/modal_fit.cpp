@@ -204,7 +204,7 @@ void ModalFit::run() {
   } catch (const std::invalid_argument& e) {
     throw io::Error(e.what()); // it names the record, the band or the channels
   }
-  if (fit.status != identify::ModalFitStatus::ok) throw io::Error("no substructure: " + fit.reason);
+  require(fit.status.within("no substructure: "));
 
   // 4. Write: the model file and the JSON together, then the pictures.
   std::vector<std::string> inputs;
