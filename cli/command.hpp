@@ -101,5 +101,6 @@ std::unique_ptr<Command> discover_command(CLI::App& parent);
 std::unique_ptr<Command> response_command(CLI::App& parent);
 std::unique_ptr<Command> design_command(CLI::App& parent);
 std::unique_ptr<Command> compare_command(CLI::App& parent);
+std::unique_ptr<Command> modal_fit_command(CLI::App& parent);
 
 } // namespace jointid::cli

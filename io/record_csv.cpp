@@ -173,9 +173,7 @@ identify::Record read_record(const std::filesystem::path& path) {
       const auto value = parse_double(*period_text);
       if (!value || !std::isfinite(*value) || !(*value > 0.0))
         csv.fail(c.number,
-                 fmt::format("period_s: expected the period of a periodic test, a time > 0 s, "
-                             "got \"{}\"",
-                             *period_text));
+                 fmt::format("period_s: expected a period > 0 s, got \"{}\"", *period_text));
       if (record.period_s && *record.period_s != *value)
         csv.fail(c.number,
                  fmt::format("period_s given twice ({} and {} s)", *record.period_s, *value));

@@ -341,6 +341,15 @@ COMPARE_ARGV = ["jointid", "compare", "out/no_k3.toml", "out/random/random_2-40H
 COMPARE_SAME_ARGV = ["jointid", "compare", "examples/paper_cantilever/cantilever.toml",
                      "out/random/random_2-40Hz_40N_seed1.csv", "--band", "2:40", "-o",
                      "out/compare_same"]
+# modal-fit: a low-level random test of the cantilever without its joint, fitted.
+MODAL_BEAM = ("sed '/^\\[\\[joints\\]\\]/,$d' examples/paper_cantilever/cantilever.toml "
+              "> out/beam.toml")
+MODAL_SIM = ["jointid", "simulate", "out/beam.toml", "--force", "7:uy", "--excitation", "random",
+             "--band", "2:80", "--rms", "20", "--duration", "128", "--sample-rate", "256",
+             "--route", "full", "--substeps", "8", "--channels", "v", "--outputs", "3:uy,5:uy",
+             "--noise", "0.01", "-o", "out/low_level"]
+MODAL_FIT = ["jointid", "modal-fit", "out/low_level/random_2-80Hz_20N_seed1.csv", "--band",
+             "10:70", "--segment", "4096", "-o", "out/modal_fit"]
 TABLE_SIM = ["jointid", "simulate", "examples/paper_cantilever/cantilever.toml", "--force", "7:uy",
              "--freq", "2,3,4,5,6", "--amplitude", "10,80", "--steps-per-period", "512"]
 TABLE_RECORDS = TABLE_SIM + ["-o", "out/records"]
@@ -398,6 +407,11 @@ def run_commands(r: Runner, out: dict):
     r.run("commands", NOISE_SIM)
     r.run("commands", NOISE_ID)
     out["noisy"] = load_json(r.path("out/noisy.json"))
+    r.run("commands", MODAL_BEAM)
+    r.run("commands", MODAL_SIM)
+    out["modal_fit"] = r.run("commands", no_plot(r, MODAL_FIT))
+    out["modal_fit_toml"] = read(r.path("out/modal_fit/substructure.toml"))
+    out["modal_fit_json"] = load_json(r.path("out/modal_fit/modal_fit.json"))
     out["tj_design"] = r.run("commands", TJ_DESIGN_ARGV)
     out["tj_design_json"] = load_json(r.path("out/three_joints_design/design.json"))
     if not r.check and r.vtk:
@@ -405,6 +419,9 @@ def run_commands(r: Runner, out: dict):
         shutil.copyfile(r.path("out/response/response.png"),
                         ROOT / "docs" / "response_hardening_tip.png")
         shutil.copyfile(r.path("out/compare/compare.png"), ROOT / "docs" / "compare_missing_k3.png")
+        shutil.copyfile(r.path("out/modal_fit/stabilisation.png"),
+                        ROOT / "docs" / "modal_fit_stabilisation.png")
+        shutil.copyfile(r.path("out/modal_fit/fit.png"), ROOT / "docs" / "modal_fit_fit.png")
 
 
 def head(text: str, lines: int) -> str:
@@ -492,6 +509,10 @@ def render_json_compare(out) -> str:
     return json_block(out["compare_json"], 3)
 
 
+def render_json_modal_fit(out) -> str:
+    return json_block(out["modal_fit_json"], 2)
+
+
 def render_json_discover(out) -> str:
     return json_block(out["discovery"], 1)
 
@@ -512,6 +533,14 @@ def render_compare_example(out) -> str:
     return (shown + "\n\nprints\n\n" + code(printed_lines(out["compare"])) +
             "\n\nThe same record against the model that made it prints\n\n" +
             command_block([COMPARE_SAME_ARGV]) + "\n\n" + code("\n".join(same[:3])))
+
+
+def render_modal_fit_example(out) -> str:
+    toml = out["modal_fit_toml"].splitlines()
+    first = next(i for i, l in enumerate(toml) if l.startswith("[modal]"))
+    return (command_block([MODAL_BEAM, MODAL_SIM, MODAL_FIT]) + "\n\nprints\n\n" +
+            code(printed_lines(out["modal_fit"])) + "\n\nand `out/modal_fit/substructure.toml` "
+            "holds\n\n" + code("\n".join(toml[first:])))
 
 
 def render_stepped_sine(out) -> str:
@@ -716,10 +745,12 @@ RENDERERS = {
     "json-response": ("commands", render_json_response),
     "json-design": ("commands", render_json_design),
     "json-compare": ("commands", render_json_compare),
+    "json-modal-fit": ("commands", render_json_modal_fit),
     "json-discover": ("quickstart", render_json_discover),
     "response-example": ("commands", render_response_example),
     "design-example": ("commands", render_design_example),
     "compare-example": ("commands", render_compare_example),
+    "modal-fit-example": ("commands", render_modal_fit_example),
     "stepped-sine-vs-records": ("commands", render_stepped_sine),
     "noise-estimate": ("commands", render_noise_estimate),
     "stepped-sine-head": ("commands", render_stepped_sine_head),

@@ -1,5 +1,6 @@
 // Runs the built `jointid` program on the cantilever of DESIGN.md, as a user would.
 #include "io/cantilever_toml.hpp"
+#include "io/model_file.hpp"
 #include "io/record_csv.hpp"
 #include "io/test_files.hpp"
 #include "io/uff58.hpp"
@@ -108,7 +109,8 @@ TEST_F(CliTest, EveryCommandHasHelp) {
                                                {"response", "--help"},
                                                {"design", "--help"},
                                                {"compare", "--help"},
-                                               {"frf", "--help"}}) {
+                                               {"frf", "--help"},
+                                               {"modal-fit", "--help"}}) {
     const Outcome run = jointid(args, dir());
     EXPECT_EQ(run.status, 0) << args[0];
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << run.out;
@@ -118,6 +120,7 @@ TEST_F(CliTest, EveryCommandHasHelp) {
   EXPECT_NE(top.out.find("identify"), std::string::npos);
   EXPECT_NE(top.out.find("modes"), std::string::npos);
   EXPECT_NE(top.out.find("discover"), std::string::npos);
+  EXPECT_NE(top.out.find("modal-fit"), std::string::npos);
 }
 
 TEST_F(CliTest, SimulateWritesReadableRecords) {
@@ -1859,6 +1862,7 @@ std::vector<std::string> command_line(const std::string& command, const fs::path
   if (command == "simulate")
     args.insert(args.end(), {"--force", "7:uy", "--freq", "3", "--amplitude", "1"});
   if (command == "frf") args.insert(args.end(), {"--drive", "7:uy", "--freq-range", "0:10"});
+  if (command == "modal-fit") args.insert(args.end(), {"--band", "2:10"});
   if (command == "response")
     args.insert(args.end(), {"--force", "7:uy", "--amplitude", "1", "--freq-range", "2:4"});
   if (command == "design")
@@ -1870,8 +1874,8 @@ std::vector<std::string> command_line(const std::string& command, const fs::path
   return args;
 }
 
-const std::vector<std::string> commands{"modes",    "frf",      "simulate", "identify",
-                                        "discover", "response", "design",   "compare"};
+const std::vector<std::string> commands{"modes",    "frf",    "simulate", "identify", "discover",
+                                        "response", "design", "compare",  "modal-fit"};
 
 TEST_F(CliTest, VersionIsTheProjects) {
   const Outcome run = jointid({"--version"}, dir());
@@ -1897,7 +1901,8 @@ TEST_F(CliTest, EnumeratedOptionsListTheirChoices) {
       {"compare", "--route", "{modal,full}", "modal or full"},
       {"frf", "--kind", "{receptance,mobility,accelerance}", "receptance, mobility or accelerance"},
       {"discover", "--terms", "{k,c,k2,k3,c2,c3,fc}", "k, c, k2, k3, c2, c3 or fc"},
-      {"modes", "--engine", "{auto,dense,sparse,slepc}", "auto, dense, sparse or slepc"}};
+      {"modes", "--engine", "{auto,dense,sparse,slepc}", "auto, dense, sparse or slepc"},
+      {"modal-fit", "--spectra", "{auto,welch,periods,whole}", "auto, welch, periods or whole"}};
   for (const char* command : {"simulate", "frf", "identify", "discover", "response", "design"})
     options.push_back({command, "--engine", large, large_named});
   const fs::path out = dir() / "never_enumerated";
@@ -1997,6 +2002,281 @@ TEST_F(CliTest, OldSpellingsStillWorkAndWarn) {
       << discover.err;
   EXPECT_TRUE(fs::exists(report / "report.md"));
   EXPECT_FALSE(fs::exists(report / "gap.png"));
+}
+
+// modal-fit on records of the linear cantilever (the model without its joint): a random record
+// and a multisine record simulated in time, accelerations and displacements at three nodes.
+class ModalFitCli : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>();
+    std::string linear = test::cantilever_toml();
+    linear.erase(linear.find("[[joints]]"));
+    test::write_text(beam(), linear);
+    modes_ = jointid({"modes", beam().string(), "--count", "4", "--no-plot", "-o",
+                      (*dir_ / "fe_modes").string()},
+                     dir_->path());
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  static fs::path beam() { return *dir_ / "beam.toml"; }
+  static const fs::path& dir() { return dir_->path(); }
+  // The finite element model's natural frequency r (from 0) as `jointid modes` gives it.
+  static double fe_frequency(int r) {
+    const json j = json::parse(test::read_text(*dir_ / "fe_modes" / "modes.json"));
+    return j["modes"][r]["frequency_hz"].get<double>();
+  }
+  // A record of `excitation` (random or multisine), 2–80 Hz, 128 s at 256 Hz, by Newmark on the
+  // full model with `substeps` steps a sample; 1 % noise on every channel.
+  static fs::path simulate(const std::string& excitation, const std::string& channels,
+                           const std::string& name) {
+    const fs::path out = dir() / name;
+    const Outcome run = jointid({"simulate",
+                                 beam().string(),
+                                 "--force",
+                                 "7:uy",
+                                 "--excitation",
+                                 excitation,
+                                 "--band",
+                                 "2:80",
+                                 "--rms",
+                                 "20",
+                                 "--duration",
+                                 "128",
+                                 "--sample-rate",
+                                 "256",
+                                 "--route",
+                                 "full",
+                                 "--substeps",
+                                 std::to_string(substeps),
+                                 "--channels",
+                                 channels,
+                                 "--outputs",
+                                 "3:uy,5:uy",
+                                 "--noise",
+                                 "0.01",
+                                 "-o",
+                                 out.string()},
+                                dir());
+    EXPECT_EQ(run.status, 0) << run.err;
+    for (const auto& entry : fs::directory_iterator(out))
+      return entry.path();
+    return {};
+  }
+  // The trapezoidal rule (Newmark's average acceleration) lengthens the period of a mode of
+  // frequency f integrated with step h: ω_h h = 2 atan(ω h/2), no damping added. The records
+  // hold the modes at these frequencies.
+  static double newmark_frequency(double f) {
+    const double h = 1.0 / (256.0 * substeps);
+    return std::atan(std::numbers::pi * f * h) / (std::numbers::pi * h);
+  }
+  static constexpr int substeps = 8;
+  // Welch's estimate with segments of 4096 samples (lines Δf = 0.0625 Hz apart) sees the FRF
+  // through Hann's spectral window, of RMS width Δf/√3 = 0.036 Hz: the frequencies within a
+  // quarter of that (the estimate's own scatter is far smaller); the damping (1 %) within 10 %,
+  // as the window raises it by about (Δf/√3)²/(ζf)² = 3.7 % at mode 2.
+  static constexpr double hann_tolerance_hz = 0.25 * 0.0625 / 1.7320508075688772;
+  static std::unique_ptr<test::TempDir> dir_;
+  static Outcome modes_;
+};
+std::unique_ptr<test::TempDir> ModalFitCli::dir_;
+Outcome ModalFitCli::modes_;
+
+TEST_F(ModalFitCli, RandomRecordGivesTheModelsModesAndASubstructureToBuildOn) {
+  ASSERT_EQ(modes_.status, 0) << modes_.err;
+  const fs::path record = simulate("random", "a", "random");
+  const fs::path out = dir() / "fit_random";
+  // The band 10–70 Hz holds modes 2 and 3 (18.7, 52.4 Hz); segments of 4096 samples, 0.0625 Hz
+  // apart: 6 lines in mode 2's half-power band 2ζf = 0.37 Hz.
+  std::vector<std::string> args{"modal-fit", record.string(), "--band", "10:70",
+                                "--segment", "4096",          "-o",     out.string()};
+  if (!JOINTID_WITH_VTK) args.push_back("--no-plot");
+  const Outcome run = jointid(args, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json j = json::parse(test::read_text(out / "modal_fit.json"));
+  EXPECT_EQ(j["status"], "ok");
+  EXPECT_EQ(j["driving_point"], "7:uy");
+  EXPECT_EQ(j["spectra"]["method"], "welch");
+  EXPECT_NE(j["fitted_as"].get<std::string>().find("(iω)²"), std::string::npos);
+  ASSERT_EQ(j["modes"].size(), 2u) << run.out << run.err;
+  for (int r = 0; r < 2; ++r) {
+    const json& m = j["modes"][r];
+    const double f = newmark_frequency(fe_frequency(r + 1));
+    EXPECT_NEAR(m["frequency_hz"].get<double>(), f, hann_tolerance_hz) << "mode " << r + 2;
+    EXPECT_NEAR(m["damping"].get<double>() / 0.01, 1.0, 0.1) << "mode " << r + 2;
+    EXPECT_TRUE(m["in_model"].get<bool>());
+    EXPECT_GT(m["shape"]["7:uy"].get<double>(), 0.0);
+  }
+  for (const char* dof : {"7:uy", "3:uy", "5:uy"}) {
+    EXPECT_LT(j["fit_error"][dof].get<double>(), 0.05) << dof;
+    EXPECT_GT(j["coherence"][dof].get<double>(), 0.9) << dof;
+  }
+  if (JOINTID_WITH_VTK) {
+    for (const char* png : {"stabilisation.png", "fit.png"}) {
+      EXPECT_TRUE(fs::exists(out / png)) << png << ": " << run.err;
+    }
+  }
+
+  // The same record as a universal file: the same fit.
+  const fs::path uff = dir() / "random.uff";
+  io::write_uff58(uff, io::uff58_from_record(io::read_record(record)));
+  const Outcome from_uff = jointid({"modal-fit", uff.string(), "--band", "10:70", "--segment",
+                                    "4096", "--no-plot", "-o", (dir() / "fit_uff").string()},
+                                   dir());
+  ASSERT_EQ(from_uff.status, 0) << from_uff.err;
+  const json u = json::parse(test::read_text(dir() / "fit_uff" / "modal_fit.json"));
+  ASSERT_EQ(u["modes"].size(), 2u);
+  for (int r = 0; r < 2; ++r)
+    EXPECT_NEAR(u["modes"][r]["frequency_hz"].get<double>(),
+                j["modes"][r]["frequency_hz"].get<double>(), 1e-9);
+
+  // The substructure is a model file: `jointid modes` on it gives the fitted frequencies.
+  const fs::path again = dir() / "fitted_modes";
+  const Outcome modes = jointid(
+      {"modes", (out / "substructure.toml").string(), "--no-plot", "-o", again.string()}, dir());
+  ASSERT_EQ(modes.status, 0) << modes.err;
+  const json k = json::parse(test::read_text(again / "modes.json"));
+  ASSERT_EQ(k["modes"].size(), 2u);
+  for (int r = 0; r < 2; ++r)
+    EXPECT_NEAR(k["modes"][r]["frequency_hz"].get<double>(),
+                j["modes"][r]["frequency_hz"].get<double>(),
+                1e-12 * j["modes"][r]["frequency_hz"].get<double>());
+
+  // And a part of a model with a joint: its linear FRF from 7:uy peaks at the fitted mode 2.
+  test::write_text(dir() / "parent.toml",
+                   "[[substructures]]\nfile = \"fit_random/substructure.toml\"\n\n"
+                   "[[joints]]\nname = \"tip\"\nnode = 7\ndof = \"uy\"\nterms = [\"k\", \"k3\"]\n"
+                   "values = { k = 100.0, k3 = 1e6 }\n");
+  const Outcome frf =
+      jointid({"frf", (dir() / "parent.toml").string(), "--drive", "7:uy", "--freq-range", "10:30",
+               "--points", "2001", "--no-plot", "-o", (dir() / "parent_frf").string()},
+              dir());
+  ASSERT_EQ(frf.status, 0) << frf.err;
+  std::istringstream table(test::read_text(dir() / "parent_frf" / "frf.csv"));
+  std::string line;
+  double peak = 0.0, at = 0.0;
+  while (std::getline(table, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("freq_hz", 0) == 0) continue;
+    double f = 0.0, re = 0.0, im = 0.0;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &f, &re, &im), 3) << line;
+    if (std::hypot(re, im) > peak) peak = std::hypot(re, im), at = f;
+  }
+  EXPECT_NEAR(at, j["modes"][0]["frequency_hz"].get<double>(), 0.01); // the points' spacing
+}
+
+TEST_F(ModalFitCli, MultisineRecordOfDisplacements) {
+  ASSERT_EQ(modes_.status, 0) << modes_.err;
+  const fs::path record = simulate("multisine", "x", "multisine");
+  const fs::path out = dir() / "fit_multisine";
+  const Outcome run = jointid({"modal-fit", record.string(), "--band", "10:70", "--modes", "2",
+                               "--segment", "4096", "--no-plot", "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json j = json::parse(test::read_text(out / "modal_fit.json"));
+  EXPECT_EQ(j["fitted_as"], "receptance (m/N)");
+  ASSERT_EQ(j["modes"].size(), 2u);
+  for (int r = 0; r < 2; ++r) {
+    const double f = newmark_frequency(fe_frequency(r + 1));
+    EXPECT_NEAR(j["modes"][r]["frequency_hz"].get<double>(), f, hann_tolerance_hz)
+        << "mode " << r + 2;
+    EXPECT_NEAR(j["modes"][r]["damping"].get<double>() / 0.01, 1.0, 0.1) << "mode " << r + 2;
+  }
+  EXPECT_FALSE(fs::exists(out / "fit.png"));
+  const io::ModelFile back = io::read_model(out / "substructure.toml");
+  ASSERT_TRUE(back.modal.has_value());
+  EXPECT_EQ(back.modal->num_modes(), 2);
+  EXPECT_EQ(back.modal->dofs.size(), 3u);
+}
+
+TEST_F(ModalFitCli, FrfFilesOfTheModelGiveItsModes) {
+  // The model's own FRFs (`jointid frf`: every mode, exact) as a table and as a universal file:
+  // the natural frequencies to 1e-4 and the damping ratios (1 %) to 1 %.
+  ASSERT_EQ(modes_.status, 0) << modes_.err;
+  const fs::path frf = dir() / "model_frf";
+  const Outcome made =
+      jointid({"frf", beam().string(), "--drive", "7:uy", "--response", "7:uy,3:uy,5:uy",
+               "--freq-range", "10:70", "--points", "2401", "--no-plot", "-o", frf.string()},
+              dir());
+  ASSERT_EQ(made.status, 0) << made.err;
+  for (const char* file : {"frf.csv", "frf.uff"}) {
+    const fs::path out = dir() / (std::string("fit_") + file);
+    const Outcome run = jointid(
+        {"modal-fit", (frf / file).string(), "--band", "10:70", "--no-plot", "-o", out.string()},
+        dir());
+    ASSERT_EQ(run.status, 0) << file << ": " << run.err;
+    const json j = json::parse(test::read_text(out / "modal_fit.json"));
+    EXPECT_EQ(j["spectra"]["method"], "measured");
+    EXPECT_TRUE(j["coherence"]["7:uy"].is_null());
+    ASSERT_EQ(j["modes"].size(), 2u) << file;
+    for (int r = 0; r < 2; ++r) {
+      EXPECT_NEAR(j["modes"][r]["frequency_hz"].get<double>() / fe_frequency(r + 1), 1.0, 1e-4)
+          << file << ", mode " << r + 2;
+      EXPECT_NEAR(j["modes"][r]["damping"].get<double>() / 0.01, 1.0, 0.01)
+          << file << ", mode " << r + 2;
+    }
+  }
+}
+
+TEST_F(ModalFitCli, BadInputsAreRefusedAndNothingIsWritten) {
+  const fs::path out = dir() / "never_fitted";
+  auto fit = [&](const fs::path& record, const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"modal-fit", record.string(), "--no-plot", "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  // A short periodic record written here: f@7:uy, a@7:uy, a@3:uy at 128 Hz.
+  identify::Record r;
+  r.t = Eigen::VectorXd::LinSpaced(1024, 0.0, 1023.0 / 128.0);
+  const Eigen::VectorXd wave = (2.0 * std::numbers::pi * 10.0 * r.t).array().sin().matrix() +
+                               (2.0 * std::numbers::pi * 23.0 * r.t).array().cos().matrix();
+  r.channels = {{identify::Quantity::force, {7, fem::Dof::uy}, wave},
+                {identify::Quantity::acceleration, {7, fem::Dof::uy}, 0.5 * wave},
+                {identify::Quantity::acceleration, {3, fem::Dof::uy}, 0.2 * wave}};
+  const fs::path good = dir() / "short.csv";
+  io::write_record(good, r);
+  identify::Record without_force = r;
+  without_force.channels.erase(without_force.channels.begin());
+  const fs::path no_force = dir() / "no_force.csv";
+  io::write_record(no_force, without_force);
+  identify::Record without_drive = r;
+  without_drive.channels.erase(without_drive.channels.begin() + 1);
+  const fs::path no_drive = dir() / "no_drive.csv";
+  io::write_record(no_drive, without_drive);
+
+  expect_one_line_error(fit(no_force, {"--band", "5:30"}),
+                        "jointid: " + no_force.string() +
+                            ": no force channel (expected f@<node>:<dof> at the driving point "
+                            "beside the responses; the channels are a@7:uy, a@3:uy)");
+  expect_one_line_error(fit(good, {"--band", "5:100"}),
+                        "the band 5 to 100 Hz reaches above the records' Nyquist frequency, 64 Hz");
+  // Lines 1 Hz apart; 22 and 24 Hz hold the force's 23 Hz line leaked by the Hann window.
+  expect_one_line_error(fit(good, {"--band", "22:24", "--segment", "128", "--modes", "3"}),
+                        "the band holds 3 lines (22 to 24 Hz): fitting 3 modes needs at least 12 "
+                        "(2 N + 6)");
+  expect_one_line_error(fit(no_drive, {"--band", "5:30"}),
+                        "the driving point f@7:uy is not among the responses (a@3:uy)");
+  expect_one_line_error(fit(good, {"--band", "30:5"}), "--band");
+  expect_one_line_error(fit(good, {"--band", "5:30", "--modes", "-1"}), "--modes");
+  expect_one_line_error(fit(good, {"--band", "5:30", "--segment", "4"}), "--segment");
+  expect_one_line_error(fit(good, {"--band", "5:30", "--spectra", "whole", "--period", "1"}),
+                        "--period");
+  expect_one_line_error(fit(good, {"--band", "5:30", "--max-order", "2"}), "--max-order");
+  // A stepped-sine table is not a record nor an FRF file.
+  const fs::path table = dir() / "table.csv";
+  test::write_text(table, "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im\n3,1,0,1e-3,0\n");
+  expect_one_line_error(fit(table, {"--band", "5:30"}), "a stepped-sine table");
+  // Records and FRF files together; a file given twice.
+  const fs::path frf_file = dir() / "h.csv";
+  test::write_text(frf_file, "# drive = 7:uy\nfreq_hz,7:uy.re,7:uy.im\n1,1e-3,0\n2,2e-3,0\n");
+  const Outcome both = jointid({"modal-fit", good.string(), frf_file.string(), "--band", "5:30",
+                                "--no-plot", "-o", out.string()},
+                               dir());
+  expect_one_line_error(both, "is a time record but " + frf_file.string() +
+                                  " holds FRFs: give modal-fit one or the other");
+  expect_one_line_error(jointid({"modal-fit", good.string(), good.string(), "--band", "5:30",
+                                 "--no-plot", "-o", out.string()},
+                                dir()),
+                        good.string() + ": given twice");
+  EXPECT_FALSE(fs::exists(out));
 }
 
 } // namespace

@@ -244,6 +244,33 @@ TEST_F(RecordCsvTest, ExcitationGivenTwice) {
   EXPECT_EQ(*read_record(write(same)).excitation_hz, 2.0);
 }
 
+TEST_F(RecordCsvTest, PeriodOfAPeriodicTestIsReadAndWritten) {
+  // `# period_s = T` (a periodic broadband test): read into Record::period_s, written back from
+  // it, refused when not a period > 0 or given twice with two values.
+  const std::string periodic =
+      test::replaced(good_csv, "# excitation_hz = 2.0\n", "# period_s = 0.25\n");
+  const identify::Record r = read_record(write(periodic));
+  ASSERT_TRUE(r.period_s.has_value());
+  EXPECT_EQ(*r.period_s, 0.25);
+  EXPECT_FALSE(r.excitation_hz.has_value());
+  EXPECT_FALSE(read_record(write(good_csv)).period_s.has_value());
+  expect_error(test::replaced(good_csv, "# excitation_hz = 2.0\n", "# period_s = -1\n"), 2,
+               {"period_s: expected a period > 0 s, got \"-1\""});
+  expect_error(
+      test::replaced(good_csv, "# excitation_hz = 2.0\n", "# period_s = 0.25\n# period_s = 0.5\n"),
+      3, {"period_s given twice (0.25 and 0.5 s)"});
+
+  identify::Record s = sample_record();
+  s.excitation_hz.reset();
+  s.period_s = 1.0 / 3.0;
+  const auto path = dir / "periodic.csv";
+  write_record(path, s);
+  const identify::Record back = read_record(path);
+  ASSERT_TRUE(back.period_s.has_value());
+  EXPECT_TRUE(same_bits(*back.period_s, *s.period_s));
+  EXPECT_THROW(write_record(path, s, {"period_s = 2"}), Error); // only from the record
+}
+
 TEST_F(RecordCsvTest, WriterRefusesWhatTheReaderWouldRefuse) {
   identify::Record r = sample_record();
   const auto path = dir / "keep.csv";
