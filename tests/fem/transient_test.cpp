@@ -9,6 +9,7 @@
 #include "joints/joint.hpp"
 #include "support/beam_models.hpp"
 #include "support/cantilever.hpp"
+#include "support/error_of.hpp"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -487,4 +488,28 @@ TEST(Transient, AStuckJointWithStaticFlexibilityHoldsItsDofAndTheRestFollows) {
     A2 *= 2.0 / static_cast<double>(s.t.size());
     EXPECT_LE(std::abs(A2 - X2), 2e-4 * std::abs(X2)) << f;
   }
+}
+
+TEST(Transient, ATimeModelOfInconsistentSizesIsRefused) {
+  fem::ForceHistory h;
+  h.dt = 0.01;
+  h.equations = {1};
+  h.samples = Eigen::MatrixXd::Ones(4, 1);
+  const std::vector<int> outputs{0};
+  fem::TimeModel m = two_modes_with_residual();
+  m.R = Eigen::MatrixXd::Identity(3, 3).sparseView();
+  EXPECT_EQ(test::error_of([&] { fem::transient_response(m, nullptr, h, outputs); }),
+            "time model: R is 3 x 3, expected 2 x 2");
+  m = two_modes_with_residual();
+  m.T = Eigen::MatrixXd::Ones(2, 3).sparseView();
+  EXPECT_EQ(test::error_of([&] { fem::transient_response(m, nullptr, h, outputs); }),
+            "time model: T has 3 columns for 2 coordinates");
+  // Newmark's static flexibility: one row and column per local coordinate.
+  m = two_modes_with_residual();
+  joints::Joint j{"a", 1, 0, fem::Dof::ux, {joints::Term::k}, {1.0}, {true}, {}};
+  const joints::JointForces forces({j}, m.system.dofs);
+  EXPECT_EQ(test::error_of(
+                [&] { fem::Newmark(m.system, m.C, forces, Eigen::MatrixXd::Zero(2, 2), 0.01); }),
+            "Newmark: the static flexibility is 2 x 2, expected 1 x 1 (one row and column per "
+            "local coordinate)");
 }
