@@ -120,6 +120,10 @@ TEST(TimeModel, ModalModelIsItsModalCoordinatesAndItsResidualFlexibility) {
     EXPECT_DOUBLE_EQ(m.system.M.coeff(r, r), 1.0);
     EXPECT_DOUBLE_EQ(m.C.coeff(r, r), 2.0 * modal.damping(r) * w);
   }
+  ASSERT_EQ(m.T.rows(), 2);
+  ASSERT_EQ(m.T.cols(), 2);
+  ASSERT_EQ(m.R.rows(), 2) << "the residual flexibility is kept";
+  ASSERT_EQ(m.R.cols(), 2);
   EXPECT_EQ(Eigen::MatrixXd(m.T), modal.shapes.transpose()); // x = Φ q + R F
   EXPECT_EQ(Eigen::MatrixXd(m.R), modal.residual_flexibility);
   EXPECT_EQ(t.parts.size(), 1u);
