@@ -49,12 +49,11 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   s.frequency_hz = m.frequency_hz;
   s.fundamental_only = m.fundamental_only;
   for (const auto& at : m.force_at) {
-    try {
-      s.force_equations.push_back(dofs.equation(at));
-    } catch (const std::invalid_argument& e) {
-      fail("force channel f@" + fem::to_string(at) + ": " + e.what() +
-           " (a force must act on a free DOF of the model)");
-    }
+    // The record's channel is at fault, not the model: say what the model has.
+    if (const std::string why = dofs.why_not_free(at); !why.empty())
+      fail("force channel f@" + fem::to_string(at) + ": " + why +
+           "; a force must act on a free DOF of the model");
+    s.force_equations.push_back(dofs.equation(at));
   }
   s.F = m.F;
 
@@ -792,13 +791,11 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());
     // Response channels on DOFs the model does not have, or holds fixed, are not used: said.
     for (std::size_t r = 0; r < m.response_at.size(); ++r) {
-      const fem::DofMap::State state = dofs.state(m.response_at[r]);
-      if (state == fem::DofMap::State::free) continue;
-      warnings.push_back(
-          fmt::format("{}: channel {}@{}: {}; the channel is not used", m.source,
-                      quantity_letter(m.measured_as[r]), fem::to_string(m.response_at[r]),
-                      state == fem::DofMap::State::absent ? "the model has no such DOF"
-                                                          : "a support holds this DOF fixed"));
+      const std::string why = dofs.why_not_free(m.response_at[r]);
+      if (why.empty()) continue;
+      warnings.push_back(fmt::format("{}: channel {}@{}: {}; the channel is not used", m.source,
+                                     quantity_letter(m.measured_as[r]),
+                                     fem::to_string(m.response_at[r]), why));
     }
     tests.push_back(spectrum(m, dofs, joints, warnings));
     tables += m.fundamental_only ? 1 : 0;
