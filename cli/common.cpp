@@ -1,5 +1,6 @@
 #include "cli/common.hpp"
 
+#include "frf/time_model.hpp"
 #include "io/files.hpp"
 
 #include <fmt/format.h>
@@ -45,6 +46,22 @@ void check_output_file(const fs::path& file, const std::string& option) {
   if (!parent.empty() && !fs::is_directory(parent, ec))
     throw io::Error(fmt::format("{} {}: the directory {} does not exist", option, file.string(),
                                 parent.string()));
+}
+
+void check_time_simulation(const io::ModelFile& file, const std::string& alternative) {
+  std::string what;
+  if (file.measured) what = "the substructure is given by measured FRFs ([frf])";
+  for (std::size_t p = 0; p < file.parts.size() && what.empty(); ++p) {
+    if (!file.parts[p].measured) continue;
+    // The part's file as the model file names it (relative to its directory).
+    fs::path part = file.parts[p].path.lexically_relative(file.path.parent_path());
+    if (part.empty()) part = file.parts[p].path;
+    what =
+        fmt::format("substructure {} ({}) is given by measured FRFs ([frf])", p + 1, part.string());
+  }
+  if (what.empty()) return;
+  throw io::Error(fmt::format("{}: {}{}", file.path.string(), frf::no_time_domain_model(what),
+                              alternative.empty() ? "" : "; " + alternative));
 }
 
 void check_harmonics(const std::vector<int>& harmonics, int lowest) {

@@ -54,6 +54,12 @@ std::vector<identify::Quantity> parse_channels(const std::vector<std::string>& c
 /// --route modal or full.
 identify::TransientRoute parse_route(const std::string& text);
 
+/// Time simulation (simulate --method time or another excitation, compare): refuses a model
+/// whose substructure, or one of its [[substructures]], is given by measured FRFs ([frf]),
+/// which have no time-domain model: io::Error naming the model file and the part's file, and
+/// `alternative` after the reason ("or simulate by harmonic balance, --method hb").
+void check_time_simulation(const io::ModelFile& file, const std::string& alternative = "");
+
 /// The model file, its substructure (modes of a large model by the chosen engine), and the
 /// NODE:DOF options resolved against it.
 struct Model {

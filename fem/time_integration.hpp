@@ -11,6 +11,21 @@
 /// with it) after the jump at the onset of stick; the step's λ on the stuck coordinates is
 /// replaced by the one for which Bᵀü = 0 there (from M⁻¹B, factorised at the first stick; not
 /// done when M is singular or when that force would exceed a limit, i.e. the joint slips).
+///
+/// With a static correction (a model integrated in modal coordinates whose left-out modes enter
+/// by their residual flexibility, fem/transient.hpp's TimeModel) the local coordinates also move
+/// with the current forces, y = Bᵀu + z − W_s (g + λ): z is the applied forces' static
+/// deflection at the coordinates, W_s their static flexibility to their own forces. The joints'
+/// force depends on y and y on it: the loop is closed inside the same local Newton solve, whose
+/// flexibility becomes Bᵀ K_eff⁻¹ B + W_s (see docs/method.md, "Time simulation of a modal
+/// model"). ẏ_{n+1} is still the trapezoidal rule's a1 (y_{n+1} − y_n) − a4 ẏ_n − a5 ÿ_n (stick
+/// keeps y exactly), but from estimates of ẏ_n, ÿ_n that carry no memory of their own: Bᵀu̇_n
+/// plus a backward difference of the static part's history (BDF2), 0 where the coordinate
+/// sticks. The static part has no mass: the trapezoidal rule's own velocity of it would keep an
+/// undamped alternating error (amplification −1) after every kink of the force, e.g. at each
+/// stick–slip transition. A coordinate with static flexibility is not held as above: its
+/// friction force follows from the positions (the static part is a spring), and Bᵀü = 0 would
+/// be the wrong condition; one without (W_s's row zero) is held as in the finite element model.
 #include "fem/assembly.hpp"
 #include "fem/status.hpp"
 
@@ -52,15 +67,28 @@ public:
   /// be factorised (singular: a DOF with neither stiffness nor mass, nor damping) is a status.
   Newmark(const Assembled& system, const SparseMatrix& C, const LocalForces* forces, double h,
           const NewmarkOptions& options = {});
+  /// With a static correction: `static_flexibility` is W_s (n_c × n_c, symmetric, positive
+  /// semi-definite; m/N), and every set_state() and step() gives z. Throws
+  /// std::invalid_argument for W_s of the wrong size or not finite, or no forces.
+  Newmark(const Assembled& system, const SparseMatrix& C, const LocalForces& forces,
+          const Eigen::MatrixXd& static_flexibility, double h, const NewmarkOptions& options = {});
   /// numerical_issue when the effective stiffness could not be factorised: then neither
   /// set_state() nor step() may be called.
   const Status& status() const { return status_; }
   /// Sets u, u̇ and computes ü from the equation of motion with force f (friction taken as 0).
   void set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& f);
+  /// The same with a static correction: z is the applied force's static deflection at the
+  /// coordinates (n_c); y = Bᵀu + z − W_s g(y, Bᵀv) is solved for y (the static part at rest).
+  void set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& f,
+                 const Eigen::VectorXd& z);
   /// Advances one step to the load f_{n+1} (one entry per equation). not_converging when the
   /// joints' Newton iteration did not converge within NewmarkOptions::max_newton iterations
   /// (the state is then the last iterate's).
   Status step(const Eigen::VectorXd& f_next);
+  /// The same with a static correction: z_next is the applied force's static deflection at the
+  /// coordinates at the end of the step.
+  Status step(const Eigen::VectorXd& f_next, const Eigen::VectorXd& z_next);
+  bool has_static_correction() const { return static_correction_; }
 
   const Eigen::VectorXd& u() const { return u_; }
   const Eigen::VectorXd& v() const { return v_; }
@@ -71,8 +99,13 @@ public:
   double h() const { return h_; }
 
 private:
+  void factorise();
+  Status advance(const Eigen::VectorXd& f_next, const Eigen::VectorXd* z_next);
   bool solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& e);
   void hold_stuck(Eigen::VectorXd& a_next);
+  /// Static correction: the static part y_s = z − W_s (g + λ) of the coordinates after a step,
+  /// and the estimates of ẏ, ÿ the next step starts from.
+  void update_static_estimates(const Eigen::VectorXd& z);
   const Assembled& system_;
   const SparseMatrix& C_;
   const LocalForces* forces_;
@@ -88,6 +121,12 @@ private:
   std::vector<char> stuck_, stuck_before_; ///< per coordinate: sticking after this / last step
   Eigen::MatrixXd mass_b_;     ///< M⁻¹ B, computed at the first stick (empty: not yet)
   bool mass_singular_ = false; ///< M has no inverse (massless DOFs): no projection
+  // Static correction (none unless the second constructor).
+  bool static_correction_ = false;
+  Eigen::MatrixXd static_flexibility_; ///< W_s
+  std::vector<char> no_static_;        ///< per coordinate: W_s's row is zero (held as in FE)
+  Eigen::MatrixXd static_history_;     ///< n_c × 4: y_s at steps n, n−1, n−2, n−3
+  Eigen::VectorXd ydot_, yddot_;       ///< estimates of ẏ_n, ÿ_n the next step starts from
 };
 
 /// A sinusoidal force F0·sin(2π f t) at one equation.
@@ -126,5 +165,17 @@ struct SteadyState {
 SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const LocalForces* forces,
                          const SineLoad& load, std::span<const int> output_equations,
                          const SteadyStateOptions& options = {});
+
+/// steady_state's periodic driver for any integrator (fem/transient.hpp's TimeModel uses it):
+/// from a state at rest, `step(force)` advances one time step (a period / steps_per_period) to
+/// the load amplitude·sin(2π f t) at the step's end, and `sample(u, v)` gives the n_outputs
+/// displacements and velocities at the current step. A step's failure is the result's status
+/// (its code; the reason says in which period and when). Throws std::invalid_argument as
+/// steady_state does for a frequency <= 0 or bad options.
+SteadyState
+periodic_steady_state(double amplitude, double frequency_hz, int n_outputs,
+                      const SteadyStateOptions& options,
+                      const std::function<Status(double force)>& step,
+                      const std::function<void(Eigen::VectorXd& u, Eigen::VectorXd& v)>& sample);
 
 } // namespace jointid::fem

@@ -66,14 +66,132 @@ private:
   SparseMatrix B_;
 };
 
-// Steps the integrator through the history. load(i, s) is the force vector on the integrated
-// system at sample i scaled by s; record(r, i) stores the outputs of sample i.
-TransientResponse
-integrate(const Assembled& system, const SparseMatrix& C, const LocalForces* forces,
-          const ForceHistory& history,
-          const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& load,
-          const std::function<void(const Newmark&, TransientResponse&, Eigen::Index)>& record,
-          int n_outputs, const TransientOptions& o) {
+// The forces expressed on the integrated coordinates of a TimeModel: B_w = Tᵀ B.
+class MappedForces final : public LocalForces {
+public:
+  MappedForces(const LocalForces& inner, const SparseMatrix& T) : inner_(inner) {
+    B_ = SparseMatrix(T.transpose()) * inner.coordinates();
+  }
+  const SparseMatrix& coordinates() const override { return B_; }
+  void evaluate(const Eigen::VectorXd& y, const Eigen::VectorXd& ydot, Eigen::VectorXd& g,
+                Eigen::VectorXd& dg_dy, Eigen::VectorXd& dg_dydot) const override {
+    inner_.evaluate(y, ydot, g, dg_dy, dg_dydot);
+  }
+  Eigen::VectorXd friction_limits() const override { return inner_.friction_limits(); }
+
+private:
+  const LocalForces& inner_;
+  SparseMatrix B_;
+};
+
+// Newmark on a TimeModel's coordinates w with its static correction, and its outputs on x:
+// u = T w + s, v = T ẇ + ṡ, a = T ẅ + s̈ with s = R F at the outputs, its derivatives by
+// second-order backward differences of its history.
+class TimeStepper {
+public:
+  TimeStepper(const TimeModel& m, const LocalForces* forces, double h, const NewmarkOptions& o,
+              std::span<const int> outputs)
+      : m_(m), forces_(forces), h_(h) {
+    const int n_x = m.num_equations(), n_w = m.system.dofs.num_equations();
+    if (m.T.cols() != n_w)
+      throw std::invalid_argument("time model: T has " + std::to_string(m.T.cols()) +
+                                  " columns for " + std::to_string(n_w) + " coordinates");
+    if (m.R.size() != 0 && (m.R.rows() != n_x || m.R.cols() != n_x))
+      throw std::invalid_argument("time model: R is " + std::to_string(m.R.rows()) + " x " +
+                                  std::to_string(m.R.cols()) + ", expected " + std::to_string(n_x) +
+                                  " x " + std::to_string(n_x));
+    if (forces && forces->coordinates().rows() != n_x)
+      throw std::invalid_argument("time model: the local forces act on " +
+                                  std::to_string(forces->coordinates().rows()) +
+                                  " equations, the model has " + std::to_string(n_x));
+    SparseMatrix pick(static_cast<Eigen::Index>(outputs.size()), n_x); // selects the outputs
+    std::vector<Eigen::Triplet<double>> ones;
+    for (std::size_t j = 0; j < outputs.size(); ++j)
+      ones.emplace_back(static_cast<int>(j), outputs[j], 1.0);
+    pick.setFromTriplets(ones.begin(), ones.end());
+    T_out_ = pick * m.T;
+    static_ = m.has_static_correction();
+    if (forces) mapped_.emplace(*forces, m.T);
+    if (static_) {
+      R_out_ = pick * m.R;
+      if (forces) {
+        const SparseMatrix& B = forces->coordinates();
+        Z_ = SparseMatrix(B.transpose()) * m.R;
+        RB_out_ = Eigen::MatrixXd(R_out_ * B);
+        static_flexibility_ = Eigen::MatrixXd(Z_ * B);
+      }
+      history_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(outputs.size()), 4);
+    }
+    if (static_ && forces)
+      newmark_.emplace(m.system, m.C, *mapped_, static_flexibility_, h, o);
+    else
+      newmark_.emplace(m.system, m.C, forces ? &*mapped_ : nullptr, h, o);
+  }
+  const Status& status() const { return newmark_->status(); }
+
+  /// At rest under the applied forces f (one per equation of x).
+  void start(const Eigen::VectorXd& f) {
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(m_.system.dofs.num_equations());
+    const Eigen::VectorXd load = m_.T.transpose() * f;
+    if (static_ && forces_)
+      newmark_->set_state(zero, zero, load, Z_ * f);
+    else
+      newmark_->set_state(zero, zero, load);
+    if (static_) {
+      const Eigen::VectorXd s = static_at_outputs(f);
+      for (Eigen::Index k = 0; k < history_.cols(); ++k)
+        history_.col(k) = s;
+    }
+  }
+  Status step(const Eigen::VectorXd& f) {
+    const Eigen::VectorXd load = m_.T.transpose() * f;
+    Status status = static_ && forces_ ? newmark_->step(load, Z_ * f) : newmark_->step(load);
+    if (static_ && status.ok()) {
+      for (Eigen::Index k = history_.cols() - 1; k > 0; --k)
+        history_.col(k) = history_.col(k - 1);
+      history_.col(0) = static_at_outputs(f);
+    }
+    return status;
+  }
+  /// Displacement, velocity, acceleration at the outputs now.
+  void outputs(Eigen::VectorXd& u, Eigen::VectorXd& v, Eigen::VectorXd& a) const {
+    u = T_out_ * newmark_->u();
+    v = T_out_ * newmark_->v();
+    a = T_out_ * newmark_->a();
+    if (!static_) return;
+    const Eigen::MatrixXd& s = history_;
+    u += s.col(0);
+    v += (3.0 * s.col(0) - 4.0 * s.col(1) + s.col(2)) / (2.0 * h_);
+    a += (2.0 * s.col(0) - 5.0 * s.col(1) + 4.0 * s.col(2) - s.col(3)) / (h_ * h_);
+  }
+
+private:
+  // R F at the outputs, F = f − B G with the joints' current force G.
+  Eigen::VectorXd static_at_outputs(const Eigen::VectorXd& f) const {
+    Eigen::VectorXd s = R_out_ * f;
+    if (forces_) s -= RB_out_ * newmark_->local_force();
+    return s;
+  }
+  const TimeModel& m_;
+  const LocalForces* forces_;
+  double h_;
+  bool static_ = false;
+  std::optional<MappedForces> mapped_;
+  std::optional<Newmark> newmark_;
+  SparseMatrix T_out_, R_out_, Z_;     ///< T, R at the outputs; Z = Bᵀ R
+  Eigen::MatrixXd RB_out_;             ///< R B at the outputs
+  Eigen::MatrixXd static_flexibility_; ///< Bᵀ R B
+  Eigen::MatrixXd history_;            ///< R F at the outputs, steps n … n−3 (newest first)
+};
+
+// Steps an integrator through the history: `ready` is its status before the first step, start(f)
+// sets it at rest under the force samples f (one per history column, faded in), step(f)
+// advances it to f, record(r, i) stores the outputs of sample i.
+TransientResponse integrate(const ForceHistory& history, int n_outputs, const TransientOptions& o,
+                            const std::function<Status()>& ready,
+                            const std::function<void(const Eigen::VectorXd&)>& start,
+                            const std::function<Status(const Eigen::VectorXd&)>& step,
+                            const std::function<void(TransientResponse&, Eigen::Index)>& record) {
   if (o.substeps < 1)
     throw std::invalid_argument("transient response: expected at least 1 substep, got " +
                                 std::to_string(o.substeps));
@@ -81,8 +199,6 @@ integrate(const Assembled& system, const SparseMatrix& C, const LocalForces* for
     throw std::invalid_argument("transient response: expected a fade-in >= 0 s, got " +
                                 std::to_string(o.fade_in_s));
   const Eigen::Index n = history.samples.rows();
-  const int n_sys = system.dofs.num_equations();
-  const double h = history.dt / o.substeps;
   auto fade = [&](double t) {
     return t >= o.fade_in_s ? 1.0 : 0.5 * (1.0 - std::cos(std::numbers::pi * t / o.fade_in_s));
   };
@@ -99,7 +215,7 @@ integrate(const Assembled& system, const SparseMatrix& C, const LocalForces* for
       const double t = static_cast<double>(i) * history.dt;
       f = (1.0 - tau) * fade(t) * history.samples.row(i).transpose() +
           tau * fade(t + history.dt) * history.samples.row(i + 1).transpose();
-      return Eigen::VectorXd(load(f));
+      return f;
     }
     const Eigen::Index first =
         std::clamp<Eigen::Index>(static_cast<Eigen::Index>(sample) - 1, 0, n - 4);
@@ -113,40 +229,60 @@ integrate(const Assembled& system, const SparseMatrix& C, const LocalForces* for
       f += w * fade(static_cast<double>(node) * history.dt) *
            history.samples.row(node).transpose();
     }
-    return Eigen::VectorXd(load(f));
+    return f;
   };
 
   TransientResponse out;
   out.t = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) * history.dt);
   out.u = out.v = out.a = Eigen::MatrixXd::Zero(n, n_outputs);
-  Newmark integrator(system, C, forces, h, o.newmark);
-  if (!integrator.status().ok()) {
-    out.status = integrator.status();
+  if (Status status = ready(); !status.ok()) {
+    out.status = std::move(status);
     out.samples_done = 0;
     return out;
   }
-  integrator.set_state(Eigen::VectorXd::Zero(n_sys), Eigen::VectorXd::Zero(n_sys), applied(0.0));
-  record(integrator, out, 0);
+  start(applied(0.0));
+  record(out, 0);
   out.samples_done = 1;
   for (Eigen::Index i = 0; i + 1 < n; ++i) {
     for (int s = 1; s <= o.substeps; ++s) {
       const double sample = static_cast<double>(i) + static_cast<double>(s) / o.substeps;
-      if (Status step = integrator.step(applied(sample)); !step.ok()) {
+      if (Status status = step(applied(sample)); !status.ok()) {
         std::ostringstream reason;
         reason << "the joints' Newton iteration failed after t = "
                << static_cast<double>(i) * history.dt << " s (no convergence in "
                << o.newmark.max_newton << " iterations on the way to t = " << sample * history.dt
                << " s)";
-        out.status = Status::failure(step.code, reason.str());
+        out.status = Status::failure(status.code, reason.str());
         return out;
       }
     }
-    record(integrator, out, i + 1);
+    record(out, i + 1);
     out.samples_done = static_cast<int>(i + 2);
     if (o.progress && (i + 2) % std::max<Eigen::Index>(1, n / 100) == 0)
       o.progress(static_cast<double>(i + 2) / static_cast<double>(n));
   }
   return out;
+}
+
+// A Newmark integrator of (system, C, forces) through `integrate`: `load` maps the history's
+// force samples to the integrated equations, `record` stores the outputs.
+TransientResponse integrate_newmark(
+    const Assembled& system, const SparseMatrix& C, const LocalForces* forces,
+    const ForceHistory& history, const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& load,
+    const std::function<void(const Newmark&, TransientResponse&, Eigen::Index)>& record,
+    int n_outputs, const TransientOptions& o) {
+  if (o.substeps < 1)
+    throw std::invalid_argument("transient response: expected at least 1 substep, got " +
+                                std::to_string(o.substeps));
+  const int n_sys = system.dofs.num_equations();
+  Newmark integrator(system, C, forces, history.dt / o.substeps, o.newmark);
+  return integrate(
+      history, n_outputs, o, [&] { return integrator.status(); },
+      [&](const Eigen::VectorXd& f) {
+        integrator.set_state(Eigen::VectorXd::Zero(n_sys), Eigen::VectorXd::Zero(n_sys), load(f));
+      },
+      [&](const Eigen::VectorXd& f) { return integrator.step(load(f)); },
+      [&](TransientResponse& r, Eigen::Index i) { record(integrator, r, i); });
 }
 
 } // namespace
@@ -172,7 +308,8 @@ TransientResponse transient_response(const Assembled& system, const SparseMatrix
       r.a(i, c) = m.a()(out_eq[j]);
     }
   };
-  return integrate(system, C, forces, history, load, record, static_cast<int>(out_eq.size()), o);
+  return integrate_newmark(system, C, forces, history, load, record,
+                           static_cast<int>(out_eq.size()), o);
 }
 
 ModalReduction modal_reduction(const Assembled& system, const Modes& modes, const Damping& damping,
@@ -292,8 +429,66 @@ TransientResponse transient_response(const ModalReduction& red, const LocalForce
     r.v.row(i) = (at_outputs * m.v()).transpose();
     r.a.row(i) = (at_outputs * m.a()).transpose();
   };
-  return integrate(red.system, red.C, projected ? &*projected : nullptr, history, load, record,
-                   static_cast<int>(outputs.size()), o);
+  return integrate_newmark(red.system, red.C, projected ? &*projected : nullptr, history, load,
+                           record, static_cast<int>(outputs.size()), o);
+}
+
+TransientResponse transient_response(const TimeModel& model, const LocalForces* forces,
+                                     const ForceHistory& history, std::span<const int> outputs,
+                                     const TransientOptions& o) {
+  const int n_x = model.num_equations();
+  check_history(history, n_x);
+  check_outputs(outputs, n_x);
+  if (o.substeps < 1)
+    throw std::invalid_argument("transient response: expected at least 1 substep, got " +
+                                std::to_string(o.substeps));
+  TimeStepper stepper(model, forces, history.dt / o.substeps, o.newmark, outputs);
+  auto applied = [&](const Eigen::VectorXd& f) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(n_x);
+    for (std::size_t j = 0; j < history.equations.size(); ++j)
+      x(history.equations[j]) += f(static_cast<Eigen::Index>(j));
+    return x;
+  };
+  Eigen::VectorXd u, v, a;
+  return integrate(
+      history, static_cast<int>(outputs.size()), o, [&] { return stepper.status(); },
+      [&](const Eigen::VectorXd& f) { stepper.start(applied(f)); },
+      [&](const Eigen::VectorXd& f) { return stepper.step(applied(f)); },
+      [&](TransientResponse& r, Eigen::Index i) {
+        stepper.outputs(u, v, a);
+        r.u.row(i) = u.transpose();
+        r.v.row(i) = v.transpose();
+        r.a.row(i) = a.transpose();
+      });
+}
+
+SteadyState steady_state(const TimeModel& model, const LocalForces* forces, const SineLoad& load,
+                         std::span<const int> outputs, const SteadyStateOptions& o) {
+  const int n_x = model.num_equations();
+  if (load.equation < 0 || load.equation >= n_x)
+    throw std::invalid_argument("sine load: bad equation");
+  if (!(load.frequency_hz > 0.0))
+    throw std::invalid_argument("sine load: frequency must be > 0 Hz");
+  if (o.steps_per_period < 8)
+    throw std::invalid_argument(
+        "steady state: need >= 8 steps per period and max_periods > output_periods + 1");
+  check_outputs(outputs, n_x);
+  const double h = 1.0 / load.frequency_hz / o.steps_per_period;
+  TimeStepper stepper(model, forces, h, o.newmark, outputs);
+  if (!stepper.status().ok()) {
+    SteadyState out;
+    out.status = stepper.status();
+    return out;
+  }
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n_x), a;
+  stepper.start(f);
+  return periodic_steady_state(
+      load.amplitude, load.frequency_hz, static_cast<int>(outputs.size()), o,
+      [&](double force) {
+        f(load.equation) = force;
+        return stepper.step(f);
+      },
+      [&](Eigen::VectorXd& u, Eigen::VectorXd& v) { stepper.outputs(u, v, a); });
 }
 
 } // namespace jointid::fem

@@ -90,4 +90,36 @@ TransientResponse transient_response(const ModalReduction& reduction, const Loca
                                      const ForceHistory& history, std::span<const int> outputs,
                                      const TransientOptions& options = {});
 
+/// Any linear substructure in the coordinates w its time integration uses, with the static
+/// correction of modes left out:
+///     M ẅ + C ẇ + K w = Tᵀ F,    x = T w + R F,    F = f − B (g + λ),
+/// x: the substructure's equations (physical DOFs), f the applied forces there, B the joints'.
+/// T maps w to x: the identity for a finite element model in full, the mode shapes Φ (and
+/// pseudo-modes) in modal coordinates, block by block for several substructures side by side.
+/// R (symmetric, positive semi-definite; m/N) is the static flexibility of the modes a modal
+/// model leaves out, applied with the current total force, the joints' included (the static
+/// correction, see docs/method.md); empty where there is none. frf::time_domain_model builds it.
+struct TimeModel {
+  Assembled system; ///< K, M of w; its DofMap numbers w (no physical meaning)
+  SparseMatrix C;   ///< damping of w (may be empty: none)
+  SparseMatrix T;   ///< n_x × n_w
+  SparseMatrix R;   ///< n_x × n_x, or 0 × 0: no static correction
+  int num_equations() const { return static_cast<int>(T.rows()); }
+  bool has_static_correction() const { return R.nonZeros() > 0; }
+};
+
+/// The simulation of a TimeModel: `forces` act on its physical equations x (their coordinates
+/// B are x's), the history and the outputs are equations of x. The outputs' velocity and
+/// acceleration are T ẇ + R Ḟ and T ẅ + R F̈, the force's derivatives by second-order backward
+/// differences of R F (the static part has no state of its own). Throws std::invalid_argument
+/// as the other overloads do, or for T, R of inconsistent sizes.
+TransientResponse transient_response(const TimeModel& model, const LocalForces* forces,
+                                     const ForceHistory& history, std::span<const int> outputs,
+                                     const TransientOptions& options = {});
+
+/// fem::steady_state of a TimeModel: the sine load acts on equation load.equation of x, the
+/// outputs are equations of x.
+SteadyState steady_state(const TimeModel& model, const LocalForces* forces, const SineLoad& load,
+                         std::span<const int> outputs, const SteadyStateOptions& options = {});
+
 } // namespace jointid::fem

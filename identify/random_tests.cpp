@@ -4,8 +4,8 @@
 #include "identify/spectra.hpp"
 
 #include "fem/excitation.hpp"
-#include "fem/modal.hpp"
 #include "fem/transient.hpp"
+#include "frf/time_model.hpp"
 
 #include <fmt/format.h>
 
@@ -20,6 +20,14 @@ namespace {
 
 void add_unique(std::vector<int>& list, int value) {
   if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
+}
+
+// "1: full model, 36 equations; 2: 5 modes of its [modal] model, …"
+std::string substructure_list(const std::vector<std::string>& parts) {
+  std::string text;
+  for (std::size_t p = 0; p < parts.size(); ++p)
+    text += fmt::format("{}{}: {}", p ? "; " : "", p + 1, parts[p]);
+  return text;
 }
 
 } // namespace
@@ -91,10 +99,6 @@ double power_band_hz(const ForceInput& in, double fraction) {
 ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joints::Joint>& joints,
                            const ForceInput& in, const ForcedOptions& o) {
   // 1. Checks.
-  if (!sub.system())
-    throw std::invalid_argument(std::string("time simulation needs a finite element model; this "
-                                            "substructure is given by ") +
-                                sub.given_by());
   if (!(std::isfinite(in.sample_rate_hz) && in.sample_rate_hz > 0.0))
     throw std::invalid_argument(
         fmt::format("force history: expected a sample rate > 0 Hz, got {}", in.sample_rate_hz));
@@ -132,78 +136,41 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
   options.fade_in_s = o.fade_in_s;
   options.progress = o.progress;
 
-  // 3. Simulate.
+  // 3. Simulate: the substructure in its time model's coordinates (frf/time_model.hpp).
   ForcedTest test;
-  fem::TransientResponse r;
-  const fem::Assembled& system = *sub.system();
+  frf::TimeModelOptions to;
+  to.modal_coordinates = o.route == TransientRoute::modal;
+  to.modal_cutoff_hz = o.modal_cutoff_hz > 0.0 ? o.modal_cutoff_hz : 0.5 * in.sample_rate_hz;
+  to.static_correction = o.static_correction;
+  to.loaded = history.equations;
+  for (int e : joints::joint_dof_set(joints, dofs))
+    add_unique(to.loaded, e);
+  // The frequency below which 99 % of the force's power lies: a mode left out below it is
+  // driven at its resonance, which the static correction does not hold (a warning).
+  if (to.modal_coordinates) to.force_band_hz = power_band_hz(in, 0.99);
+  const frf::TimeDomainModel model = frf::time_domain_model(sub, to);
+  if (!model.status.ok()) {
+    test.status = model.status.within("time simulation: ");
+    return test;
+  }
+  test.modes_kept = model.modes_kept;
+  test.static_columns = model.static_columns;
+  test.warnings.insert(test.warnings.end(), model.warnings.begin(), model.warnings.end());
+  const fem::TransientResponse r =
+      fem::transient_response(model.model, local, history, outputs, options);
   std::string method;
-  if (o.route == TransientRoute::full) {
-    const fem::Outcome<fem::SparseMatrix> damping = sub.damping_matrix();
-    if (!damping.status.ok()) {
-      test.status = damping.status.within("time simulation: ");
-      return test;
-    }
-    r = fem::transient_response(system, damping.value, local, history, outputs, options);
+  if (sub.system() && o.route == TransientRoute::full)
     method = fmt::format("method: time, full model (Newmark, average acceleration, {} equations, "
                          "{} steps per sample)",
                          dofs.num_equations(), o.substeps);
-  } else {
-    const double cutoff = o.modal_cutoff_hz > 0.0 ? o.modal_cutoff_hz : 0.5 * in.sample_rate_hz;
-    // The frequency below which 99 % of the force's power lies: a mode left out below it is
-    // driven at its resonance, which the static correction does not hold.
-    const double force_band = power_band_hz(in, 0.99);
-    // Small models: every mode (dense); others: only the band below the cutoff (shift-invert
-    // Lanczos on a sparse factorisation) — a dense eigensolution of 1000 equations alone takes
-    // longer than the whole simulation.
-    constexpr int every_mode_limit = 200;
-    fem::ModalOptions mo;
-    mo.num_modes = 0;
-    if (dofs.num_equations() <= every_mode_limit) {
-      mo.engine = fem::ModalEngine::dense;
-    } else {
-      mo.engine = fem::ModalEngine::sparse;
-      mo.max_frequency_hz = std::max(cutoff, force_band);
-    }
-    fem::Modes modes = fem::modal_analysis(system, mo);
-    if (!modes.status.ok()) {
-      test.status = modes.status.within("time simulation: the modal analysis failed: ");
-      return test;
-    }
-    int kept = 0;
-    while (kept < modes.num_modes() && modes.frequency_hz(kept) < cutoff)
-      ++kept;
-    const bool all = kept == dofs.num_equations();
-    int below_band = 0;
-    for (int r = kept; r < modes.num_modes() && modes.frequency_hz(r) <= force_band; ++r)
-      ++below_band;
-    if (below_band > 0)
-      test.warnings.push_back(fmt::format(
-          "modal route: {} mode{} between the modal cutoff, {:.4g} Hz, and {:.4g} Hz (below which "
-          "99 % of the force's power lies) {} left out (the first at {:.4g} Hz): the force drives "
-          "{} near resonance, which the static correction does not hold, so the response can be "
-          "tens of per cent off; raise the modal cutoff above {:.4g} Hz (0: the Nyquist frequency)",
-          below_band, below_band > 1 ? "s" : "", cutoff, force_band, below_band > 1 ? "are" : "is",
-          modes.frequency_hz(kept), below_band > 1 ? "them" : "it", force_band));
-    modes.omega.conservativeResize(kept);
-    modes.phi.conservativeResize(Eigen::NoChange, kept);
-    std::vector<int> loaded = history.equations;
-    for (int e : joints::joint_dof_set(joints, dofs))
-      add_unique(loaded, e);
-    if (!o.static_correction || all) loaded.clear();
-    const fem::ModalReduction reduction =
-        fem::modal_reduction(system, modes, sub.damping(), loaded);
-    test.modes_kept = reduction.kept_modes;
-    test.static_columns = reduction.static_columns;
-    r = fem::transient_response(reduction, local, history, outputs, options);
-    method =
-        fmt::format("method: time, modal coordinates (Newmark, average acceleration, {} modes "
-                    "below {} Hz of {} equations{}, {} steps per sample)",
-                    kept, cutoff, dofs.num_equations(),
-                    reduction.static_columns > 0
-                        ? fmt::format(", static correction at {} DOFs", reduction.static_columns)
-                        : std::string(all ? ", every mode" : ", no static correction"),
-                    o.substeps);
-  }
+  else if (sub.parts().empty()) // in modal coordinates: a finite element model's, or [modal]
+    method = fmt::format("method: time, modal coordinates (Newmark, average acceleration, {}, {} "
+                         "steps per sample)",
+                         model.parts.front(), o.substeps);
+  else
+    method = fmt::format("method: time, each substructure in its own coordinates (Newmark, "
+                         "average acceleration; {}; {} steps per sample)",
+                         substructure_list(model.parts), o.substeps);
   if (!r.status.ok()) {
     test.status = r.status.within("time simulation: ");
     return test;

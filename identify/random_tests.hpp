@@ -1,9 +1,12 @@
 #pragma once
 /// Virtual tests under any force history (band-limited random, sine sweep, multisine, or a force
-/// channel of a measured record): the finite element model with its joints at their values,
-/// simulated in time (fem/transient.hpp) — in full (the reference) or in modal coordinates with
-/// a static correction (fast) — and written as a measurement record (DESIGN.md's CSV contract).
-/// SI units; the record's sample rate is the force history's.
+/// channel of a measured record): the substructure with its joints at their values, simulated in
+/// time (fem/transient.hpp, frf/time_model.hpp) — a finite element model in full (the
+/// reference) or in modal coordinates with a static correction (fast), a [modal] model in its
+/// modal coordinates with its residual flexibility as the static correction, several
+/// substructures each so — and written as a measurement record (DESIGN.md's CSV contract).
+/// Measured FRFs ([frf]) have no time-domain model. SI units; the record's sample rate is the
+/// force history's.
 #include "fem/status.hpp"
 #include "frf/substructure.hpp"
 #include "identify/record.hpp"
@@ -17,6 +20,8 @@
 
 namespace jointid::identify {
 
+/// How finite element models and [matrices] (also as parts of several substructures) are
+/// integrated; a [modal] model is always in its modal coordinates.
 enum class TransientRoute {
   full, ///< Newmark on the whole finite element model
   modal ///< Newmark on the retained modes, the rest as static flexibility at the loaded DOFs
@@ -64,14 +69,14 @@ struct ForcedTest {
   Record record;
   std::vector<std::string> comments; ///< how it was made, for the CSV's comment lines
   std::vector<std::string> warnings;
-  int modes_kept = 0;     ///< modal route: modes integrated
-  int static_columns = 0; ///< modal route: static-correction coordinates
+  int modes_kept = 0;     ///< modal coordinates integrated (modal route, [modal] models)
+  int static_columns = 0; ///< modal route: static pseudo-modes of finite element models
 };
 
 /// Simulates the structure from rest under the forces. Outputs: every joint DOF, then the force
 /// DOFs, then extra_outputs (each once). Throws std::invalid_argument for bad options or a
-/// modal substructure (time integration needs a finite element model). A numerical failure
-/// (the joints' iteration at a step, the modal analysis) is the result's status.
+/// substructure (or part) given by measured FRFs (frf::time_domain_model says why). A numerical
+/// failure (the joints' iteration at a step, the modal analysis) is the result's status.
 ForcedTest simulate_forced(const frf::Substructure& substructure,
                            const std::vector<joints::Joint>& joints, const ForceInput& input,
                            const ForcedOptions& options = {});

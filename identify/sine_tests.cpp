@@ -2,6 +2,8 @@
 
 #include "fem/parallel.hpp"
 #include "fem/time_integration.hpp"
+#include "fem/transient.hpp"
+#include "frf/time_model.hpp"
 
 #include <fmt/format.h>
 
@@ -105,10 +107,6 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     if (q == Quantity::force)
       throw std::invalid_argument("simulate: force is always written; responses are x, v or a");
   const bool time_domain = o.method == SimulationMethod::time_integration;
-  if (time_domain && !sub.system())
-    throw std::invalid_argument(std::string("simulate: time integration needs a finite element "
-                                            "model; this substructure is given by ") +
-                                sub.given_by() + " (use harmonic balance)");
 
   const fem::DofMap& dofs = sub.dofs();
   joints::validate_joints(joints, dofs);
@@ -173,15 +171,31 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
   };
   std::vector<SimulatedTest> out;
   if (time_domain) {
-    const fem::Outcome<fem::SparseMatrix> damping = sub.damping_matrix();
-    if (!damping.status.ok()) {
+    // Finite element models in full, [modal] models in their modal coordinates with their
+    // residual flexibility (frf/time_model.hpp).
+    frf::TimeDomainModel model;
+    try {
+      model = frf::time_domain_model(sub);
+    } catch (const std::invalid_argument& e) { // measured FRFs
+      throw std::invalid_argument(std::string("simulate: ") + e.what() +
+                                  "; or simulate by harmonic balance");
+    }
+    if (!model.status.ok()) {
       for (const auto& plan : plans)
-        out.push_back(failed_test(plan, damping.status.within(fmt::format(
+        out.push_back(failed_test(plan, model.status.within(fmt::format(
                                             "time integration at {} Hz, {} N: ",
                                             compact(plan.frequency_hz), compact(plan.amplitude)))));
       return out;
     }
-    const fem::SparseMatrix& C = damping.value;
+    // How the substructure is integrated, when it is not one finite element model in full.
+    std::string coordinates;
+    if (!sub.system()) {
+      for (std::size_t p = 0; p < model.parts.size(); ++p)
+        coordinates += model.parts.size() == 1 ? model.parts[p]
+                                               : fmt::format("{}substructure {}: {}", p ? "; " : "",
+                                                             p + 1, model.parts[p]);
+      coordinates = ", " + coordinates;
+    }
     const joints::JointForces forces(joints, dofs);
     fem::SteadyStateOptions options;
     options.steps_per_period = o.steps_per_period;
@@ -192,7 +206,7 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     for (const auto& plan : plans)
       jobs.push_back([&, plan] {
         const fem::SteadyState s = fem::steady_state(
-            *sub.system(), C, &forces, {force_equation, plan.amplitude, plan.frequency_hz}, outputs,
+            model.model, &forces, {force_equation, plan.amplitude, plan.frequency_hz}, outputs,
             options);
         const bool periodic = s.status.ok();
         if (!periodic && s.status.code != fem::Status::Code::not_periodic) {
@@ -203,7 +217,7 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
         }
         SimulatedTest test = make_test(plan, s.t, s.force, s.u, s.v);
         test.comments.push_back(fmt::format(
-            "method: time (Newmark, average acceleration, {} steps per period{})",
+            "method: time{} (Newmark, average acceleration, {} steps per period{})", coordinates,
             o.steps_per_period,
             stride > 1 ? fmt::format(", every {}th step recorded", stride) : std::string()));
         test.comments.push_back(fmt::format(

@@ -1,8 +1,10 @@
 #pragma once
 /// Virtual sine tests: the model with its joints at their values, driven by F0 sin(2π f t) at
 /// one DOF, simulated to its periodic steady state, and written as measurement records
-/// (DESIGN.md's CSV contract) — by implicit time integration of the finite element model
-/// (exact stick–slip friction) or by harmonic balance on the joint DOFs. Optionally with
+/// (DESIGN.md's CSV contract) — by implicit time integration (exact stick–slip friction) of
+/// the finite element model in full, of a [modal] model in its modal coordinates with its
+/// residual flexibility as a static correction, or of several substructures each so
+/// (frf/time_model.hpp) — or by harmonic balance on the joint DOFs. Optionally with
 /// measurement noise, so that identification and discovery can be tested on data whose truth
 /// is known.
 #include "fem/status.hpp"
@@ -68,9 +70,9 @@ std::string sine_test_name(const SineTestPlan& plan);
 
 /// Simulates every test. Outputs: every joint DOF, then the force DOF, then `extra_outputs`
 /// (each once). Throws std::invalid_argument for bad plans or options (naming the value), or a
-/// force DOF the model lacks. A test that cannot be simulated has a status that says why
-/// (SimulatedTest::status) and no record; the others are simulated all the same. Time
-/// integration needs a finite element substructure.
+/// force DOF the model lacks, or time integration of measured FRFs ([frf], also as a part:
+/// they have no time-domain model). A test that cannot be simulated has a status that says why
+/// (SimulatedTest::status) and no record; the others are simulated all the same.
 std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& substructure,
                                                const std::vector<joints::Joint>& joints,
                                                const fem::NodeDof& force_at,

@@ -72,6 +72,7 @@ void Compare::run() {
 
   // 2. The inputs.
   const io::ModelFile file = io::read_model(model_);
+  check_time_simulation(file); // the prediction is a time simulation
   if (file.joints.empty())
     warn(model_.string() + ": no [[joints]]: the prediction is the linear substructure's");
   const identify::Record record = io::read_record(record_);

@@ -172,6 +172,8 @@ void Simulate::run_sine() {
 
   // 2. The model and the tests.
   const Model model(model_, engine());
+  if (options.method == identify::SimulationMethod::time_integration)
+    check_time_simulation(model.file, "or simulate by harmonic balance (--method hb)");
   const fem::NodeDof force_at = model.dof("--force", force_);
   // Refused before the simulation, not after: the outputs never replace an input.
   io::check_not_an_input(output_dir_ / "stepped_sine.csv");
@@ -332,6 +334,7 @@ void Simulate::run_signal() {
 
   // 3. The model and the simulation.
   const Model model(model_, engine());
+  check_time_simulation(model.file);
   if (!from_record) input.at = {model.dof("--force", force_)};
   for (const auto& at : input.at) // a record's force channel is its fault, not the model's
     if (const std::string why = model.sub.dofs().why_not_free(at); from_record && !why.empty())
