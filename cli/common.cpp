@@ -1,5 +1,7 @@
 #include "cli/common.hpp"
 
+#include "io/arguments.hpp"
+
 #include "frf/time_model.hpp"
 #include "io/files.hpp"
 
@@ -65,42 +67,18 @@ void check_time_simulation(const io::ModelFile& file, const std::string& alterna
 }
 
 void check_harmonics(const std::vector<int>& harmonics, int lowest) {
-  if (harmonics.empty()) throw io::Error("--harmonics: expected at least one harmonic, e.g. 1,2,3");
-  if (harmonics.size() == 1 && harmonics[0] == 0)
-    throw io::Error("--harmonics: 0 alone is the mean (static) balance, which a sine test does not "
-                    "excite: add harmonic 1 (e.g. 0,1,2,3)");
-  std::set<int> seen;
-  for (int k : harmonics) {
-    // No upper cap: the sampling sets the highest harmonic a record has (measure() says so).
-    if (k < lowest)
-      throw io::Error(fmt::format("--harmonics: expected harmonics >= {}, got {}", lowest, k));
-    if (!seen.insert(k).second)
-      throw io::Error(fmt::format("--harmonics: harmonic {} is listed twice", k));
-  }
+  io::check_harmonics("--harmonics", harmonics, lowest);
 }
 
 void check_balance_harmonics(int harmonics, int lowest, const std::string& why) {
-  if (harmonics < lowest || harmonics > 200)
-    throw io::Error(why.empty() ? fmt::format("--balance-harmonics: expected {} to 200, got {}",
-                                              lowest, harmonics)
-                                : fmt::format("--balance-harmonics: expected from {} ({}) to 200, "
-                                              "got {}",
-                                              lowest, why, harmonics));
+  io::check_balance_harmonics("--balance-harmonics", harmonics, lowest, why);
 }
 
 void check_amplitudes(const std::vector<double>& amplitudes) {
-  if (amplitudes.empty()) throw io::Error("--amplitude: expected at least one amplitude (N)");
-  for (double a : amplitudes)
-    if (!(std::isfinite(a) && a > 0.0))
-      throw io::Error(
-          fmt::format("--amplitude: expected finite amplitudes > 0 (N or N m), got {}", a));
+  io::check_amplitudes("--amplitude", amplitudes);
 }
 
-void check_noise(double noise) {
-  if (!(std::isfinite(noise) && noise >= 0.0 && noise < 1.0))
-    throw io::Error(fmt::format(
-        "--noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", noise));
-}
+void check_noise(double noise) { io::check_noise("--noise", noise); }
 
 std::pair<double, double> parse_pair(const std::string& option, const std::string& text,
                                      const char* example) {
@@ -132,19 +110,7 @@ std::pair<double, double> parse_band(const std::string& option, const std::strin
 }
 
 std::vector<identify::Quantity> parse_channels(const std::vector<std::string>& channels) {
-  std::vector<identify::Quantity> out;
-  for (const auto& c : channels) {
-    const identify::Quantity q =
-        c == "x"   ? identify::Quantity::displacement
-        : c == "v" ? identify::Quantity::velocity
-        : c == "a" ? identify::Quantity::acceleration
-                   : throw io::Error(fmt::format("--channels: expected x, v or a, got \"{}\"", c));
-    if (std::find(out.begin(), out.end(), q) != out.end())
-      throw io::Error(fmt::format("--channels: {} is listed twice", c));
-    out.push_back(q);
-  }
-  if (out.empty()) throw io::Error("--channels: expected x, v and/or a");
-  return out;
+  return io::parse_channels("--channels", channels);
 }
 
 identify::TransientRoute parse_route(const std::string& text) {

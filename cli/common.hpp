@@ -36,7 +36,8 @@ void make_output_dir(const std::filesystem::path& dir);
 /// -o FILE (and the other file outputs): a file name in an existing directory.
 void check_output_file(const std::filesystem::path& file, const std::string& option = "-o");
 
-/// --harmonics: at least one, each from `lowest` to 50 and once, not 0 alone.
+/// --harmonics: at least one, each >= `lowest` and once, not 0 alone (no upper cap: the
+/// sampling sets the highest harmonic a record has).
 void check_harmonics(const std::vector<int>& harmonics, int lowest);
 /// --balance-harmonics K from `lowest` to 200; `why` says where the lowest comes from.
 void check_balance_harmonics(int harmonics, int lowest, const std::string& why = "");

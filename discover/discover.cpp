@@ -277,7 +277,8 @@ Result discover(const frf::Substructure& substructure, const std::vector<joints:
   // Tests left out (too few steady periods) are passed over, with their reason.
   std::vector<std::string> left_out;
   const std::vector<identify::Measurement> kept = identify::usable(tests, left_out);
-  if (kept.empty())
+  // (No tests at all is refused by the Problem, which says what it needs.)
+  if (kept.empty() && !left_out.empty())
     throw std::invalid_argument("discover: every test is left out: " + left_out.front());
   detail::Problem problem(substructure, start, kept, options);
   Result result = detail::Loop(problem).run();

@@ -855,9 +855,9 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   out.residual_rms = std::sqrt(residual.squaredNorm() / m);
   out.residual_relative = residual.norm() / std::max(p.norm(), 1e-300);
   if (out.condition_number > 1e8)
-    out.warnings.push_back("Q is ill-conditioned (condition number " +
-                           std::to_string(out.condition_number) +
-                           "): parameters may be poorly determined");
+    out.warnings.push_back(fmt::format(
+        "Q is ill-conditioned (condition number {:.3g}): parameters may be poorly determined",
+        out.condition_number));
   const int redundancy = m - nu;
   // The variance factor: the weighted residual's χ² per degree of freedom, at least 1 (a misfit
   // beyond the noise widens the intervals, never narrows them); without the noise, the plain

@@ -5,6 +5,7 @@
 #include "identify/sweep.hpp"
 
 #include <Eigen/Dense>
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -182,9 +183,9 @@ Measurement measure_sine(const Record& r, double frequency_hz, const MeasureOpti
          number(1.0 / m.frequency_hz) + " s");
   const double nyquist = 0.5 / dt;
   if (K * m.frequency_hz >= nyquist)
-    fail("harmonic " + std::to_string(K) + " (" + std::to_string(K * m.frequency_hz) +
-         " Hz) is at or above the Nyquist frequency of the sampling (" + std::to_string(nyquist) +
-         " Hz): sample faster, or ask fewer harmonics");
+    fail(fmt::format("harmonic {} ({:.6g} Hz) is at or above the Nyquist frequency of the "
+                     "sampling ({:.6g} Hz): sample faster, or ask fewer harmonics",
+                     K, K * m.frequency_hz, nyquist));
   if (n < 2 * K + 1)
     fail("its whole periods hold " + std::to_string(n) +
          " samples, too few to fit harmonics 0 to " + std::to_string(K) + " (at least " +

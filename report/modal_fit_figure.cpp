@@ -119,7 +119,12 @@ Figure modal_fit_figure(const identify::ModalFit& fit, const identify::MeasuredF
   for (int c = 0; c < O; ++c) {
     const auto k = static_cast<std::size_t>(c);
     Chart mag, ph;
-    mag.title = fmt::format("{} / {}", data.response_names[k], data.drive_name);
+    // Receptance whatever was measured: the title says which channel it was converted from.
+    const std::string to = fem::to_string(data.responses[k]);
+    mag.title = data.response_names[k] == to
+                    ? fmt::format("receptance {} / {}", to, fem::to_string(data.drive))
+                    : fmt::format("receptance {} / {} (from {})", to,
+                                  fem::to_string(data.drive), data.response_names[k]);
     mag.x_label = ph.x_label = "frequency (Hz)";
     mag.y_label = "|H| (" + unit(data.responses[k], data.drive) + ")";
     mag.log_y = true;

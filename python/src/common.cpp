@@ -1,4 +1,5 @@
 #include "common.hpp"
+#include "io/arguments.hpp"
 
 #include "io/record_csv.hpp"
 #include "joints/basis.hpp"
@@ -203,35 +204,15 @@ std::vector<std::string> strings(const py::handle& values, const std::string& ar
 // The checks of arguments.
 
 void check_harmonics(const std::vector<int>& harmonics, int lowest) {
-  if (harmonics.empty()) throw io::Error("harmonics: expected at least one harmonic, e.g. 1,2,3");
-  if (harmonics.size() == 1 && harmonics[0] == 0)
-    throw io::Error("harmonics: 0 alone is the mean (static) balance, which a sine test does not "
-                    "excite: add harmonic 1 (e.g. 0,1,2,3)");
-  std::set<int> seen;
-  for (int k : harmonics) {
-    if (k < lowest || k > 50)
-      throw io::Error(
-          fmt::format("harmonics: expected harmonics from {} to 50, got {}", lowest, k));
-    if (!seen.insert(k).second)
-      throw io::Error(fmt::format("harmonics: harmonic {} is listed twice", k));
-  }
+  io::check_harmonics("harmonics", harmonics, lowest);
 }
 
 void check_balance_harmonics(int harmonics, int lowest, const std::string& why) {
-  if (harmonics < lowest || harmonics > 200)
-    throw io::Error(why.empty() ? fmt::format("balance_harmonics: expected {} to 200, got {}",
-                                              lowest, harmonics)
-                                : fmt::format("balance_harmonics: expected from {} ({}) to 200, "
-                                              "got {}",
-                                              lowest, why, harmonics));
+  io::check_balance_harmonics("balance_harmonics", harmonics, lowest, why);
 }
 
 void check_amplitudes(const std::vector<double>& amplitudes) {
-  if (amplitudes.empty()) throw io::Error("amplitude: expected at least one amplitude (N)");
-  for (double a : amplitudes)
-    if (!(std::isfinite(a) && a > 0.0))
-      throw io::Error(
-          fmt::format("amplitude: expected finite amplitudes > 0 (N or N m), got {}", a));
+  io::check_amplitudes("amplitude", amplitudes);
 }
 
 // ---------------------------------------------------------------------------------------------

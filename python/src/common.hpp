@@ -138,7 +138,7 @@ std::vector<std::string> strings(const py::handle& values, const std::string& ar
 // The checks of arguments: the CLI's (cli/common.hpp) with the keyword named instead of the
 // option.
 
-/// harmonics: at least one, each from `lowest` to 50 and once, not 0 alone.
+/// harmonics: at least one, each >= `lowest` and once, not 0 alone (io::check_harmonics).
 void check_harmonics(const std::vector<int>& harmonics, int lowest);
 /// balance_harmonics K from `lowest` to 200; `why` says where the lowest comes from.
 void check_balance_harmonics(int harmonics, int lowest, const std::string& why = "");

@@ -2,6 +2,7 @@
 // jointid.read_record / read_tests (the files `jointid identify` reads) and
 // jointid.simulate_sine (as `jointid simulate`).
 #include "common.hpp"
+#include "io/arguments.hpp"
 
 #include "identify/sine_tests.hpp"
 #include "io/record_csv.hpp"
@@ -115,22 +116,6 @@ struct SimulateArguments {
   unsigned long long seed = 1;
 };
 
-std::vector<identify::Quantity> quantities(const std::vector<std::string>& channels) {
-  std::vector<identify::Quantity> out;
-  for (const auto& c : channels) {
-    const identify::Quantity q =
-        c == "x"   ? identify::Quantity::displacement
-        : c == "v" ? identify::Quantity::velocity
-        : c == "a" ? identify::Quantity::acceleration
-                   : throw io::Error(fmt::format("channels: expected x, v or a, got \"{}\"", c));
-    if (std::find(out.begin(), out.end(), q) != out.end())
-      throw io::Error(fmt::format("channels: {} is listed twice", c));
-    out.push_back(q);
-  }
-  if (out.empty()) throw io::Error("channels: expected x, v and/or a");
-  return out;
-}
-
 py::list simulate_sine(const ModelPtr& model, const SimulateArguments& a) {
   // 1. The arguments, as `jointid simulate` checks its options.
   if (a.freq_hz.empty()) throw io::Error("freq_hz: expected at least one frequency (Hz)");
@@ -153,10 +138,8 @@ py::list simulate_sine(const ModelPtr& model, const SimulateArguments& a) {
   if (options.balance.harmonics < 1)
     throw io::Error(
         fmt::format("balance_harmonics: expected at least 1, got {}", options.balance.harmonics));
-  if (!(std::isfinite(a.noise) && a.noise >= 0.0 && a.noise < 1.0))
-    throw io::Error(fmt::format(
-        "noise: expected a fraction of each channel's RMS from 0 to below 1, got {}", a.noise));
-  options.quantities = quantities(a.channels);
+  io::check_noise("noise", a.noise);
+  options.quantities = io::parse_channels("channels", a.channels);
   if (a.method == "time")
     options.method = identify::SimulationMethod::time_integration;
   else if (a.method == "hb")
