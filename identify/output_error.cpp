@@ -55,6 +55,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
   if (o.balance.harmonics < K)
     throw std::invalid_argument("output error: the harmonic balance needs at least the " +
                                 std::to_string(K) + " harmonics compared");
+  check_identifiable(joints);
   std::vector<joints::Joint> model = start.identified(joints);
 
   // The parameters: every non-fixed term, then Re and Im of each test's force fundamentals.
@@ -359,6 +360,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     for (std::size_t t = 0; t < identified[j].terms.size(); ++t) {
       TermEstimate te;
       te.term = identified[j].terms[t];
+      te.parameters = parameters_of(identified[j], t);
       te.value = identified[j].values[t];
       te.fixed = identified[j].fixed[t];
       if (te.fixed) {

@@ -182,6 +182,7 @@ void read_joints(ModelReading& ctx, const Table& root) {
                                  [](const joints::Parameter& p) { return p.fixed; });
     j.given = has_value;
     ctx.joint_lines.push_back(t.line());
+    ctx.out.joint_lines.push_back(t.line());
     ctx.out.joints.push_back(std::move(j));
   }
 }

@@ -32,6 +32,16 @@ std::string identify_result_json(const identify::FitResult& result,
       Json term;
       term["term"] = std::string(joints::term_name(t.term));
       term["effect"] = std::string(joints::term_effect(t.term));
+      if (!t.parameters.empty()) { // a parametric term: its named parameters (all fixed)
+        Json parameters = Json::object();
+        for (const auto& [name, value] : t.parameters)
+          parameters[name] = number(value);
+        term["parameters"] = std::move(parameters);
+        term["fixed"] = t.fixed;
+        term["determined"] = t.determined;
+        terms.push_back(std::move(term));
+        continue;
+      }
       term["value"] = number(t.value);
       term["std"] = number(t.std);
       term["ci95"] = Json::array({number(t.ci_low), number(t.ci_high)});
