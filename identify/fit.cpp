@@ -79,12 +79,14 @@ void check_identifiable(const std::vector<joints::Joint>& joints) {
     }
 }
 
-std::vector<std::pair<std::string, double>> parameters_of(const joints::Joint& j, std::size_t t) {
-  std::vector<std::pair<std::string, double>> out;
+std::vector<ParameterEstimate> parameters_of(const joints::Joint& j, std::size_t t) {
+  std::vector<ParameterEstimate> out;
   const auto list = j.parameters_of(t);
   const auto& info = joints::term_info(j.terms[t]).parameters;
-  for (std::size_t p = 0; p < list.size() && p < info.size(); ++p)
-    out.emplace_back(std::string(info[p].name), list[p].value);
+  for (std::size_t p = 0; p < list.size() && p < info.size(); ++p) {
+    const double v = list[p].value;
+    out.push_back({std::string(info[p].name), v, 0.0, v, v, list[p].fixed, true});
+  }
   return out;
 }
 

@@ -43,11 +43,24 @@ struct FitOptions {
   bool average_periods = true;
 };
 
+/// A named parameter of a parametric term as identified (or held).
+struct ParameterEstimate {
+  std::string name; ///< "fs"
+  /// NaN when the tests do not determine it (determined false): never a value then.
+  double value = 0.0;
+  double std = 0.0; ///< of the value; NaN when unknown
+  double ci_low = 0.0, ci_high = 0.0;
+  bool fixed = false;
+  /// False when the tests do not determine it apart from another parameter (FitResult::
+  /// identifiability says which combination they do determine) or its std is too large.
+  bool determined = true;
+};
+
 struct TermEstimate {
   joints::Term term = joints::Term::k;
-  /// A parametric term (jenkins, iwan, gap): its named parameters and their values, in the
-  /// table's order (empty for a coefficient term; `value` is then its coefficient, 1).
-  std::vector<std::pair<std::string, double>> parameters;
+  /// A parametric term (jenkins, iwan, gap): its named parameters, in the table's order (empty
+  /// for a coefficient term; `value` is then its coefficient, 1).
+  std::vector<ParameterEstimate> parameters;
   double value = 0.0;
   double std = 0.0;    ///< standard deviation (FitResult::interval_method says how)
   double ci_low = 0.0; ///< 95 % confidence interval (Student's t)
@@ -127,8 +140,7 @@ using joints::joint_dof_set;
 /// std::invalid_argument naming the joint, the term and its parameters otherwise.
 void check_identifiable(const std::vector<joints::Joint>& joints);
 /// The parameters of term t of joint j for a TermEstimate (empty for a coefficient term).
-std::vector<std::pair<std::string, double>> parameters_of(const joints::Joint& joint,
-                                                          std::size_t term);
+std::vector<ParameterEstimate> parameters_of(const joints::Joint& joint, std::size_t term);
 
 /// A measured test as the identification of these joints needs it: the forces on free DOFs of
 /// the model, the displacement at every joint DOF, and the harmonics of every joint term's
