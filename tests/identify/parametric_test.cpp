@@ -156,5 +156,20 @@ TEST(ParametricIdentification, IwanInMicroslipSaysWhatTheTestsDoNotDetermine) {
   EXPECT_NEAR(sum, 4800.0 + 1.0e4, 0.03 * (4800.0 + 1.0e4)) << said;
 }
 
+TEST(ParametricIdentification, EquationErrorTakesAParametricTermOnlyFixed) {
+  // The route Q b = p cannot estimate parameters that enter non-linearly: a non-fixed one is
+  // refused naming the joint, the term and its parameters; all fixed, it is a known force.
+  joints::Joint j = tip(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}, false);
+  try {
+    identify::check_identifiable({j});
+    FAIL() << "a non-fixed iwan was taken by the equation error";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("joint 'tip'"), std::string::npos) << what;
+    EXPECT_NE(what.find("'iwan' (fs, kt, chi, beta)"), std::string::npos) << what;
+  }
+  EXPECT_NO_THROW(identify::check_identifiable({tip(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}, true)}));
+}
+
 } // namespace
 } // namespace jointid
