@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <string>
 
 using namespace jointid;
 using joints::Term;
@@ -88,11 +89,16 @@ int main(int argc, char** argv) {
   const double t_hb = seconds_since(t0) / reps;
   std::printf("harmonic balance (K = %d, from the linear start): %.3f ms a point (mean of %d), "
               "converged %d after %d iterations; |X1| at joint a %.4e m, X3/X1 %.2e\n",
-              K, 1e3 * t_hb, reps, hb.converged, hb.iterations, std::abs(hb.X(1, 0)),
+              K, 1e3 * t_hb, reps, hb.status.ok(), hb.iterations, std::abs(hb.X(1, 0)),
               std::abs(hb.X(3, 0)) / std::abs(hb.X(1, 0)));
 
   t0 = std::chrono::steady_clock::now();
-  const fem::SparseMatrix C = sub.damping_matrix();
+  const fem::Outcome<fem::SparseMatrix> damping = sub.damping_matrix();
+  if (!damping.status.ok()) {
+    std::fprintf(stderr, "%s\n", damping.status.reason.c_str());
+    return 1;
+  }
+  const fem::SparseMatrix& C = damping.value;
   const joints::JointForces forces(js, system.dofs);
   fem::SteadyStateOptions so;
   so.steps_per_period = steps;
@@ -106,9 +112,9 @@ int main(int argc, char** argv) {
     X1 += td.u(i, 0) * std::polar(1.0, -w * td.t(i));
   X1 *= 2.0 / static_cast<double>(td.t.size());
   std::printf("time integration (%d steps a period, to 1e-6 period-to-period): %.2f s, %d "
-              "periods, status %d; |X1| at joint a %.4e m, differs from the harmonic balance by "
+              "periods, status %s; |X1| at joint a %.4e m, differs from the harmonic balance by "
               "%.2e relative\n",
-              steps, t_td, td.periods_run, static_cast<int>(td.status), std::abs(X1),
-              std::abs(X1 - hb.X(1, 0)) / std::abs(hb.X(1, 0)));
+              steps, t_td, td.periods_run, std::string(fem::code_name(td.status.code)).c_str(),
+              std::abs(X1), std::abs(X1 - hb.X(1, 0)) / std::abs(hb.X(1, 0)));
   std::printf("ratio: %.0f x\n", t_td / t_hb);
 }

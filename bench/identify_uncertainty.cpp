@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -153,9 +154,9 @@ std::vector<double> cramer_rao(const frf::Substructure& sub, const Study& s,
       Eigen::MatrixXcd F = Eigen::MatrixXcd::Zero(2, 1);
       F(1, 0) = F1;
       const auto r = hb.solve(js, F, &Y0);
-      if (!r.converged)
+      if (!r.status.ok())
         std::fprintf(stderr, "CRB: %g Hz, %g N: %s\n", plan.frequency_hz, plan.amplitude,
-                     r.reason.c_str());
+                     r.status.reason.c_str());
       if (first) Y0 = r.Y, first = false;
       // Data: x and v harmonics 0 … K_info at every output (v_k = ikω x_k).
       Eigen::VectorXcd d(2 * (K_info + 1) * static_cast<Eigen::Index>(outputs.size()));
@@ -240,6 +241,8 @@ struct Prepared {
     so.samples_per_period = 256;
     so.periods = 8;
     clean = identify::simulate_sine_tests(sub, s.truth, {7, fem::Dof::uy}, s.plans, so);
+    for (const auto& t : clean)
+      if (!t.status.ok()) throw std::runtime_error(t.status.reason);
     for (const auto& j : s.truth)
       for (Term t : j.terms)
         names.push_back(std::string(joints::term_name(t)) + " of '" + j.name + "'");
@@ -310,6 +313,8 @@ void harmonics_study(const Study& s, int reps) {
   so.samples_per_period = 256;
   so.periods = 8;
   const auto clean = identify::simulate_sine_tests(sub, s.truth, {7, fem::Dof::uy}, s.plans, so);
+  for (const auto& t : clean)
+    if (!t.status.ok()) throw std::runtime_error(t.status.reason);
   std::printf("\n### Harmonics used: %s, 1 %% noise, %d repetitions\n\n", s.name.c_str(), reps);
   std::printf("| harmonics | equations | mean condition number |");
   for (const auto& j : s.truth)

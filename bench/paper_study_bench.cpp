@@ -10,6 +10,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <stdexcept>
+
 using namespace jointid;
 
 namespace {
@@ -38,10 +40,12 @@ const Setup& setup() {
 identify::Record record(const Setup& s, double f) {
   identify::SimulationOptions o;
   o.periods = 4;
-  return identify::simulate_sine_tests(frf::Substructure(s.model), {s.joint}, {7, fem::Dof::uy},
-                                       {{f, 80.0}}, o)
-      .front()
-      .record;
+  const identify::SimulatedTest t =
+      identify::simulate_sine_tests(frf::Substructure(s.model), {s.joint}, {7, fem::Dof::uy},
+                                    {{f, 80.0}}, o)
+          .front();
+  if (!t.status.ok()) throw std::runtime_error(t.status.reason);
+  return t.record;
 }
 
 void BM_Assembly(benchmark::State& state) {

@@ -19,6 +19,10 @@ void warn(const std::string& what) {
   std::cerr << "jointid: warning: " << what << "\n";
 }
 
+void require(const fem::Status& status) {
+  if (!status.ok()) throw std::runtime_error(status.reason);
+}
+
 void check_output_dir(const fs::path& dir) {
   std::error_code ec;
   if (dir.empty()) throw io::Error("-o: expected a directory");

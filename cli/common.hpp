@@ -5,6 +5,7 @@
 #include "cli/engine.hpp"
 #include "cli/terminal_progress.hpp"
 #include "fem/dof.hpp"
+#include "fem/status.hpp"
 #include "frf/substructure.hpp"
 #include "identify/random_tests.hpp"
 #include "identify/record.hpp"
@@ -23,6 +24,10 @@ namespace jointid::cli {
 
 /// "jointid: warning: <what>" on stderr.
 void warn(const std::string& what);
+
+/// A numerical outcome that ends the command: throws std::runtime_error with the status's
+/// reason (main() prints it as the one-line reason) unless `status` is ok.
+void require(const fem::Status& status);
 
 /// -o DIR: not empty, and not an existing file.
 void check_output_dir(const std::filesystem::path& dir);

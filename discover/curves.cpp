@@ -71,14 +71,14 @@ ResponseCurve sweep(const Problem& problem, const State& state,
     const Eigen::MatrixXcd F = frf::sine_force(amplitude);
     if (friction_problem(state.joints).empty()) {
       r = hb.solve(state.joints, F, previous ? &*previous : nullptr);
-      if (!r.converged && previous) r = hb.solve(state.joints, F);
+      if (!r.status.ok() && previous) r = hb.solve(state.joints, F);
     }
     c.x.push_back(x);
-    c.converged.push_back(r.converged);
+    c.converged.push_back(r.status.ok());
     for (std::size_t j = 0; j < c.channels.size(); ++j)
-      c.X1[j].push_back(r.converged ? r.X(1, static_cast<Eigen::Index>(j))
-                                    : std::complex<double>(nan, nan));
-    if (r.converged) previous = r.Y;
+      c.X1[j].push_back(r.status.ok() ? r.X(1, static_cast<Eigen::Index>(j))
+                                      : std::complex<double>(nan, nan));
+    if (r.status.ok()) previous = r.Y;
   }
   if (down) { // ascending order, as the sweep up
     std::reverse(c.x.begin(), c.x.end());

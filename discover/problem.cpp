@@ -38,17 +38,19 @@ Problem::Problem(const frf::Substructure& sub, const std::vector<joints::Joint>&
   set_up_equations(start);
   set_up_drive_and_start(start);
   base_ = std::make_unique<frf::ModalSynthesis>(sub.synthesis(synthesis_dofs_, f_max_, &notes_));
+  // Nothing can be re-simulated without the substructure's modes: the run ends here with their
+  // status's reason (a numerical outcome, not bad input).
+  if (!base_->status().ok())
+    throw std::runtime_error("discover: the substructure: " + base_->status().reason);
   compared_ = compared_values(tests, K_);
 }
 
 int Problem::equation(const identify::Measurement& m, const std::string& what,
                       const fem::NodeDof& at) {
-  try {
-    return dofs_.equation(at);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(m.source + ": channel " + what + fem::to_string(at) + ": " +
-                                e.what());
-  }
+  // The record's channel is at fault, not the model: say what the model has.
+  if (const std::string why = dofs_.why_not_free(at); !why.empty())
+    throw std::invalid_argument(m.source + ": " + what + fem::to_string(at) + ": " + why);
+  return dofs_.equation(at);
 }
 
 // Equations: the joints' DOFs, every force and every response of every test; the band the
@@ -65,8 +67,9 @@ void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
     for (const auto& at : m.force_at)
       forces.push_back(equation(m, "force channel f@", at));
     for (std::size_t j = 0; j < m.response_at.size(); ++j)
-      responses.push_back(equation(
-          m, std::string(1, identify::quantity_letter(m.measured_as[j])) + "@", m.response_at[j]));
+      responses.push_back(
+          equation(m, std::string("channel ") + identify::quantity_letter(m.measured_as[j]) + "@",
+                   m.response_at[j]));
     for (int e : forces)
       add_unique(synthesis_dofs_, e);
     for (int e : responses)
@@ -175,7 +178,7 @@ identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
   fo.harmonics = o_.harmonics;
   identify::FitResult fit = identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
   // Terms the tests cannot separate: this model cannot be identified (a refused candidate).
-  if (fit.status != identify::FitStatus::ok) throw std::invalid_argument("identify: " + fit.reason);
+  if (!fit.status.ok()) throw std::invalid_argument("identify: " + fit.status.reason);
   return fit;
 }
 
@@ -206,7 +209,7 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
     const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
     const frf::HarmonicBalanceResult r =
         solve(sim, static_cast<int>(i), per_test.empty() ? joints : per_test[i], start);
-    s.converged = s.converged && r.converged && r.X.allFinite();
+    s.converged = s.converged && r.status.ok() && r.X.allFinite();
     s.X[i] = r.X.topRows(K_ + 1);
     s.Y[i] = r.Y;
   }
@@ -225,13 +228,13 @@ frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,
   frf::HarmonicBalanceResult r;
   if (warm && warm->rows() == sim.harmonics + 1) {
     r = sim.balance[i].solve(joints, drive_[i], warm);
-    if (r.converged) return r;
+    if (r.status.ok()) return r;
   }
   r = sim.balance[i].solve(joints, drive_[i], &measured_start_[i]);
-  if (!r.converged) {
+  if (!r.status.ok()) {
     frf::HarmonicBalanceResult again = sim.balance[i].solve(joints, drive_[i]);
     again.iterations += r.iterations;
-    if (again.converged || again.residual < r.residual) r = std::move(again);
+    if (again.status.ok() || again.residual < r.residual) r = std::move(again);
   }
   return r;
 }

@@ -210,8 +210,8 @@ double cross_validated(Problem& problem, const std::vector<joints::Joint>& joint
         const frf::HarmonicBalanceResult r = problem.solve(sim, i, fitted);
         for (const auto& e : compared.entries) // a failed prediction counts as predicting nothing
           if (e.test == i)
-            S += r.converged ? std::norm(e.measured - r.X(e.harmonic, e.response))
-                             : std::norm(e.measured);
+            S += r.status.ok() ? std::norm(e.measured - r.X(e.harmonic, e.response))
+                               : std::norm(e.measured);
       }
       return S;
     });

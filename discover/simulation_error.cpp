@@ -48,7 +48,7 @@ void Problem::propagate_force_noise(const State& s, const Simulator& sim) {
         F(1, c) += std::sqrt(v) * unit;
         const frf::HarmonicBalanceResult r =
             sim.balance[i].solve(s.joints, F, s.Y[i].size() > 0 ? &s.Y[i] : nullptr);
-        if (!r.converged) continue;
+        if (!r.status.ok()) continue;
         for (auto& e : compared_.entries)
           if (e.test == static_cast<int>(i))
             e.force +=
@@ -86,8 +86,8 @@ double Problem::estimate_simulation_error(State& s) {
       Eigen::MatrixXcd start = Eigen::MatrixXcd::Zero(fine.harmonics + 1, layout_.size());
       start.topRows(measured_start_[i].rows()) = measured_start_[i];
       frf::HarmonicBalanceResult r = fine.balance[i].solve(s.joints, drive_[i], &start);
-      if (!r.converged) r = fine.balance[i].solve(s.joints, drive_[i]);
-      if (r.converged) reference = r.X;
+      if (!r.status.ok()) r = fine.balance[i].solve(s.joints, drive_[i]);
+      if (r.status.ok()) reference = r.X;
       factor = 4.0; // twice the difference
     }
     for (auto& e : compared_.entries)
@@ -115,7 +115,9 @@ std::vector<Eigen::MatrixXcd> Problem::time_integrated(const State& s) const {
   if (!system) return out;
   fem::SparseMatrix C;
   try {
-    C = sub_.damping_matrix() * s.damping_scale;
+    const fem::Outcome<fem::SparseMatrix> damping = sub_.damping_matrix();
+    if (!damping.status.ok()) return out;
+    C = damping.value * s.damping_scale;
   } catch (const std::exception&) {
     return out;
   }
@@ -137,7 +139,7 @@ std::vector<Eigen::MatrixXcd> Problem::time_integrated(const State& s) const {
       o.tolerance = 1e-8;
       const fem::SteadyState ss = fem::steady_state(
           *system, C, &forces, {force_eq_[i][0], std::abs(F1), m.frequency_hz}, response_eq_[i], o);
-      if (ss.status != fem::SteadyStateStatus::converged) return {};
+      if (!ss.status.ok()) return {};
       Eigen::MatrixXcd X =
           identify::fit_harmonics(ss.t, ss.u, 2.0 * std::numbers::pi * m.frequency_hz, K_);
       const Complex turn = F1 / Complex(0.0, -std::abs(F1)); // sin → the measured phase

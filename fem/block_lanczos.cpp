@@ -1,5 +1,7 @@
 #include "fem/block_lanczos.hpp"
 
+#include "fem/assert.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <cblas.h>
 
@@ -83,6 +85,14 @@ MatrixXd svqb(const ShiftInvertPencil& P, MatrixXd& Z, MatrixXd& MZ, double floo
     floor = 0.0;
   }
   return R;
+}
+
+// Whether ZᵀMZ = I to well within rounding's reach (1e-8): an orthonormalised block, checked
+// by debug asserts (n q² flops, a fraction of the orthonormalisation's own).
+[[maybe_unused]] bool m_orthonormal(const MatrixXd& Z, const MatrixXd& MZ) {
+  if (Z.cols() == 0) return true;
+  const MatrixXd G = Z.transpose() * MZ;
+  return (G - MatrixXd::Identity(G.rows(), G.cols())).cwiseAbs().maxCoeff() <= 1e-8;
 }
 
 // The products with the basis, n × m by m × b for n up to 10⁶, are the largest dense work
@@ -218,17 +228,28 @@ public:
     start();
     // A block at a time, with Rayleigh–Ritz and the convergence test after each (they cost
     // O(cap³), nothing next to a solve): no solve is spent once the wanted pairs converged.
+    bool converged = false;
     for (int restarts = 0;; ++restarts) {
       out.restarts = restarts;
       do {
         absorb();
-        if (m_ >= nev_ && ritz(out)) break;
+        converged = m_ >= nev_ && ritz(out);
+        if (converged) break;
       } while (q_ > 0 && m_ + q_ <= cap_);
-      if (out.converged || restarts == o_.max_restarts) break;
+      if (converged || restarts == o_.max_restarts) break;
       restart();
     }
     out.theta = theta_.head(nev_);
-    if (out.converged) refine(out);
+    if (converged) {
+      refine(out);
+    } else {
+      out.status = Status::failure(
+          Status::Code::not_converging,
+          "block Lanczos: " + std::to_string(out.converged_count) + " of " + std::to_string(nev_) +
+              " wanted eigenpairs met the tolerance " + std::to_string(o_.tolerance) + " in " +
+              std::to_string(o_.max_restarts) + " restarts (largest relative residual " +
+              std::to_string(out.max_residual) + ")");
+    }
     out.solves = solves_;
     out.right_hand_sides = rhs_;
     return out;
@@ -297,6 +318,8 @@ private:
     const MatrixXd D = local.bottomRows(q) + p.C.bottomRows(q); // Q_jᵀ M Op Q_j
     H_.block(j, j, q, q) = 0.5 * (D + D.transpose());
     Index kept = W.cols();
+    JOINTID_ASSERT(m_ + kept <= V_.cols(), "the next block fits in the basis storage");
+    JOINTID_ASSERT(m_orthonormal(W, MW), "the next Lanczos block is M-orthonormal");
     MatrixXd R = MatrixXd::Zero(q, q);
     R.topRows(kept) = p.R;
     V_.middleCols(m_, kept) = W;
@@ -339,8 +362,7 @@ private:
       if (residual <= o_.tolerance * scale) ++out.converged_count;
       out.max_residual = std::max(out.max_residual, residual / std::abs(theta_(i)));
     }
-    out.converged = out.converged_count == nev_;
-    return out.converged;
+    return out.converged_count == nev_;
   }
 
   // Keeps the k leading Ritz vectors and the next block: V ← [V S_k, Q], H ← diag(θ_k), and Q

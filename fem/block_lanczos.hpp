@@ -26,6 +26,8 @@
 /// one (a random start block has a component in every direction of its eigenspace); a larger
 /// multiplicity only through rounding, as in single-vector Lanczos, so keep the block at least
 /// as large as the multiplicities expected (6 rigid-body modes of a free 3D body).
+#include "fem/status.hpp"
+
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -63,7 +65,9 @@ struct BlockLanczosOptions {
 };
 
 struct BlockLanczosResult {
-  bool converged = false;
+  /// not_converging when the wanted pairs did not all meet the tolerance within max_restarts
+  /// (the reason says how many did and the largest residual)
+  Status status;
   int converged_count = 0; ///< wanted pairs that met the tolerance at the last check
   Eigen::VectorXd theta;   ///< the nev largest eigenvalues of Op, descending
   Eigen::MatrixXd vectors; ///< n × nev, M-orthonormal (θ's eigenvectors, in its order)
@@ -77,7 +81,7 @@ struct BlockLanczosResult {
 
 /// The nev largest eigenpairs of Op = (K − σM)⁻¹ M. Throws std::invalid_argument for bad
 /// options (nev ≥ the dimension of the space, block size < 1, negative tolerance or restarts).
-/// Not converging within max_restarts is a result (converged = false), not an exception.
+/// Not converging within max_restarts is a result (status not_converging), not an exception.
 BlockLanczosResult block_lanczos(ShiftInvertPencil& pencil, const BlockLanczosOptions& options);
 
 } // namespace jointid::fem

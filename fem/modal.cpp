@@ -1,5 +1,6 @@
 #include "fem/modal.hpp"
 
+#include "fem/assert.hpp"
 #include "fem/block_lanczos.hpp"
 
 #include <Eigen/Cholesky>
@@ -78,11 +79,19 @@ Modes dense_modes(const Assembled& s, const ModalOptions& o) {
   if (Eigen::LLT<Eigen::MatrixXd>(M).info() == Eigen::Success) {
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(K, M);
     if (solver.info() != Eigen::Success) {
-      out.status = ModalStatus::numerical_issue;
-      out.reason = "the dense generalised eigensolver (K, M) did not succeed";
+      out.status = Status::failure(Status::Code::numerical_issue,
+                                   "the dense generalised eigensolver (K, M) did not succeed");
       return out;
     }
     const Eigen::VectorXd& lambda = solver.eigenvalues();
+    // Eigen reports success even when the reduction L⁻¹KL⁻ᵀ overflowed (a mass many decades
+    // below the stiffness): its eigenvalues are then NaN.
+    if (!lambda.allFinite()) {
+      out.status = Status::failure(Status::Code::numerical_issue,
+                                   "the dense generalised eigensolver (K, M) gave eigenvalues that "
+                                   "are not finite (a mass too small for its stiffness?)");
+      return out;
+    }
     const int count = wanted_count(lambda, o);
     out.omega = lambda.head(count).unaryExpr(&to_omega);
     out.phi = solver.eigenvectors().leftCols(count);
@@ -101,13 +110,20 @@ Modes dense_modes(const Assembled& s, const ModalOptions& o) {
     throw not_positive_definite(s, o.shift_hz, bare_equation(s));
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(M, A);
   if (solver.info() != Eigen::Success) {
-    out.status = ModalStatus::numerical_issue;
-    out.reason = "the dense generalised eigensolver (M, K - sigma M) did not succeed";
+    out.status =
+        Status::failure(Status::Code::numerical_issue,
+                        "the dense generalised eigensolver (M, K - sigma M) did not succeed");
     return out;
   }
   // μ ascending: the finite modes are the positive μ from the largest down. μ at rounding level
   // (relative to the largest) belongs to a massless DOF.
   const Eigen::VectorXd& mu = solver.eigenvalues();
+  if (!mu.allFinite()) {
+    out.status = Status::failure(Status::Code::numerical_issue,
+                                 "the dense generalised eigensolver (M, K - sigma M) gave "
+                                 "eigenvalues that are not finite");
+    return out;
+  }
   const int n = static_cast<int>(mu.size());
   const double floor = 1e3 * std::numeric_limits<double>::epsilon() * mu.cwiseAbs().maxCoeff();
   int finite = 0;
@@ -289,13 +305,12 @@ Modes block_lanczos_modes(const Assembled& s, const ModalOptions& o, ShiftInvert
   stats.restarts = r.restarts;
   Modes out;
   out.sparse = stats;
-  if (!r.converged) {
-    out.status = ModalStatus::not_converging;
+  if (!r.status.ok()) {
     std::ostringstream reason;
     reason << "block shift-invert Lanczos did not converge to " << nev << " modes in "
            << o.max_iterations << " restarts (tolerance " << o.tolerance << "; "
            << r.converged_count << " of " << nev << " converged)";
-    out.reason = reason.str();
+    out.status = Status::failure(Status::Code::not_converging, reason.str());
     return out;
   }
   // θ descending is λ = σ + 1/θ ascending.
@@ -341,11 +356,10 @@ Modes spectra_modes(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
   Modes out;
   out.sparse = stats;
   if (solver.info() != Spectra::CompInfo::Successful) {
-    out.status = ModalStatus::not_converging;
     std::ostringstream reason;
     reason << "shift-invert Lanczos (Spectra) did not converge to " << nev << " modes in "
            << o.max_iterations << " restarts (tolerance " << o.tolerance << ")";
-    out.reason = reason.str();
+    out.status = Status::failure(Status::Code::not_converging, reason.str());
     return out;
   }
   out.omega = solver.eigenvalues().unaryExpr(&to_omega);
@@ -359,6 +373,16 @@ Modes spectra_modes(const Assembled& s, const ModalOptions& o, ShiftInvert& op,
     }
   }
   return out;
+}
+
+// What every engine guarantees of modes it reports as ok (debug asserts): one shape per
+// frequency, the frequencies ascending.
+Modes checked(Modes m) {
+  JOINTID_ASSERT(!m.status.ok() || m.phi.cols() == m.omega.size(),
+                 "one mode shape per natural frequency");
+  for (int r = 1; m.status.ok() && r < m.num_modes(); ++r)
+    JOINTID_ASSERT(m.omega(r - 1) <= m.omega(r), "natural frequencies in ascending order");
+  return m;
 }
 
 // The nev lowest modes with the factorisation held by `op`, by the method asked for.
@@ -379,7 +403,7 @@ Modes sparse_modes(const Assembled& s, const ModalOptions& o) {
   while (true) {
     nev = std::min(nev, last);
     Modes m = sparse_modes_count(s, o, op, stats, nev);
-    if (m.status != ModalStatus::success) return m;
+    if (!m.status.ok()) return m;
     const double omega_max = two_pi * o.max_frequency_hz;
     if (m.omega(m.num_modes() - 1) >= omega_max || nev == last) {
       int count = 0;
@@ -411,9 +435,9 @@ Modes modal_analysis(const Assembled& s, const ModalOptions& o) {
       throw std::invalid_argument("the sparse engine finds fewer modes than DOFs (" +
                                   std::to_string(n) +
                                   "); ask for fewer modes or use the dense engine");
-    return sparse_modes(s, o);
+    return checked(sparse_modes(s, o));
   }
-  return dense_modes(s, o);
+  return checked(dense_modes(s, o));
 }
 
 } // namespace jointid::fem

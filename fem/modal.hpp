@@ -7,6 +7,7 @@
 /// (`SymGEigsShiftSolver`) is kept as an option to compare with.
 #include "fem/assembly.hpp"
 #include "fem/sparse_cholesky.hpp"
+#include "fem/status.hpp"
 
 #include <Eigen/Core>
 
@@ -17,7 +18,6 @@
 namespace jointid::fem {
 
 enum class ModalEngine { automatic, dense, sparse };
-enum class ModalStatus { success, not_converging, numerical_issue };
 /// The sparse engine's iteration on the factor of K − σM.
 enum class SparseMethod {
   block_lanczos, ///< thick-restart block Lanczos, `block_size` right-hand sides per solve
@@ -75,8 +75,9 @@ struct DistributedModalStats {
 };
 
 struct Modes {
-  ModalStatus status = ModalStatus::success;
-  std::string reason;    ///< why, when status is not success
+  /// not_converging (the sparse engine's restarts ran out), numerical_issue (a dense solver
+  /// failed), with the reason
+  Status status;
   Eigen::VectorXd omega; ///< circular frequencies ω_r, rad/s, ascending (rigid modes ≈ 0)
   /// n_eq × n_modes, mass-normalised; or |rows| × n_modes when `rows` is not empty.
   Eigen::MatrixXd phi;

@@ -269,9 +269,10 @@ Modes slepc_modal_analysis(const Model& model, const ModalOptions& o, const Slep
     stats.restarts = static_cast<int>(iterations);
     if (converged < nev) {
       stats.solve_s = seconds_since(start);
-      out.status = ModalStatus::not_converging;
-      out.reason = "Krylov-Schur (SLEPc) converged " + std::to_string(converged) + " of " +
-                   std::to_string(nev) + " modes in " + std::to_string(iterations) + " restarts";
+      out.status = Status::failure(Status::Code::not_converging,
+                                   "Krylov-Schur (SLEPc) converged " + std::to_string(converged) +
+                                       " of " + std::to_string(nev) + " modes in " +
+                                       std::to_string(iterations) + " restarts");
       out.distributed = stats;
       return out;
     }
@@ -330,9 +331,10 @@ Modes slepc_modal_analysis(const Model& model, const ModalOptions& o, const Slep
     PetscScalar mass = 0.0;
     check(VecDot(mx.get(), x.get(), &mass), "VecDot");
     if (!(mass > 0.0)) {
-      out.status = ModalStatus::numerical_issue;
-      out.reason = "mode " + std::to_string(r + 1) +
-                   " has no positive modal mass (M is not positive definite on it)";
+      out.status = Status::failure(Status::Code::numerical_issue,
+                                   "mode " + std::to_string(r + 1) +
+                                       " has no positive modal mass (M is not positive definite "
+                                       "on it)");
       out.phi.resize(0, 0);
       out.omega.resize(0);
       out.distributed = stats;

@@ -8,7 +8,7 @@
 /// M it owns (an even split of the equations), and the eigenvectors stay distributed; only the
 /// rows asked for are gathered (to rank 0, or to every rank). Same result and status
 /// conventions as fem::modal_analysis: ascending ω, mass-normalised φ (φᵀMφ = 1), caller
-/// mistakes std::invalid_argument, a solver that does not converge ModalStatus::not_converging.
+/// mistakes std::invalid_argument, a solver that does not converge Status::Code::not_converging.
 #include "fem/modal.hpp"
 #include "fem/model.hpp"
 

@@ -1,9 +1,10 @@
 #include "fem/supernodal_solve.hpp"
 
+#include "fem/assert.hpp"
+
 #include <algorithm>
 #include <array>
 #include <barrier>
-#include <cassert>
 #include <cstring>
 #include <new>
 #include <thread>
@@ -248,10 +249,26 @@ struct SupernodalSolver::Plan {
 
 SupernodalSolver::Plan::Plan(const SupernodalFactorView& factor, int cores)
     : F(factor), threads(std::max(1, cores)) {
+  // CHOLMOD's supernodal layout, which every kernel indexes without checks: the supernodes'
+  // columns partition 0 … n, each holds at least its own triangle's rows, the pointers ascend.
+  JOINTID_ASSERT(F.supernodes == 0 || (F.first_column[0] == 0 && F.row_pointer[0] == 0 &&
+                                       F.first_column[F.supernodes] == F.n),
+                 "the supernodes' columns partition the factor's");
+  for (Long s = 0; s < F.supernodes; ++s)
+    JOINTID_ASSERT(F.first_column[s] < F.first_column[s + 1] &&
+                       F.row_pointer[s + 1] - F.row_pointer[s] >=
+                           F.first_column[s + 1] - F.first_column[s] &&
+                       F.value_pointer[s + 1] - F.value_pointer[s] >=
+                           (F.first_column[s + 1] - F.first_column[s]) *
+                               (F.row_pointer[s + 1] - F.row_pointer[s]),
+                   "a supernode holds its columns' rows, at least its triangle, densely");
   if (F.permutation) {
     inverse.resize(static_cast<std::size_t>(F.n));
-    for (Long k = 0; k < F.n; ++k)
+    for (Long k = 0; k < F.n; ++k) {
+      JOINTID_ASSERT(F.permutation[k] >= 0 && F.permutation[k] < F.n,
+                     "the permutation maps rows of L to equations");
       inverse[static_cast<std::size_t>(F.permutation[k])] = k;
+    }
   }
   for (Long s = 0; s < F.supernodes; ++s)
     widest = std::max(widest, F.row_pointer[s + 1] - F.row_pointer[s]);

@@ -1,10 +1,13 @@
 #include "fem/time_integration.hpp"
 
+#include "fem/assert.hpp"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 
 namespace jointid::fem {
@@ -24,9 +27,12 @@ Newmark::Newmark(const Assembled& system, const SparseMatrix& C, const LocalForc
   SparseMatrix keff = system.K + a0_ * system.M;
   if (C.nonZeros() > 0) keff += a1_ * C;
   keff_.compute(keff);
-  if (keff_.info() != Eigen::Success)
-    throw std::runtime_error("Newmark: the effective stiffness K + a1 C + a0 M is singular (a DOF "
-                             "with neither stiffness nor mass?)");
+  if (keff_.info() != Eigen::Success) {
+    status_ = Status::failure(Status::Code::numerical_issue,
+                              "Newmark: the effective stiffness K + a1 C + a0 M is singular (a "
+                              "DOF with neither stiffness nor mass?)");
+    return;
+  }
   const int nc = forces ? static_cast<int>(forces->coordinates().cols()) : 0;
   if (forces) {
     const Eigen::MatrixXd B(forces->coordinates());
@@ -83,6 +89,9 @@ void Newmark::hold_stuck(Eigen::VectorXd& a_next) {
 
 void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                         const Eigen::VectorXd& f) {
+  JOINTID_ASSERT(status_.ok(), "Newmark::set_state after a failed factorisation");
+  JOINTID_ASSERT(u.size() == u_.size() && v.size() == u_.size() && f.size() == u_.size(),
+                 "Newmark::set_state: one entry per equation");
   u_ = u;
   v_ = v;
   Eigen::VectorXd rhs = f - system_.K * u;
@@ -185,24 +194,29 @@ bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& 
   return false;
 }
 
-StepStatus Newmark::step(const Eigen::VectorXd& f_next) {
+Status Newmark::step(const Eigen::VectorXd& f_next) {
+  JOINTID_ASSERT(status_.ok(), "Newmark::step after a failed factorisation");
+  JOINTID_ASSERT(f_next.size() == u_.size(), "Newmark::step: one load per equation");
   Eigen::VectorXd rhs = f_next + system_.M * (a0_ * u_ + a2_ * v_ + a3_ * a_);
   if (C_.nonZeros() > 0) rhs += C_ * (a1_ * u_ + a4_ * v_ + a5_ * a_);
   Eigen::VectorXd u_next = keff_.solve(rhs);
-  StepStatus status = StepStatus::success;
+  Status status;
   if (forces_ && forces_->coordinates().cols() > 0) {
     const SparseMatrix& B = forces_->coordinates();
     const Eigen::VectorXd y_pred = B.transpose() * u_next;
     // ẏ_{n+1} = a1 (y − y_n) − Bᵀ(a4 v_n + a5 a_n) = a1 y + e
     const Eigen::VectorXd e = -a1_ * y_ - B.transpose() * (a4_ * v_ + a5_ * a_);
     stuck_before_ = stuck_;
-    if (!solve_local(y_pred, e)) status = StepStatus::newton_failed;
-    if (status == StepStatus::success) forces_->advance(history_, y_);
+    if (!solve_local(y_pred, e))
+      status = Status::failure(Status::Code::not_converging,
+                               "the joints' Newton iteration did not converge in " +
+                                   std::to_string(o_.max_newton) + " iterations");
+    if (status.ok()) forces_->advance(history_, y_);
     u_next -= S_ * g_total_;
   }
   Eigen::VectorXd a_next = a0_ * (u_next - u_) - a2_ * v_ - a3_ * a_;
-  v_ += h_ * ((1.0 - o_.gamma) * a_ + o_.gamma * a_next);           // the scheme's (keeps ẏ = 0)
-  if (forces_ && status == StepStatus::success) hold_stuck(a_next); // the true ü, and λ, kept
+  v_ += h_ * ((1.0 - o_.gamma) * a_ + o_.gamma * a_next); // the scheme's (keeps ẏ = 0)
+  if (forces_ && status.ok()) hold_stuck(a_next);         // the true ü, and λ, kept
   a_ = a_next;
   u_ = u_next;
   return status;
@@ -223,13 +237,17 @@ SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const L
   const double T = 1.0 / load.frequency_hz, h = T / N,
                omega = 2.0 * std::numbers::pi * load.frequency_hz;
   Newmark integrator(system, C, forces, h, o.newmark);
+  SteadyState out;
+  if (!integrator.status().ok()) {
+    out.status = integrator.status();
+    return out;
+  }
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
   integrator.set_state(Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n), f);
 
   // Ring of the last output_periods + 1 periods: samples at the start of each step.
   const int keep = o.output_periods + 1;
   Eigen::MatrixXd u_hist(keep * N, nout), v_hist(keep * N, nout);
-  SteadyState out;
   int calm = 0;
   for (int p = 0; p < o.max_periods; ++p) {
     const int slot = p % keep;
@@ -239,8 +257,12 @@ SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const L
         v_hist(slot * N + k, j) = integrator.v()(outputs[j]);
       }
       f(load.equation) = load.amplitude * std::sin(omega * (k + 1) * h);
-      if (integrator.step(f) != StepStatus::success) {
-        out.status = SteadyStateStatus::newton_failed;
+      if (Status step = integrator.step(f); !step.ok()) {
+        std::ostringstream reason;
+        reason << "the joints' Newton iteration failed in period " << p + 1
+               << " (t = " << (p * N + k + 1) * h << " s; no convergence in "
+               << o.newmark.max_newton << " iterations)";
+        out.status = Status::failure(step.code, reason.str());
         out.periods_run = p + 1;
         return out;
       }
@@ -254,7 +276,13 @@ SteadyState steady_state(const Assembled& system, const SparseMatrix& C, const L
     calm = out.period_change < o.tolerance ? calm + 1 : 0;
     if (calm >= 2 && p + 1 >= keep) break;
   }
-  if (calm < 2) out.status = SteadyStateStatus::not_periodic;
+  if (calm < 2) {
+    std::ostringstream reason;
+    reason << "not a periodic steady state after " << out.periods_run
+           << " periods (last period-to-period change " << out.period_change << ", tolerance "
+           << o.tolerance << ")";
+    out.status = Status::failure(Status::Code::not_periodic, reason.str());
+  }
   // Assemble the last output_periods periods in time order.
   const int last = (out.periods_run - 1) % keep;
   const int total = o.output_periods * N;

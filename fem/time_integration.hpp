@@ -19,6 +19,7 @@
 /// Newton steps are damped (halved until the residual decreases): such forces are only
 /// piecewise smooth in y.
 #include "fem/assembly.hpp"
+#include "fem/status.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
@@ -66,18 +67,23 @@ struct NewmarkOptions {
   double newton_tolerance = 1e-13; ///< on the local equations, relative to |y|
 };
 
-enum class StepStatus { success, newton_failed };
-
-/// State-holding integrator: construct, then step(). Time step h fixed (s).
+/// State-holding integrator: construct, check status(), then step(). Time step h fixed (s).
 class Newmark {
 public:
+  /// Throws std::invalid_argument for h <= 0. An effective stiffness K + a1 C + a0 M that cannot
+  /// be factorised (singular: a DOF with neither stiffness nor mass, nor damping) is a status.
   Newmark(const Assembled& system, const SparseMatrix& C, const LocalForces* forces, double h,
           const NewmarkOptions& options = {});
+  /// numerical_issue when the effective stiffness could not be factorised: then neither
+  /// set_state() nor step() may be called.
+  const Status& status() const { return status_; }
   /// Sets u, u̇ and computes ü from the equation of motion with force f (friction taken as 0);
   /// a history (sliders) is moved from its state to u, as if the joints were deformed to it.
   void set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& f);
-  /// Advances one step to the load f_{n+1}.
-  StepStatus step(const Eigen::VectorXd& f_next);
+  /// Advances one step to the load f_{n+1} (one entry per equation). not_converging when the
+  /// joints' Newton iteration did not converge within NewmarkOptions::max_newton iterations
+  /// (the state is then the last iterate's).
+  Status step(const Eigen::VectorXd& f_next);
 
   const Eigen::VectorXd& u() const { return u_; }
   const Eigen::VectorXd& v() const { return v_; }
@@ -97,6 +103,7 @@ private:
   const LocalForces* forces_;
   double h_;
   NewmarkOptions o_;
+  Status status_;
   double a0_, a1_, a2_, a3_, a4_, a5_;
   Eigen::SimplicialLDLT<SparseMatrix> keff_;
   Eigen::MatrixXd S_; ///< K_eff⁻¹ B
@@ -126,10 +133,11 @@ struct SteadyStateOptions {
   NewmarkOptions newmark;
 };
 
-enum class SteadyStateStatus { converged, not_periodic, newton_failed };
-
 struct SteadyState {
-  SteadyStateStatus status = SteadyStateStatus::converged;
+  /// not_periodic: max_periods ran without two consecutive periods within the tolerance (the
+  /// last periods are returned all the same); not_converging: the joints' Newton iteration
+  /// failed at a step (no samples); numerical_issue: the effective stiffness is singular.
+  Status status;
   int periods_run = 0;
   double period_change = 0.0; ///< last relative period-to-period change
   Eigen::VectorXd t;          ///< uniformly sampled whole periods, s (starting at 0)

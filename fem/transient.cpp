@@ -8,6 +8,7 @@
 #include <functional>
 #include <numbers>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -109,16 +110,27 @@ integrate(const Assembled& system, const SparseMatrix& C, const LocalForces* for
   out.t = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) * history.dt);
   out.u = out.v = out.a = Eigen::MatrixXd::Zero(n, n_outputs);
   Newmark integrator(system, C, forces, h, o.newmark);
+  if (!integrator.status().ok()) {
+    out.status = integrator.status();
+    out.samples_done = 0;
+    return out;
+  }
   integrator.set_state(Eigen::VectorXd::Zero(n_sys), Eigen::VectorXd::Zero(n_sys), applied(0.0));
   record(integrator, out, 0);
   out.samples_done = 1;
   for (Eigen::Index i = 0; i + 1 < n; ++i) {
-    for (int s = 1; s <= o.substeps; ++s)
-      if (integrator.step(applied(static_cast<double>(i) + static_cast<double>(s) / o.substeps)) !=
-          StepStatus::success) {
-        out.status = TransientStatus::newton_failed;
+    for (int s = 1; s <= o.substeps; ++s) {
+      const double sample = static_cast<double>(i) + static_cast<double>(s) / o.substeps;
+      if (Status step = integrator.step(applied(sample)); !step.ok()) {
+        std::ostringstream reason;
+        reason << "the joints' Newton iteration failed after t = "
+               << static_cast<double>(i) * history.dt << " s (no convergence in "
+               << o.newmark.max_newton << " iterations on the way to t = " << sample * history.dt
+               << " s)";
+        out.status = Status::failure(step.code, reason.str());
         return out;
       }
+    }
     record(integrator, out, i + 1);
     out.samples_done = static_cast<int>(i + 2);
     if (o.progress && (i + 2) % std::max<Eigen::Index>(1, n / 100) == 0)

@@ -45,10 +45,10 @@ struct TransientOptions {
   std::function<void(double)> progress;
 };
 
-enum class TransientStatus { success, newton_failed };
-
 struct TransientResponse {
-  TransientStatus status = TransientStatus::success;
+  /// not_converging: the joints' Newton iteration failed at a step (the reason says when; the
+  /// samples before it are kept); numerical_issue: the effective stiffness is singular.
+  Status status;
   int samples_done = 0; ///< samples computed (all unless the joints' iteration failed)
   Eigen::VectorXd t;    ///< s, the samples' times
   Eigen::MatrixXd u;    ///< n_samples × n_outputs displacement (m or rad)

@@ -489,7 +489,7 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
                                                             : 0.0);
     ResponsePoint p;
     p.hb = f.hb->result(*f.eq, st.z);
-    p.hb.converged = true;
+    p.hb.status = {};
     p.hb.iterations = st.iterations;
     p.hb.residual = st.residual;
     if (o.stability && !exact_friction) {
@@ -624,6 +624,10 @@ ResponseCurves response_curves(const Substructure& sub, const std::vector<joints
     out.dofs.push_back(dofs.node_dof(e));
   const ModalSynthesis synthesis = sub.synthesis(
       outputs, synthesis_band_hz(std::max(start_hz, end_hz), o.hb.harmonics), &out.notes);
+  if (!synthesis.status().ok()) {
+    out.status = synthesis.status();
+    return out;
+  }
   for (std::size_t i = 0; i < amplitudes.size(); ++i) {
     std::function<void(double)> each;
     if (progress) each = [&progress, i](double fraction) { progress(i, fraction); };

@@ -84,6 +84,8 @@ ResponseBranch trace_response(const ModalSynthesis& synthesis,
 
 /// Response curves of a model: one branch per force amplitude of F0 sin ωt at one DOF.
 struct ResponseCurves {
+  /// ok, or the synthesis' status (its modal analysis failed; then no curves)
+  fem::Status status;
   int harmonics = 0;
   std::vector<fem::NodeDof> dofs; ///< the outputs: every joint DOF, then the force DOF (once each)
   std::vector<double> amplitudes; ///< N (or N m)
@@ -94,8 +96,8 @@ struct ResponseCurves {
 /// The model's response curves over start_hz … end_hz for each amplitude, by trace_response()
 /// on the synthesis of `substructure` over the band the harmonics need
 /// (synthesis_band_hz(max frequency, K)). Throws std::invalid_argument for a force DOF not in
-/// the model, amplitudes not > 0, or the arguments trace_response() refuses.
-/// `progress(curve, fraction)` follows each curve.
+/// the model, amplitudes not > 0, or the arguments trace_response() refuses. A modal analysis
+/// that fails is the result's status. `progress(curve, fraction)` follows each curve.
 ResponseCurves response_curves(const Substructure& substructure,
                                const std::vector<joints::Joint>& joints, const fem::NodeDof& force,
                                const std::vector<double>& amplitudes, double start_hz,

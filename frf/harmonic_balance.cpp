@@ -556,8 +556,9 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
     }
   }
   HarmonicBalanceResult out = result(*P, z);
-  out.converged = converged;
-  out.reason = std::move(reason);
+  out.status = converged
+                   ? fem::Status{}
+                   : fem::Status::failure(fem::Status::Code::not_converging, std::move(reason));
   out.iterations = iterations;
   out.residual = residual;
   return out;

@@ -24,6 +24,8 @@
 /// (n, m)), so Newton converges as for a smooth force. An element that never slides keeps its
 /// rest position: where time integration from rest left it elsewhere (a slide during the
 /// transient only), the two steady states differ by a mean, not in their harmonics k ≥ 1.
+#include "fem/assert.hpp"
+#include "fem/status.hpp"
 #include "frf/receptance.hpp"
 #include "joints/joint.hpp"
 
@@ -44,8 +46,14 @@ struct HarmonicBlocks {
   void resize(Eigen::Index rows, Eigen::Index columns, int K) {
     data.resize(rows, columns * (K + 1)), cols = columns;
   }
-  auto operator[](int k) { return data.middleCols(k * cols, cols); }
-  auto operator[](int k) const { return data.middleCols(k * cols, cols); }
+  auto operator[](int k) {
+    JOINTID_ASSERT(k >= 0 && (k + 1) * cols <= data.cols(), "harmonic k is one of 0 … K");
+    return data.middleCols(k * cols, cols);
+  }
+  auto operator[](int k) const {
+    JOINTID_ASSERT(k >= 0 && (k + 1) * cols <= data.cols(), "harmonic k is one of 0 … K");
+    return data.middleCols(k * cols, cols);
+  }
 };
 } // namespace detail
 
@@ -71,11 +79,11 @@ struct HarmonicBalanceOptions {
 };
 
 struct HarmonicBalanceResult {
-  bool converged = false;
-  /// Why not, when not converged (empty otherwise): the residual reached and how the solve
-  /// went, e.g. "no convergence: relative residual 3.2e-04 after 60 Newton iterations from the
-  /// linear response, then 20 load steps (stalled at step 7 of 20)".
-  std::string reason;
+  /// ok, or not_converging with the residual reached and how the solve went, e.g. "no
+  /// convergence: relative residual 3.2e-04 after 60 Newton iterations from the linear
+  /// response; then load steps stalled at step 7 of 20 (…)". A result not (yet) solved is
+  /// not_converging.
+  fem::Status status{fem::Status::Code::not_converging, "not solved"};
   int iterations = 0;
   double residual = 0.0;
   Eigen::MatrixXcd Y; ///< (K+1) × n_joints: harmonics of the joint deformations

@@ -382,6 +382,7 @@ struct Equations {
   // (size()), and, if asked, its (generalised) Jacobian there (as jacobian()).
   void residual(const Eigen::VectorXd& z, double load, Eigen::VectorXd& r,
                 Eigen::MatrixXd* J) const {
+    JOINTID_ASSERT(z.size() == size(), "the packed unknowns have the equations' size");
     Scratch& s = scratch();
     r = z;
     // Per joint a: its rows get Σ_b H_yy(kω)_ab G_b,k, with G_b the smooth force of joint b

@@ -1,5 +1,7 @@
 #include "frf/receptance.hpp"
 
+#include "fem/assert.hpp"
+
 #include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
 #include <algorithm>
@@ -13,15 +15,16 @@ ModalSynthesis::ModalSynthesis(const fem::Assembled& system, const fem::Modes& m
                                const fem::Damping& damping, std::vector<int> dofs,
                                const ModalSynthesisOptions& options)
     : dofs_(std::move(dofs)) {
-  if (modes.status != fem::ModalStatus::success)
-    throw std::invalid_argument("modal synthesis: the modal analysis failed (" + modes.reason +
-                                "): no modes to synthesise from");
   const int n = system.dofs.num_equations(), m = modes.num_modes(),
             d = static_cast<int>(dofs_.size());
   for (int e : dofs_)
     if (e < 0 || e >= n)
       throw std::invalid_argument("modal synthesis: equation " + std::to_string(e) +
                                   " out of range");
+  if (!modes.status.ok()) {
+    status_ = modes.status.within("the modal analysis failed: ");
+    return;
+  }
   phi_.resize(d, m);
   for (int i = 0; i < d; ++i) {
     int row = dofs_[i];
@@ -105,6 +108,7 @@ ModalSynthesis ModalSynthesis::block_diagonal(const std::vector<ModalSynthesis>&
   ModalSynthesis out;
   Eigen::Index d = 0, m = 0;
   for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (!parts[p].status_.ok() && out.status_.ok()) out.status_ = parts[p].status_;
     if (equations[p].size() != parts[p].dofs_.size())
       throw std::invalid_argument("block_diagonal: part " + std::to_string(p + 1) + " serves " +
                                   std::to_string(parts[p].dofs_.size()) + " equations, given " +
@@ -118,6 +122,7 @@ ModalSynthesis ModalSynthesis::block_diagonal(const std::vector<ModalSynthesis>&
     m += parts[p].phi_.cols();
   }
   d = static_cast<Eigen::Index>(out.dofs_.size());
+  if (!out.status_.ok()) return out;
   out.phi_ = Eigen::MatrixXd::Zero(d, m);
   out.omega_.resize(m);
   out.modal_damping_.resize(m);
@@ -142,7 +147,22 @@ ModalSynthesis ModalSynthesis::block_diagonal(const std::vector<ModalSynthesis>&
   return out;
 }
 
+ModalSynthesis ModalSynthesis::failed(fem::Status status, std::vector<int> dofs) {
+  JOINTID_ASSERT(!status.ok(), "a failed synthesis needs a status that is not ok");
+  ModalSynthesis out;
+  out.status_ = std::move(status);
+  out.dofs_ = std::move(dofs);
+  return out;
+}
+
+void ModalSynthesis::require_ok() const {
+  if (!status_.ok())
+    throw std::logic_error("modal synthesis used although it failed (check status() first): " +
+                           status_.reason);
+}
+
 ModalSynthesis ModalSynthesis::with_damping_scale(double factor) const {
+  require_ok();
   if (phi_.cols() == 0 && !measured_.empty())
     throw std::logic_error("receptance: measured FRFs have no modal damping to scale");
   if (!(factor > 0.0) || !std::isfinite(factor))
@@ -155,6 +175,7 @@ ModalSynthesis ModalSynthesis::with_damping_scale(double factor) const {
 }
 
 Eigen::MatrixXd ModalSynthesis::shapes(std::span<const int> equations) const {
+  require_ok();
   Eigen::MatrixXd out(equations.size(), phi_.cols());
   for (std::size_t i = 0; i < equations.size(); ++i)
     out.row(static_cast<Eigen::Index>(i)) = phi_.row(position(equations[i]));
@@ -163,6 +184,7 @@ Eigen::MatrixXd ModalSynthesis::shapes(std::span<const int> equations) const {
 
 Eigen::MatrixXd ModalSynthesis::residual_flexibility(std::span<const int> rows,
                                                      std::span<const int> cols) const {
+  require_ok();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(rows.size(), cols.size());
   if (!has_residual_) return out;
   for (std::size_t i = 0; i < rows.size(); ++i)
@@ -186,7 +208,13 @@ CMatrix ModalSynthesis::receptance(double omega, std::span<const int> rows,
 
 CMatrix ModalSynthesis::receptances(std::span<const double> omegas, std::span<const int> rows,
                                     std::span<const int> cols) const {
+  require_ok();
   const int m = static_cast<int>(omega_.size());
+  JOINTID_ASSERT(phi_.rows() == static_cast<Eigen::Index>(dofs_.size()) && phi_.cols() == m &&
+                     modal_damping_.size() == m,
+                 "one shape row per DOF served, one frequency and damping per mode");
+  JOINTID_ASSERT(residual_.rows() == phi_.rows() && residual_.cols() == phi_.rows(),
+                 "the residual flexibility is |dofs| × |dofs|");
   const auto nr = static_cast<Eigen::Index>(rows.size()),
              nc = static_cast<Eigen::Index>(cols.size());
   const auto nw = static_cast<Eigen::Index>(omegas.size());
@@ -268,8 +296,9 @@ Blocks ModalSynthesis::blocks(double omega, const Partition& p) const {
           receptance(omega, p.set2, p.set1), receptance(omega, p.set2, p.set2)};
 }
 
-CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix& C, double omega,
-                          std::span<const int> rows, std::span<const int> cols) {
+fem::Outcome<CMatrix> direct_receptance(const fem::Assembled& system, const fem::SparseMatrix& C,
+                                        double omega, std::span<const int> rows,
+                                        std::span<const int> cols) {
   using CSparse = Eigen::SparseMatrix<Complex>;
   const int n = system.dofs.num_equations();
   CSparse D = (system.K - omega * omega * system.M).cast<Complex>();
@@ -277,10 +306,13 @@ CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix&
   D.makeCompressed();
   Eigen::UmfPackLU<CSparse> lu(D);
   if (lu.info() != Eigen::Success)
-    throw std::runtime_error(
-        "direct receptance: K - w^2 M + i w C is singular at w = " + std::to_string(omega) +
-        " rad/s (" + std::to_string(omega / (2.0 * std::numbers::pi)) +
-        " Hz): an undamped natural frequency, or a DOF with neither stiffness nor mass");
+    return {
+        fem::Status::failure(
+            fem::Status::Code::numerical_issue,
+            "direct receptance: K - w^2 M + i w C is singular at w = " + std::to_string(omega) +
+                " rad/s (" + std::to_string(omega / (2.0 * std::numbers::pi)) +
+                " Hz): an undamped natural frequency, or a DOF with neither stiffness nor mass"),
+        {}};
   Eigen::MatrixXcd unit = Eigen::MatrixXcd::Zero(n, static_cast<int>(cols.size()));
   for (std::size_t j = 0; j < cols.size(); ++j)
     unit(cols[j], j) = 1.0;
@@ -288,7 +320,7 @@ CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix&
   CMatrix H(rows.size(), cols.size());
   for (std::size_t i = 0; i < rows.size(); ++i)
     H.row(i) = X.row(rows[i]);
-  return H;
+  return {{}, std::move(H)};
 }
 
 } // namespace jointid::frf

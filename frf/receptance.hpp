@@ -4,6 +4,7 @@
 /// and by a direct sparse solve of (K − ω²M + iωC), the cross-check.
 #include "fem/damping.hpp"
 #include "fem/modal.hpp"
+#include "fem/status.hpp"
 #include "frf/measured_frf.hpp"
 #include "frf/modal_model.hpp"
 
@@ -40,8 +41,14 @@ struct ModalSynthesisOptions {
 /// H(ω)_ij = Σ_r φ_ir φ_jr / (ω_r² − ω² + 2iζ_r ω_r ω) [+ R_ij], for DOFs among `dofs`.
 /// ζ_r comes from the model's damping (modal ratio, or Rayleigh's α/2ω_r + βω_r/2), or from a
 /// modal model's ratios.
+///
+/// A synthesis from modes whose analysis failed has that status (status(), with its reason)
+/// and nothing to synthesise from: check status() first; using it otherwise (receptance(),
+/// shapes(), …) throws std::logic_error with the reason, never returns a number.
 class ModalSynthesis {
 public:
+  /// Throws std::invalid_argument for an equation out of range or a row the modes lack; modes
+  /// whose status is not ok give a synthesis with that status.
   ModalSynthesis(const fem::Assembled& system, const fem::Modes& modes, const fem::Damping& damping,
                  std::vector<int> dofs, const ModalSynthesisOptions& options = {});
   /// From a substructure given by its modes: equation e is modal.dofs[e] (the numbering of
@@ -58,9 +65,14 @@ public:
   /// entry i of parts[p].dofs() is equation equations[p][i] here). The modes of every part
   /// together (each shape zero outside its part), their residuals block by block, and the
   /// measured FRFs of each part in its block. Throws std::invalid_argument when the sizes
-  /// differ or an equation is served twice.
+  /// differ or an equation is served twice. A part whose status is not ok makes the whole
+  /// synthesis fail with that status.
   static ModalSynthesis block_diagonal(const std::vector<ModalSynthesis>& parts,
                                        const std::vector<std::vector<int>>& equations);
+  /// A synthesis over `dofs` that could not be made, with the status that says why (not ok).
+  static ModalSynthesis failed(fem::Status status, std::vector<int> dofs);
+  /// ok, or why there are no modes to synthesise from (the modal analysis' status).
+  const fem::Status& status() const { return status_; }
   /// A copy with every mode's damping 2ζ_rω_r multiplied by `factor` (> 0; else
   /// std::invalid_argument): "the substructure's damping is off by a factor".
   /// Measured FRFs have no modal damping to scale: std::logic_error (check measured()).
@@ -82,16 +94,26 @@ public:
   const std::vector<int>& dofs() const { return dofs_; }
   /// The modes behind the synthesis: ω_r (rad/s), 2ζ_rω_r (1/s), and the mass-normalised shapes
   /// at the given equations (|equations| × n_modes; each one of `dofs`).
-  const Eigen::VectorXd& natural_frequencies() const { return omega_; }
-  const Eigen::VectorXd& modal_damping() const { return modal_damping_; }
+  const Eigen::VectorXd& natural_frequencies() const {
+    require_ok();
+    return omega_;
+  }
+  const Eigen::VectorXd& modal_damping() const {
+    require_ok();
+    return modal_damping_;
+  }
   Eigen::MatrixXd shapes(std::span<const int> equations) const;
   /// The static residual flexibility (m/N) of the modes not computed, rows × cols (zero when
   /// the synthesis has none).
   Eigen::MatrixXd residual_flexibility(std::span<const int> rows, std::span<const int> cols) const;
 
 private:
-  ModalSynthesis() = default; // for block_diagonal
+  ModalSynthesis() = default; // for block_diagonal and failed
   int position(int equation) const;
+  /// Throws std::logic_error with the status' reason when it is not ok (a caller that did not
+  /// check status()).
+  void require_ok() const;
+  fem::Status status_;
   std::vector<int> dofs_;
   Eigen::MatrixXd phi_; ///< |dofs| × n_modes
   Eigen::VectorXd omega_;
@@ -108,8 +130,10 @@ private:
 };
 
 /// Direct receptance (K − ω²M + iωC)⁻¹ restricted to rows × cols, by a complex sparse LU
-/// (UMFPACK). Cost: one factorisation per frequency.
-CMatrix direct_receptance(const fem::Assembled& system, const fem::SparseMatrix& C, double omega,
-                          std::span<const int> rows, std::span<const int> cols);
+/// (UMFPACK). Cost: one factorisation per frequency. A singular K − ω²M + iωC (an undamped
+/// natural frequency, a DOF with neither stiffness nor mass) is numerical_issue, with no value.
+fem::Outcome<CMatrix> direct_receptance(const fem::Assembled& system, const fem::SparseMatrix& C,
+                                        double omega, std::span<const int> rows,
+                                        std::span<const int> cols);
 
 } // namespace jointid::frf

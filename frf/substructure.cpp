@@ -26,12 +26,6 @@ std::string number(double value) {
   return std::string(buffer, end);
 }
 
-fem::Modes checked(fem::Modes modes) {
-  if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error("modal analysis failed: " + modes.reason);
-  return modes;
-}
-
 } // namespace
 
 Substructure::Substructure(fem::Model model)
@@ -147,7 +141,7 @@ const fem::Modes& Substructure::all_modes() const {
     fem::ModalOptions options;
     options.num_modes = 0;
     options.engine = fem::ModalEngine::dense;
-    all_modes_ = checked(fem::modal_analysis(*system_, options));
+    all_modes_ = fem::modal_analysis(*system_, options);
   }
   return *all_modes_;
 }
@@ -172,6 +166,9 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
       if (local[p].empty()) continue;
       std::vector<std::string> part_notes;
       syntheses.push_back(parts_[p].synthesis(local[p], f_max_hz, &part_notes));
+      if (const fem::Status& status = syntheses.back().status(); !status.ok())
+        return ModalSynthesis::failed(status.within("substructure " + std::to_string(p + 1) + ": "),
+                                      std::move(dofs));
       served.push_back(here[p]);
       if (notes)
         for (const std::string& note : part_notes)
@@ -206,8 +203,8 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
     fem::ModalOptions options;
     options.max_frequency_hz = f_max_hz;
     options.engine = fem::ModalEngine::sparse;
-    band = checked(band_solver_ ? band_solver_(*model_, *system_, options, dofs)
-                                : fem::modal_analysis(*system_, options));
+    band = band_solver_ ? band_solver_(*model_, *system_, options, dofs)
+                        : fem::modal_analysis(*system_, options);
   }
   const fem::Modes& modes = band ? *band : all_modes();
   ModalSynthesis synthesis(*system_, modes, damping_, std::move(dofs));
@@ -219,20 +216,25 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
   return synthesis;
 }
 
-fem::SparseMatrix Substructure::damping_matrix() const {
+fem::Outcome<fem::SparseMatrix> Substructure::damping_matrix() const {
   if (!system_)
     throw std::logic_error(std::string("time integration needs a finite element model; this "
                                        "substructure is given by ") +
                            given_by());
   const fem::Damping& damping = damping_;
-  if (damping.kind != fem::Damping::Kind::modal) return fem::damping_matrix(*system_, damping);
+  if (damping.kind != fem::Damping::Kind::modal)
+    return {{}, fem::damping_matrix(*system_, damping)};
   const int n = system_->dofs.num_equations();
   if (n > dense_limit())
     throw std::invalid_argument(
         "modal damping in a time simulation needs every mode, and the model has " +
         std::to_string(n) + " equations (more than " + std::to_string(dense_limit()) +
         "); use [damping] rayleigh = [alpha, beta]");
-  return fem::damping_matrix(*system_, damping, &all_modes());
+  const fem::Modes& modes = all_modes();
+  if (!modes.status.ok())
+    return {modes.status.within("modal damping needs every mode, and the modal analysis failed: "),
+            {}};
+  return {{}, fem::damping_matrix(*system_, damping, &modes)};
 }
 
 } // namespace jointid::frf

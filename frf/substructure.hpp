@@ -5,6 +5,7 @@
 #include "fem/assembly.hpp"
 #include "fem/modal.hpp"
 #include "fem/model.hpp"
+#include "fem/status.hpp"
 #include "frf/modal_model.hpp"
 #include "frf/receptance.hpp"
 
@@ -70,10 +71,11 @@ public:
   /// engine, frequency band) with residual flexibility. A modal model uses its given modes and
   /// residual. `notes` (if not null) receives what the user should know, e.g. "receptance from
   /// 12 of 3000 modes without residual flexibility (the model has rigid-body modes): the modes
-  /// left out are ignored". Throws std::runtime_error when the modal analysis fails, saying why
-  /// (its status and reason), std::invalid_argument for an
-  /// equation outside the model or f_max_hz <= 0 where it is needed. Measured FRFs: notes
-  /// receive the estimated interpolation error when it exceeds 1e-3 of a function's peak.
+  /// left out are ignored". A modal analysis that fails gives a synthesis with its status
+  /// (ModalSynthesis::status(), the reason saying why; a part's prefixed "substructure p: ");
+  /// throws std::invalid_argument for an equation outside the model or f_max_hz <= 0 where it
+  /// is needed. Measured FRFs: notes receive the estimated interpolation error when it exceeds
+  /// 1e-3 of a function's peak.
   ModalSynthesis synthesis(std::vector<int> dofs, double f_max_hz,
                            std::vector<std::string>* notes = nullptr) const;
 
@@ -81,7 +83,8 @@ public:
   /// empty matrix); modal damping needs every mode, so a model above the dense limit is refused
   /// (std::invalid_argument saying to use [damping] rayleigh = [alpha, beta]). Throws
   /// std::logic_error for a modal model ("time integration needs a finite element model").
-  fem::SparseMatrix damping_matrix() const;
+  /// The modal analysis modal damping needs can fail: its status, and no matrix.
+  fem::Outcome<fem::SparseMatrix> damping_matrix() const;
 
   /// Computes the band of modes a synthesis of an FE model above the dense limit needs:
   /// (model, assembled system, options with max_frequency_hz set, equations whose rows of φ

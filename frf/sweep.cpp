@@ -54,6 +54,10 @@ FrfSweep frf_sweep(const Substructure& sub, int drive, std::vector<int> response
   // synthesis() checks the equations; its band covers harmonic 1 up to f_max.
   const ModalSynthesis H =
       sub.synthesis(dofs, synthesis_band_hz(std::max(f_max, 1e-3), 1), &out.notes);
+  if (!H.status().ok()) {
+    out.status = H.status();
+    return out;
+  }
   out.values.resize(static_cast<Eigen::Index>(freq_hz.size()),
                     static_cast<Eigen::Index>(responses.size()));
   const std::array<int, 1> column{drive};

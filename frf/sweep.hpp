@@ -5,6 +5,7 @@
 /// response x(t) = Re(H F e^{iωt}), so mobility is iω H and accelerance −ω² H, with H the
 /// receptance (K − ω²M + iωC)⁻¹ by modal synthesis (frf::Substructure::synthesis). SI units:
 /// m/N, (m/s)/N, (m/s²)/N; rad for rotations and N m for moments.
+#include "fem/status.hpp"
 #include "frf/substructure.hpp"
 
 #include <Eigen/Core>
@@ -22,6 +23,8 @@ std::string_view frf_kind_name(FrfKind kind);
 FrfKind parse_frf_kind(std::string_view name);
 
 struct FrfSweep {
+  /// ok, or the synthesis' status (its modal analysis failed; then no values)
+  fem::Status status;
   FrfKind kind = FrfKind::receptance;
   int drive = 0;                  ///< equation of the force
   std::vector<int> responses;     ///< equations of the responses (columns of `values`)
@@ -34,7 +37,8 @@ struct FrfSweep {
 /// finite and >= 0). The synthesis covers the band up to the highest frequency (its modes
 /// below twice that, with residual flexibility, for a model above the dense limit). Throws
 /// std::invalid_argument for an equation outside the model, no response, a response listed
-/// twice, no frequency or a frequency that is negative or not finite.
+/// twice, no frequency or a frequency that is negative or not finite. A modal analysis that
+/// fails is the sweep's status.
 FrfSweep frf_sweep(const Substructure& sub, int drive, std::vector<int> responses,
                    std::vector<double> freq_hz, FrfKind kind = FrfKind::receptance);
 

@@ -19,13 +19,11 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
   if (responses.empty())
     throw std::invalid_argument(
         fmt::format("{}: no response channel (expected x@, v@ or a@NODE:DOF columns)", name));
-  for (const auto& c : measured.channels)
-    try {
-      sub.dofs().equation(c.at);
-    } catch (const std::invalid_argument& e) {
+  for (const auto& c : measured.channels) // the record's channel is at fault, not the model
+    if (const std::string why = sub.dofs().why_not_free(c.at); !why.empty())
       throw std::invalid_argument(
-          fmt::format("{}: channel {}: {} in the model", name, c.name(), e.what()));
-    }
+          fmt::format("{}: {} {}: {}", name,
+                      c.quantity == Quantity::force ? "force channel" : "channel", c.name(), why));
   const double fs = input.sample_rate_hz, nyquist = 0.5 * fs;
   const Eigen::Index n = measured.t.size();
   const double duration = static_cast<double>(n) / fs;
@@ -81,6 +79,11 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
     out.prediction = simulate_forced(sub, joints, input, sim);
   } catch (const std::invalid_argument& e) { // e.g. a channel at a DOF the model lacks
     throw std::invalid_argument(fmt::format("{}: {}", name, e.what()));
+  }
+  if (!out.prediction.status.ok()) {
+    out.source = name;
+    out.status = out.prediction.status.within(name + ": ");
+    return out;
   }
 
   // 3. Spectra of both over the kept part.

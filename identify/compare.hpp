@@ -34,6 +34,8 @@ struct ChannelComparison {
 };
 
 struct Comparison {
+  /// ok, or the prediction's status (its simulation failed; then no channels are compared)
+  fem::Status status;
   std::string source;
   double f0_hz = 0.0, f1_hz = 0.0;
   double sample_rate_hz = 0.0;
@@ -51,6 +53,7 @@ struct Comparison {
 
 /// Throws std::invalid_argument naming the record for: no force or no response channel, a band
 /// outside 0 … Nyquist or holding no bin, a segment longer than what remains after skip_s.
+/// A prediction that fails (simulate_forced's status) is the comparison's status.
 Comparison compare_spectra(const frf::Substructure& substructure,
                            const std::vector<joints::Joint>& joints, const Record& measured,
                            const CompareOptions& options = {});

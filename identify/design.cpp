@@ -110,7 +110,6 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
   sim.steps_per_period = samples_per_period;
   sim.quantities = o.quantities;
   sim.balance = o.balance;
-  sim.skip_unconverged = true;
   if (o.progress) sim.progress = [&](double done) { o.progress(0.5 * done); };
   std::vector<SimulatedTest> tests = simulate_sine_tests(sub, joints, force_at, candidates, sim);
   // Solved again from the linear response: where the two differ, the test has coexisting
@@ -146,6 +145,16 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
     f_max = std::max(f_max, c.frequency_hz);
   const frf::ModalSynthesis synthesis =
       sub.synthesis(rows, frf::synthesis_band_hz(f_max, std::max(K, 1)));
+  if (!synthesis.status().ok()) { // no receptance: no candidate can be weighed
+    std::vector<CandidateTest> out;
+    for (const auto& test : tests) {
+      CandidateTest c;
+      c.plan = test.plan;
+      c.reason = synthesis.status().reason;
+      out.push_back(std::move(c));
+    }
+    return out;
+  }
   const ReceptanceFn H = [&synthesis](double omega, std::span<const int> r,
                                       std::span<const int> c) {
     return synthesis.receptance(omega, r, c);
@@ -161,7 +170,9 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& sub,
     CandidateTest c;
     c.plan = test.plan;
     if (test.record.channels.empty()) {
-      c.reason = test.warnings.empty() ? "not predicted" : test.warnings.front();
+      c.reason = !test.status.ok()       ? test.status.reason
+                 : test.warnings.empty() ? "not predicted"
+                                         : test.warnings.front();
       out.push_back(std::move(c));
       continue;
     }

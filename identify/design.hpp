@@ -68,7 +68,9 @@ struct DesignUnknown {
 };
 
 /// Predicts every candidate (in parallel). Throws std::invalid_argument for bad options
-/// (naming them), no unknowns, or a force DOF the model lacks.
+/// (naming them), no unknowns, or a force DOF the model lacks. A candidate that cannot be
+/// predicted (its harmonic balance, or the modal analysis, failed) is not usable, and its
+/// reason is that status' reason.
 std::vector<CandidateTest> predict_candidates(const frf::Substructure& substructure,
                                               const std::vector<joints::Joint>& joints,
                                               const fem::NodeDof& force_at,

@@ -1,5 +1,7 @@
 #include "identify/fit.hpp"
 
+#include "fem/assert.hpp"
+
 #include "identify/harmonics.hpp"
 #include "identify/statistics.hpp"
 
@@ -109,12 +111,11 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   s.frequency_hz = m.frequency_hz;
   s.fundamental_only = m.fundamental_only;
   for (const auto& at : m.force_at) {
-    try {
-      s.force_equations.push_back(dofs.equation(at));
-    } catch (const std::invalid_argument& e) {
-      fail("force channel f@" + fem::to_string(at) + ": " + e.what() +
-           " (a force must act on a free DOF of the model)");
-    }
+    // The record's channel is at fault, not the model: say what the model has.
+    if (const std::string why = dofs.why_not_free(at); !why.empty())
+      fail("force channel f@" + fem::to_string(at) + ": " + why +
+           "; a force must act on a free DOF of the model");
+    s.force_equations.push_back(dofs.equation(at));
   }
   s.F = m.F;
 
@@ -210,7 +211,7 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
 
 std::vector<joints::Joint>
 FitResult::identified(const std::vector<joints::Joint>& model_joints) const {
-  if (status != FitStatus::ok) throw std::invalid_argument("identify: " + reason);
+  if (!status.ok()) throw std::invalid_argument("identify: " + status.reason);
   std::vector<joints::Joint> out = model_joints;
   for (std::size_t i = 0; i < out.size() && i < joints.size(); ++i)
     for (std::size_t t = 0; t < out[i].terms.size(); ++t)
@@ -605,6 +606,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   const Eigen::MatrixXd& Q = eq.Q;
   const Eigen::VectorXd& p = eq.p;
   const std::vector<Row>& rows = eq.rows;
+  JOINTID_ASSERT(Q.rows() == m && Q.cols() == nu && p.size() == m,
+                 "Q b = p: one row of Q and p per equation, one column of Q per unknown");
   for (int u = 0; u < nu; ++u)
     if (!(Q.col(u).norm() > 0.0))
       throw std::invalid_argument("identify: term " + name_of(u) +
@@ -645,8 +648,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
   // it were determined).
   auto inseparable = [&](const Solution& sol) {
     FitResult out;
-    out.status = FitStatus::not_separable;
-    out.reason = sol.inseparable;
+    out.status = fem::Status::failure(fem::Status::Code::not_separable, sol.inseparable);
     out.warnings = warnings;
     out.equations = m;
     out.unknowns = nu;
@@ -832,6 +834,12 @@ FitResult fit(const frf::Substructure& sub, const std::vector<joints::Joint>& jo
   std::vector<std::string> notes;
   const frf::ModalSynthesis synthesis =
       sub.synthesis(dofs, frf::synthesis_band_hz(f_max, K), &notes);
+  if (!synthesis.status().ok()) {
+    FitResult failed;
+    failed.status = synthesis.status();
+    failed.warnings = std::move(notes);
+    return failed;
+  }
   const ReceptanceFn H = [&synthesis](double omega, std::span<const int> rows,
                                       std::span<const int> cols) {
     return synthesis.receptance(omega, rows, cols);
@@ -861,13 +869,11 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());
     // Response channels on DOFs the model does not have, or holds fixed, are not used: said.
     for (std::size_t r = 0; r < m.response_at.size(); ++r) {
-      const fem::DofMap::State state = dofs.state(m.response_at[r]);
-      if (state == fem::DofMap::State::free) continue;
-      warnings.push_back(
-          fmt::format("{}: channel {}@{}: {}; the channel is not used", m.source,
-                      quantity_letter(m.measured_as[r]), fem::to_string(m.response_at[r]),
-                      state == fem::DofMap::State::absent ? "the model has no such DOF"
-                                                          : "a support holds this DOF fixed"));
+      const std::string why = dofs.why_not_free(m.response_at[r]);
+      if (why.empty()) continue;
+      warnings.push_back(fmt::format("{}: channel {}@{}: {}; the channel is not used", m.source,
+                                     quantity_letter(m.measured_as[r]),
+                                     fem::to_string(m.response_at[r]), why));
     }
     tests.push_back(spectrum(m, dofs, joints, warnings));
     tables += m.fundamental_only ? 1 : 0;

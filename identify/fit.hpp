@@ -76,17 +76,13 @@ struct JointEstimate {
   std::vector<TermEstimate> terms;
 };
 
-/// The outcome of a fit (Spectra's rule: bad input throws; a numerical outcome is a status).
-enum class FitStatus {
-  ok,
-  /// The equations do not separate the unknowns (condition number of the column-scaled Q at
-  /// least 1e13): every non-fixed value, std and interval is NaN; `reason` names the term.
-  not_separable
-};
-
 struct FitResult {
-  FitStatus status = FitStatus::ok;
-  std::string reason; ///< why not ok (empty when ok)
+  /// The outcome (bad input throws; a numerical outcome is a status): ok; not_separable, the
+  /// equations do not separate the unknowns (condition number of the column-scaled Q at least
+  /// 1e13): every non-fixed value, std and interval is NaN and the reason names the term; or
+  /// the status of the substructure's modal analysis or of a harmonic balance (output error)
+  /// that failed, with no estimates.
+  fem::Status status;
   std::vector<JointEstimate> joints;
   int equations = 0;
   int unknowns = 0;
@@ -103,7 +99,7 @@ struct FitResult {
   std::vector<std::string> identifiability; ///< what the tests do not determine, in words
   std::vector<std::string> warnings;
   /// The joints with their identified values (fixed terms unchanged). Throws
-  /// std::invalid_argument with `reason` when the status is not ok.
+  /// std::invalid_argument with the status' reason when it is not ok (there are no values).
   std::vector<joints::Joint> identified(const std::vector<joints::Joint>& model_joints) const;
 };
 
@@ -154,7 +150,7 @@ TestSpectrum spectrum(const Measurement& measurement, const fem::DofMap& dofs,
 
 /// Identifies the non-fixed terms of every joint from the tests. Throws std::invalid_argument
 /// for bad input: no joints or tests, a term whose basis function is zero in every test, fewer
-/// equations than unknowns. Unknowns the tests cannot separate give FitStatus::not_separable
+/// equations than unknowns. Unknowns the tests cannot separate give the status not_separable
 /// with its reason (no values). Tests from
 /// stepped-sine tables contribute harmonic 1 only (with a warning if others were asked).
 FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
@@ -176,7 +172,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
 /// The whole pipeline for a substructure: its receptance over the joints' DOFs and the tests'
 /// force DOFs, for the tests' frequencies and the harmonics asked (frf::Substructure::synthesis),
 /// then fit(). What the synthesis leaves out (modes without residual flexibility) is added to
-/// the result's warnings.
+/// the result's warnings; a synthesis whose modal analysis failed is the result's status.
 FitResult fit(const frf::Substructure& substructure, const std::vector<joints::Joint>& joints,
               const std::vector<Measurement>& measurements, const FitOptions& options = {});
 

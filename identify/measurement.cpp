@@ -109,7 +109,17 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   m.source = r.source;
   m.harmonics = K;
   const auto forces = r.all(Quantity::force);
-  if (forces.empty()) fail("no force channel (expected a column such as f@7:uy)");
+  // Worded for every format a record is read from (CSV columns, UFF58 datasets).
+  const auto channel_list = [&] {
+    std::string names;
+    for (const auto& c : r.channels)
+      names += (names.empty() ? "" : ", ") + c.name();
+    return names.empty() ? std::string("none") : names;
+  };
+  if (forces.empty())
+    fail("no force channel among its channels (" + channel_list() +
+         "): a test needs its excitation force (a channel f@NODE:DOF) recorded with the "
+         "responses");
   // Response DOFs in order of first appearance, each with its best channel (x, then v, then a).
   std::vector<const Channel*> best;
   for (const auto& c : r.channels) {
@@ -125,7 +135,9 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
     }
   }
   if (best.empty())
-    fail("no response channel (expected x, v or a columns such as x@7:uy next to the force)");
+    fail("no response channel among its channels (" + channel_list() +
+         "): a test needs a displacement, velocity or acceleration recorded with its force, "
+         "e.g. x@" + fem::to_string(forces.front()->at));
 
   // A force channel that is zero in every sample measured no force.
   std::vector<const Channel*> loaded;

@@ -49,8 +49,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
                        const std::vector<joints::Joint>& joints,
                        const std::vector<Measurement>& measurements, const FitResult& start,
                        const OutputErrorOptions& o) {
-  if (start.status != FitStatus::ok)
-    throw std::invalid_argument("output error: the equation-error start failed: " + start.reason);
+  if (!start.status.ok()) return start; // nothing to refine: its status passed up
   if (measurements.empty()) throw std::invalid_argument("output error: no tests");
   if (o.harmonics.empty()) throw std::invalid_argument("output error: no harmonics to compare");
   const int K = *std::max_element(o.harmonics.begin(), o.harmonics.end());
@@ -225,7 +224,9 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     }
     return js;
   };
-  // The simulated outputs of test i at θ (nullopt when the harmonic balance fails).
+  // The simulated outputs of test i at θ (nullopt when the harmonic balance fails; `failure`
+  // then holds its status).
+  fem::Status failure;
   const auto simulate =
       [&](std::size_t i, const Eigen::VectorXd& th,
           const std::vector<joints::Joint>& js) -> std::optional<Eigen::MatrixXcd> {
@@ -237,7 +238,10 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     for (Eigen::Index c = 0; c < F.cols(); ++c)
       F(1, c) = Complex(th(at + 2 * c), th(at + 2 * c + 1));
     const frf::HarmonicBalanceResult r = t.balance->solve(js, F, t.Y.size() > 0 ? &t.Y : nullptr);
-    if (!r.converged) return std::nullopt;
+    if (!r.status.ok()) {
+      failure = r.status;
+      return std::nullopt;
+    }
     t.Y = r.Y;
     return r.X;
   };
@@ -281,10 +285,14 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     const std::vector<joints::Joint> js = joints_at(theta);
     for (std::size_t i = 0; i < tests.size(); ++i) {
       auto x = simulate(i, theta, js);
-      if (!x)
-        throw std::invalid_argument(measurements[i].source +
-                                    ": output error: the harmonic balance does not converge at "
-                                    "the equation-error estimate");
+      if (!x) { // no start for the iteration: a status, no estimates
+        FitResult failed;
+        failed.status = failure.within(measurements[i].source +
+                                       ": output error: the harmonic balance does not converge "
+                                       "at the equation-error estimate: ");
+        failed.warnings = start.warnings;
+        return failed;
+      }
       X[i] = std::move(*x);
     }
   }
@@ -543,7 +551,7 @@ FitResult output_error(const frf::Substructure& sub, const std::vector<joints::J
   const std::vector<joints::Joint> begin =
       describing_function_start(sub, joints, tests, fit_options, started);
   const FitResult start = fit(sub, with_parametric_fixed(begin), tests, fit_options);
-  if (start.status != FitStatus::ok) return start;
+  if (!start.status.ok()) return start;
   std::vector<int> equations = joint_dof_set(joints, sub.dofs());
   double f_max = 0.0;
   for (const Measurement& m : tests) {
@@ -559,6 +567,12 @@ FitResult output_error(const frf::Substructure& sub, const std::vector<joints::J
   std::vector<std::string> notes;
   const frf::ModalSynthesis H =
       sub.synthesis(equations, frf::synthesis_band_hz(f_max, o.balance.harmonics), &notes);
+  if (!H.status().ok()) {
+    FitResult failed;
+    failed.status = H.status();
+    failed.warnings = std::move(notes);
+    return failed;
+  }
   FitResult out = output_error(H, sub.dofs(), begin, tests, start, o);
   out.warnings.insert(out.warnings.begin(), started.begin(), started.end());
   for (const std::string& note : notes) // those of the fit's own synthesis are there already

@@ -38,12 +38,14 @@ struct OutputErrorOptions {
   double poorly_determined = 0.05;
 };
 
-/// Refines `start` (an equation-error fit of `joints` from the same tests, status ok) by output
-/// error on the synthesis `H`, which must cover the joints', forces' and responses' equations.
-/// Throws std::invalid_argument naming the test: a test whose noise is unknown (a stepped-sine
-/// table, a record of one period), no response harmonic to compare, a harmonic balance that
-/// does not converge at the start. FitResult::interval_method is "output error"; equations is
-/// the number of real residuals (data), unknowns the terms plus two per force channel and test.
+/// Refines `start` (an equation-error fit of `joints` from the same tests) by output error on
+/// the synthesis `H`, which must cover the joints', forces' and responses' equations. A start
+/// whose status is not ok is returned as it is. Throws std::invalid_argument naming the test: a
+/// test whose noise is unknown (a stepped-sine table, a record of one period), no response
+/// harmonic to compare. A harmonic balance that does not converge at the start is the status
+/// not_converging, naming the test, with no estimates. FitResult::interval_method is "output
+/// error"; equations is the number of real residuals (data), unknowns the terms plus two per force
+/// channel and test.
 FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
                        const std::vector<joints::Joint>& joints,
                        const std::vector<Measurement>& tests, const FitResult& start,

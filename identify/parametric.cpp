@@ -152,7 +152,7 @@ std::vector<joints::Joint> describing_function_start(const frf::Substructure& su
       if (!(a > 0.0)) continue;
       try {
         const FitResult r = fit(sub, model, {m}, fit_options);
-        if (r.status != FitStatus::ok) continue;
+        if (!r.status.ok()) continue;
         const double omega = 2.0 * std::numbers::pi * m.frequency_hz;
         const double k = r.joints[jj].terms[0].value, c = r.joints[jj].terms[1].value;
         points.push_back({a, omega, Complex(k - k_fixed, omega * (c - c_fixed))});

@@ -100,7 +100,12 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
   const fem::Assembled& system = *sub.system();
   std::string method;
   if (o.route == TransientRoute::full) {
-    r = fem::transient_response(system, sub.damping_matrix(), local, history, outputs, options);
+    const fem::Outcome<fem::SparseMatrix> damping = sub.damping_matrix();
+    if (!damping.status.ok()) {
+      test.status = damping.status.within("time simulation: ");
+      return test;
+    }
+    r = fem::transient_response(system, damping.value, local, history, outputs, options);
     method = fmt::format("method: time, full model (Newmark, average acceleration, {} equations, "
                          "{} steps per sample)",
                          dofs.num_equations(), o.substeps);
@@ -119,8 +124,10 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
       mo.max_frequency_hz = cutoff;
     }
     fem::Modes modes = fem::modal_analysis(system, mo);
-    if (modes.status != fem::ModalStatus::success)
-      throw std::runtime_error("modal analysis failed: " + modes.reason);
+    if (!modes.status.ok()) {
+      test.status = modes.status.within("time simulation: the modal analysis failed: ");
+      return test;
+    }
     int kept = 0;
     while (kept < modes.num_modes() && modes.frequency_hz(kept) < cutoff)
       ++kept;
@@ -145,10 +152,10 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
                         : std::string(all ? ", every mode" : ", no static correction"),
                     o.substeps);
   }
-  if (r.status != fem::TransientStatus::success)
-    throw std::runtime_error(
-        fmt::format("time simulation: the joints' Newton iteration failed after t = {:.6g} s",
-                    (r.samples_done - 1) * history.dt));
+  if (!r.status.ok()) {
+    test.status = r.status.within("time simulation: ");
+    return test;
+  }
 
   // 4. The record.
   Record& rec = test.record;

@@ -4,6 +4,7 @@
 /// simulated in time (fem/transient.hpp) — in full (the reference) or in modal coordinates with
 /// a static correction (fast) — and written as a measurement record (DESIGN.md's CSV contract).
 /// SI units; the record's sample rate is the force history's.
+#include "fem/status.hpp"
 #include "frf/substructure.hpp"
 #include "identify/record.hpp"
 #include "joints/joint.hpp"
@@ -50,6 +51,10 @@ struct ForceInput {
 };
 
 struct ForcedTest {
+  /// ok, or why the simulation stopped: the joints' Newton iteration failed at a step
+  /// (not_converging, the reason says when; the record holds nothing), the modal analysis or
+  /// the effective stiffness failed.
+  fem::Status status;
   Record record; ///< the force channels as applied (faded in), then x/v/a at every output
   std::vector<std::string> comments; ///< how it was made, for the CSV's comment lines
   std::vector<std::string> warnings;
@@ -59,8 +64,8 @@ struct ForcedTest {
 
 /// Simulates the structure from rest under the forces. Outputs: every joint DOF, then the force
 /// DOFs, then extra_outputs (each once). Throws std::invalid_argument for bad options or a
-/// modal substructure (time integration needs a finite element model), std::runtime_error when
-/// the joints' iteration fails at a step (naming the time) or the modal analysis fails.
+/// modal substructure (time integration needs a finite element model). A numerical failure
+/// (the joints' iteration at a step, the modal analysis) is the result's status.
 ForcedTest simulate_forced(const frf::Substructure& substructure,
                            const std::vector<joints::Joint>& joints, const ForceInput& input,
                            const ForcedOptions& options = {});

@@ -172,9 +172,25 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     const std::lock_guard<std::mutex> lock(progress_lock);
     o.progress(static_cast<double>(++finished) / static_cast<double>(plans.size()));
   };
+  // A test without a record: its name and why.
+  auto failed_test = [](const SineTestPlan& plan, fem::Status status) {
+    SimulatedTest failed;
+    failed.plan = plan;
+    failed.record.source = sine_test_name(plan);
+    failed.status = std::move(status);
+    return failed;
+  };
   std::vector<SimulatedTest> out;
   if (time_domain) {
-    const fem::SparseMatrix C = sub.damping_matrix();
+    const fem::Outcome<fem::SparseMatrix> damping = sub.damping_matrix();
+    if (!damping.status.ok()) {
+      for (const auto& plan : plans)
+        out.push_back(failed_test(plan, damping.status.within(fmt::format(
+                                            "time integration at {} Hz, {} N: ",
+                                            compact(plan.frequency_hz), compact(plan.amplitude)))));
+      return out;
+    }
+    const fem::SparseMatrix& C = damping.value;
     const joints::JointForces forces(joints, dofs);
     fem::SteadyStateOptions options;
     options.steps_per_period = o.steps_per_period;
@@ -187,23 +203,24 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
         const fem::SteadyState s = fem::steady_state(
             *sub.system(), C, &forces, {force_equation, plan.amplitude, plan.frequency_hz}, outputs,
             options);
-        if (s.status == fem::SteadyStateStatus::newton_failed)
-          throw std::runtime_error(
-              fmt::format("time integration at {} Hz, {} N: the joints' Newton iteration failed in "
-                          "period {}",
-                          compact(plan.frequency_hz), compact(plan.amplitude), s.periods_run));
+        const bool periodic = s.status.ok();
+        if (!periodic && s.status.code != fem::Status::Code::not_periodic) {
+          one_done();
+          return failed_test(plan, s.status.within(fmt::format("time integration at {} Hz, {} N: ",
+                                                               compact(plan.frequency_hz),
+                                                               compact(plan.amplitude))));
+        }
         SimulatedTest test = make_test(plan, s.t, s.force, s.u, s.v);
         test.comments.push_back(fmt::format(
             "method: time (Newmark, average acceleration, {} steps per period{})",
             o.steps_per_period,
             stride > 1 ? fmt::format(", every {}th step recorded", stride) : std::string()));
-        const bool converged = s.status == fem::SteadyStateStatus::converged;
         test.comments.push_back(fmt::format(
             "periods run: {} from rest ({}; last period-to-period change {:.3g}); the record "
             "holds the last {}",
-            s.periods_run, converged ? "steady state reached" : "NOT periodic", s.period_change,
+            s.periods_run, periodic ? "steady state reached" : "NOT periodic", s.period_change,
             o.periods));
-        if (!converged) {
+        if (!periodic) {
           const std::string what =
               fmt::format("{}: not a periodic steady state after {} periods (last period-to-period "
                           "change {:.3g})",
@@ -222,6 +239,13 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
     std::vector<std::string> notes;
     const frf::ModalSynthesis synthesis =
         sub.synthesis(outputs, frf::synthesis_band_hz(f_max, o.balance.harmonics), &notes);
+    if (!synthesis.status().ok()) {
+      for (const auto& plan : plans)
+        out.push_back(failed_test(plan, synthesis.status().within(fmt::format(
+                                            "harmonic balance at {} Hz, {} N: ",
+                                            compact(plan.frequency_hz), compact(plan.amplitude)))));
+      return out;
+    }
     // Each force level swept up in frequency, every solution the next one's start (a hardening
     // joint's response has a fold that a solve from the linear response can miss).
     std::vector<std::size_t> order(plans.size());
@@ -242,22 +266,18 @@ std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& sub,
                                          plan.frequency_hz, o.balance);
       const Eigen::MatrixXcd F = frf::sine_force(plan.amplitude);
       frf::HarmonicBalanceResult hb = problem.solve(joints, F, previous ? &*previous : nullptr);
-      if (!hb.converged && previous) hb = problem.solve(joints, F);
-      if (!hb.converged && o.skip_unconverged) {
-        SimulatedTest failed;
-        failed.plan = plan;
-        failed.record.source = sine_test_name(plan);
-        failed.warnings.push_back(
-            fmt::format("{}: no periodic solution found ({})", failed.record.source, hb.reason));
-        done[i] = std::move(failed);
+      if (!hb.status.ok() && previous) hb = problem.solve(joints, F);
+      if (!hb.status.ok()) {
+        done[i] = failed_test(
+            plan, fem::Status::failure(
+                      hb.status.code,
+                      fmt::format("harmonic balance at {} Hz, {} N: no periodic solution found "
+                                  "({}); simulate this test by time integration",
+                                  compact(plan.frequency_hz), compact(plan.amplitude),
+                                  hb.status.reason)));
         one_done();
         continue;
       }
-      if (!hb.converged)
-        throw std::runtime_error(fmt::format(
-            "harmonic balance at {} Hz, {} N: no periodic solution found ({}); simulate this "
-            "test by time integration",
-            compact(plan.frequency_hz), compact(plan.amplitude), hb.reason));
       previous = hb.Y;
       const int samples = o.periods * o.steps_per_period;
       const double h = 1.0 / (plan.frequency_hz * o.steps_per_period);

@@ -5,6 +5,7 @@
 /// (exact stick–slip friction) or by harmonic balance on the joint DOFs. Optionally with
 /// measurement noise, so that identification and discovery can be tested on data whose truth
 /// is known.
+#include "fem/status.hpp"
 #include "frf/harmonic_balance.hpp"
 #include "frf/substructure.hpp"
 #include "identify/record.hpp"
@@ -36,9 +37,6 @@ struct SimulationOptions {
   std::vector<fem::NodeDof> extra_outputs;
   frf::HarmonicBalanceOptions balance{}; ///< harmonic balance
   double steady_tolerance = 1e-10;       ///< time integration: period-to-period change
-  /// Harmonic balance: a test without a periodic solution is returned with an empty record and
-  /// the reason in its warnings, instead of throwing.
-  bool skip_unconverged = false;
   /// Harmonic balance: start each test from the solution of the one below it in frequency at
   /// the same force (a sweep up, which follows a hardening joint's upper branch); false: every
   /// test from the linear response.
@@ -49,10 +47,17 @@ struct SimulationOptions {
 };
 
 struct SimulatedTest {
+  /// ok, or why the test has no record (its channels empty; record.source is still its name):
+  /// the harmonic balance found no periodic solution (not_converging), the joints' Newton
+  /// iteration failed at a time step (not_converging), the effective stiffness or the modal
+  /// analysis failed. Each reason names the test.
+  fem::Status status;
   Record record; ///< source = its file name, sine_f<freq>Hz_F<amp>N.csv
   SineTestPlan plan;
   std::vector<std::string> comments; ///< how it was made, for the CSV's comment lines
-  std::vector<std::string> warnings; ///< not periodic, not converged
+  /// A record that is not a periodic steady state after the most periods allowed (time
+  /// integration; the record holds the last periods all the same).
+  std::vector<std::string> warnings;
 };
 
 /// "joint 'tip': 7:uy to ground; k = 4800, c = 20": a record's comment line describing a joint.
@@ -63,8 +68,9 @@ std::string sine_test_name(const SineTestPlan& plan);
 
 /// Simulates every test. Outputs: every joint DOF, then the force DOF, then `extra_outputs`
 /// (each once). Throws std::invalid_argument for bad plans or options (naming the value), or a
-/// force DOF the model lacks; std::runtime_error when a time step's joint iteration fails.
-/// Time integration needs a finite element substructure.
+/// force DOF the model lacks. A test that cannot be simulated has a status that says why
+/// (SimulatedTest::status) and no record; the others are simulated all the same. Time
+/// integration needs a finite element substructure.
 std::vector<SimulatedTest> simulate_sine_tests(const frf::Substructure& substructure,
                                                const std::vector<joints::Joint>& joints,
                                                const fem::NodeDof& force_at,

@@ -1,8 +1,7 @@
 #include "io/results_json.hpp"
 
 #include "io/files.hpp"
-
-#include <nlohmann/json.hpp>
+#include "io/json_text.hpp"
 
 #include <cmath>
 
@@ -10,15 +9,9 @@ namespace jointid::io {
 
 namespace {
 
-using Json = nlohmann::ordered_json; // keeps the contract's key order
-
-Json number(double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
-
-std::string text(const Json& json) {
-  return json.dump(2) + "\n";
-}
+using json::Json;
+using json::number;
+using json::text;
 
 } // namespace
 
@@ -68,8 +61,8 @@ std::string identify_result_json(const identify::FitResult& result,
     warnings.push_back(w);
 
   Json out;
-  out["status"] = result.status == identify::FitStatus::ok ? "ok" : "not_separable";
-  out["reason"] = result.reason;
+  out["status"] = std::string(fem::code_name(result.status.code));
+  out["reason"] = result.status.reason;
   out["joints"] = std::move(joints);
   out["equations"] = result.equations;
   out["unknowns"] = result.unknowns;

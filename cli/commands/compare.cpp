@@ -89,6 +89,7 @@ void Compare::run() {
           throw io::Error(fmt::format("{} (model {})", e.what(), model_.string()));
         }
       });
+  require(result.status);
 
   // 4. Write.
   make_output_dir(output_dir_);

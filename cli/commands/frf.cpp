@@ -88,6 +88,7 @@ void Frf::run() {
     return frf::frf_sweep(model.sub, model.sub.dofs().equation(drive), std::move(responses),
                           frf::evenly_spaced_hz(f0, f1, points_), kind);
   });
+  require(sweep.status);
   if (!output_rank()) return;
   const std::size_t joints = model.file.joints.size();
   if (joints > 0)

@@ -95,7 +95,7 @@ void Identify::run() {
   const identify::FitResult result =
       output_error_ ? identify::output_error(model.sub, model.file.joints, measured, fit_, refined)
                     : identify::fit(model.sub, model.file.joints, measured, fit_);
-  if (result.status != identify::FitStatus::ok) throw io::Error("identify: " + result.reason);
+  if (!result.status.ok()) throw io::Error("identify: " + result.status.reason);
   if (!output_rank()) return;
 
   // 4. Write and report.

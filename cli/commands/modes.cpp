@@ -128,8 +128,7 @@ void Modes::run() {
   options.max_iterations = max_restarts_;
   const fem::Modes modes =
       compute_modes(file.model, sub ? sub->system() : nullptr, options, engine);
-  if (modes.status != fem::ModalStatus::success)
-    throw std::runtime_error("modal analysis failed: " + modes.reason);
+  if (!modes.status.ok()) throw std::runtime_error("modal analysis failed: " + modes.status.reason);
   if (!output_rank()) return;
 
   // 3. Write.

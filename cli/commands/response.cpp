@@ -93,6 +93,7 @@ void Response::run() {
                                       options_, each);
         });
       });
+  require(curves.status);
   if (!output_rank()) return;
 
   // 4. Write.

@@ -191,6 +191,8 @@ void Simulate::run_sine() {
                                                options);
         });
       });
+  for (const auto& t : tests)
+    require(t.status);
   identify::add_noise(tests, noise_, seed_);
   const std::vector<std::string> made_by{"jointid simulate", "model: " + model_.string()};
   for (auto& t : tests) {
@@ -320,6 +322,11 @@ void Simulate::run_signal() {
   // 3. The model and the simulation.
   const Model model(model_, engine());
   if (!from_record) input.at = {model.dof("--force", force_)};
+  for (const auto& at : input.at) // a record's force channel is its fault, not the model's
+    if (const std::string why = model.sub.dofs().why_not_free(at); from_record && !why.empty())
+      throw io::Error(fmt::format("{}: force channel f@{}: {}; a force must act on a free DOF of "
+                                  "the model ({})",
+                                  force_from_.string(), fem::to_string(at), why, model.name()));
   for (const auto& text : outputs_)
     options.extra_outputs.push_back(model.dof("--outputs", text));
   io::check_not_an_input(output_dir_ / name);
@@ -330,6 +337,7 @@ void Simulate::run_signal() {
           return identify::simulate_forced(model.sub, model.file.joints, input, options);
         });
       });
+  require(test.status);
   test.record.source = name;
   test.comments.insert(test.comments.begin(), {"jointid simulate", "model: " + model_.string()});
   identify::add_noise(test, noise_, seed_);

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -133,6 +134,8 @@ int main(int argc, char** argv) {
         so.steps_per_period = 2048;
         so.samples_per_period = 256;
         const auto clean = identify::simulate_sine_tests(sub, joints, tip, design.tests, so);
+        for (const auto& t : clean)
+          if (!t.status.ok()) throw std::runtime_error(t.status.reason);
         identify::FitOptions fo;
         fo.harmonics = harmonics;
         Eigen::VectorXd square = Eigen::VectorXd::Zero(scale.size());
@@ -149,7 +152,7 @@ int main(int argc, char** argv) {
           try {
             const identify::FitResult fit = identify::fit(
                 sub, joints, identify::measure(tests, identify::measure_options(fo)), fo);
-            if (fit.status != identify::FitStatus::ok) throw std::invalid_argument(fit.reason);
+            if (!fit.status.ok()) throw std::invalid_argument(fit.status.reason);
             for (Eigen::Index u = 0; u < scale.size(); ++u)
               square(u) += std::pow(
                   fit.joints[0].terms[static_cast<std::size_t>(u)].value / scale(u) - 1.0, 2);

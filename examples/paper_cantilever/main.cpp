@@ -129,8 +129,8 @@ private:
     substructure_.emplace(file_.substructure());
     const fem::Assembled& system = *substructure_->system();
     modes_ = fem::modal_analysis(system, {.num_modes = 3});
-    if (modes_.status != fem::ModalStatus::success)
-      throw std::runtime_error("modal analysis failed");
+    if (!modes_.status.ok())
+      throw std::runtime_error("modal analysis failed: " + modes_.status.reason);
     tip_ = system.dofs.equation({file_.joints[0].node, file_.joints[0].dof});
     synthesis_.emplace(substructure_->synthesis({tip_}, 0.0));
     std::printf("Substructure: %d DOFs, modes %.4f Hz, %.4f Hz, %.4f Hz (modal damping %.3g)\n",
@@ -156,6 +156,7 @@ private:
     std::vector<identify::Record> records;
     for (auto& test :
          identify::simulate_sine_tests(*substructure_, {joint_of(m)}, tip, plans, options)) {
+      if (!test.status.ok()) throw std::runtime_error(test.status.reason);
       if (!test.warnings.empty()) throw std::runtime_error(test.warnings.front());
       records.push_back(std::move(test.record));
     }

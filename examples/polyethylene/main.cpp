@@ -123,6 +123,7 @@ struct Study {
       auto t =
           identify::simulate_sine_tests(sub, with_friction(file.joints, fd), tip, {run.plan}, so)
               .at(0);
+      if (!t.status.ok()) throw std::runtime_error(t.status.reason);
       run.record = std::move(t.record);
       run.warnings = std::move(t.warnings);
       run.x_rms = rms_about_mean(run.record.find(identify::Quantity::displacement, tip)->samples);
@@ -155,6 +156,7 @@ struct Study {
     identify::ForcedTest test;
     auto simulate = [&](double level) {
       test = identify::simulate_forced(sub, with_friction(file.joints, level), force, fo);
+      if (!test.status.ok()) throw std::runtime_error(test.status.reason);
       const auto& x = test.record.find(identify::Quantity::displacement, tip)->samples;
       x_rms = rms_about_mean(x, x.size() / 10);
       return x_rms;
@@ -175,7 +177,7 @@ BandFit identify_fd(const Study& s, const std::vector<const identify::Record*>& 
     tests.emplace_back(*r);
   const identify::FitResult fit = identify::fit(
       s.sub, s.file.joints, identify::measure(tests, identify::measure_options(fo)), fo);
-  if (fit.status != identify::FitStatus::ok) throw std::runtime_error(fit.reason);
+  if (!fit.status.ok()) throw std::runtime_error(fit.status.reason);
   const auto& e = fit.joints.at(0).terms.at(0);
   return {e.value, e.std, e.ci_low, e.ci_high};
 }

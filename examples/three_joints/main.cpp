@@ -57,9 +57,14 @@ int main(int argc, char** argv) {
   so.steps_per_period = 2048;
   so.samples_per_period = 256;
   const auto clean = identify::simulate_sine_tests(sub, truth, force_at, plans, so);
-  for (const auto& t : clean)
+  for (const auto& t : clean) {
+    if (!t.status.ok()) {
+      fmt::print(stderr, "three_joints: {}\n", t.status.reason);
+      return 1;
+    }
     for (const auto& w : t.warnings)
       fmt::print("warning: {}\n", w);
+  }
   identify::FitOptions fo;
   fo.harmonics = {1, 2, 3};
   auto identify_once = [&](int r) {
@@ -74,8 +79,8 @@ int main(int argc, char** argv) {
 
   // 2. One realisation.
   const identify::FitResult one = identify_once(0);
-  if (one.status != identify::FitStatus::ok) {
-    fmt::print(stderr, "three_joints: {}\n", one.reason);
+  if (!one.status.ok()) {
+    fmt::print(stderr, "three_joints: {}\n", one.status.reason);
     return 1;
   }
   fmt::print("Frame of examples/three_joints/frame.toml, 12 sine tests at corner:ux, noise {:g} % "

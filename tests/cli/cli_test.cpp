@@ -458,7 +458,7 @@ TEST_F(CliTest, ZeroForceForeignChannelAndHarmonicZeroAloneAreNamed) {
                                record_files()[2], "-o", out.string()},
                               dir());
   ASSERT_EQ(run.status, 0) << run.err;
-  EXPECT_NE(run.err.find("with_uz.csv: channel x@7:uz: the model has no such DOF"),
+  EXPECT_NE(run.err.find("with_uz.csv: channel x@7:uz: node 7 has no DOF uz in the model"),
             std::string::npos)
       << run.err;
   // Harmonic 0 alone: the mean balance, which a sine test does not excite.
@@ -1213,6 +1213,22 @@ TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
                (dir() / "missing.csv").string(), "-o", out.string()},
               dir()),
       "missing.csv");
+  // A record's force channel on a node the model lacks is the record's fault, not the model's:
+  // the message starts with the record and the channel, and says what the model has.
+  {
+    std::string text = test::read_text(record_files()[0]);
+    const auto at = text.find("f@7:uy");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 6, "f@99:uy");
+    const fs::path foreign = dir() / "foreign_force.csv";
+    test::write_text(foreign, text);
+    const Outcome run = jointid({"simulate", model().string(), "--excitation", "record",
+                                 "--force-from", foreign.string(), "-o", out.string()},
+                                dir());
+    expect_one_line_error(run, "the model has no node 99 (its nodes: 1–7)");
+    EXPECT_EQ(run.err.rfind("jointid: " + foreign.string() + ": force channel f@99:uy: ", 0), 0u)
+        << run.err;
+  }
   EXPECT_FALSE(fs::exists(out));
 
   // compare: a record without a force channel, a bad band, a bad segment.
@@ -1244,7 +1260,7 @@ TEST_F(CliTest, RandomAndCompareCheckTheirOptions) {
   expect_one_line_error(
       jointid({"compare", model().string(), bad_node.string(), "--no-plot", "-o", cmp.string()},
               dir()),
-      "bad_node.csv: channel x@9:uy: node 9 does not exist");
+      "bad_node.csv: channel x@9:uy: the model has no node 9 (its nodes: 1–7)");
   EXPECT_FALSE(fs::exists(cmp));
 }
 
@@ -1630,8 +1646,8 @@ TEST_F(CliTest, HarmonicBalanceWithoutASolutionIsNamedBySimulateDesignAndRespons
       EXPECT_EQ(c["freq_hz"], 3.0);
       EXPECT_EQ(c["amplitude"], 5000.0);
       EXPECT_EQ(c["reason"].get<std::string>().rfind(
-                    "sine_f3Hz_F5000N.csv: no periodic solution found (no convergence: relative "
-                    "residual ",
+                    "harmonic balance at 3 Hz, 5000 N: no periodic solution found (no "
+                    "convergence: relative residual ",
                     0),
                 0u)
           << c["reason"];

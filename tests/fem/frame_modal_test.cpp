@@ -75,7 +75,7 @@ TEST(FrameModes, PortalSwayWithRigidGirder) {
   for (int top : {top_l, top_r})
     m.masses.push_back({top, M, Eigen::Vector3d::Zero()});
   const Modes modes = modal_analysis(assemble(m), {.num_modes = 1});
-  ASSERT_EQ(modes.status, ModalStatus::success);
+  ASSERT_TRUE(modes.status.ok());
   const double column = rho * A * h, a = span / 2;
   const double expected = sway_omega(2, E * I, E * A, h, a, 2 * M + 2 * 13.0 / 35.0 * column,
                                      (2 * M + 2 * column / 3.0) * a * a);
@@ -114,7 +114,7 @@ TEST(FrameModes, TableSwayAndTorsionWithRigidTop) {
     add_member(m, tops[c], tops[(c + 1) % 4], 1, ElementType::frame3d, 1, 1);
   m.materials[1].E = E;
   const Modes modes = modal_analysis(assemble(m), {.num_modes = 3});
-  ASSERT_EQ(modes.status, ModalStatus::success);
+  ASSERT_TRUE(modes.status.ok());
 
   const double leg = rho * A * H, H3 = H * H * H, G = E / (2 * (1 + nu));
   const double m_sway = 4 * M + 4 * 13.0 / 35.0 * leg;

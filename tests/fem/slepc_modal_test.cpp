@@ -35,8 +35,8 @@ TEST(SlepcModal, SameEigenvaluesAsTheCholmodEngine) {
   const fem::ModalOptions options{.num_modes = 20};
   const fem::Modes reference = cholmod_modes(system, options);
   const fem::Modes modes = fem::slepc_modal_analysis(model, options);
-  ASSERT_EQ(reference.status, fem::ModalStatus::success);
-  ASSERT_EQ(modes.status, fem::ModalStatus::success);
+  ASSERT_TRUE(reference.status.ok());
+  ASSERT_TRUE(modes.status.ok());
   ASSERT_EQ(modes.num_modes(), 20);
   for (int r = 0; r < 20; ++r) {
     const double lambda = modes.omega(r) * modes.omega(r);
@@ -58,7 +58,7 @@ TEST(SlepcModal, ModesAreMassNormalisedAndSolveTheEigenproblem) {
   const fem::Model model = bench::frame_lattice(6, 5, 7, 0.4);
   const fem::Assembled system = fem::assemble(model);
   const fem::Modes modes = fem::slepc_modal_analysis(model, {.num_modes = 12});
-  ASSERT_EQ(modes.status, fem::ModalStatus::success);
+  ASSERT_TRUE(modes.status.ok());
   ASSERT_EQ(modes.num_modes(), 12);
   EXPECT_TRUE(modes.rows.empty());
   for (int r = 1; r < 12; ++r)
@@ -81,7 +81,7 @@ TEST(SlepcModal, FreeFrameHasSixRigidBodyModes) {
   fem::Model model = bench::frame_lattice(3, 3, 3, 1.0);
   model.supports.clear();
   const fem::Modes modes = fem::slepc_modal_analysis(model, {.num_modes = 8});
-  ASSERT_EQ(modes.status, fem::ModalStatus::success);
+  ASSERT_TRUE(modes.status.ok());
   ASSERT_EQ(modes.num_modes(), 8);
   const fem::Assembled system = fem::assemble(model);
   const fem::Modes reference = cholmod_modes(system, {.num_modes = 8});
@@ -104,7 +104,7 @@ TEST(SlepcModal, BandWithGatheredRowsMatchesTheCholmodEngine) {
   const std::vector<int> rows{5, 100, 1234, system.dofs.num_equations() - 1};
   const fem::Modes modes =
       fem::slepc_modal_analysis(model, options, {.rows = rows, .every_rank = true});
-  ASSERT_EQ(modes.status, fem::ModalStatus::success);
+  ASSERT_TRUE(modes.status.ok());
   ASSERT_GT(reference.num_modes(), 8); // the band needs more than the first pass
   ASSERT_EQ(modes.num_modes(), reference.num_modes());
   EXPECT_EQ(modes.rows, rows);

@@ -5,6 +5,7 @@
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
 #include "support/beam_models.hpp"
+#include "support/failing_substructure.hpp"
 #include "support/synthesised_cantilever.hpp"
 
 #include <gtest/gtest.h>
@@ -126,7 +127,7 @@ TEST(Continuation, FloquetMultipliersOfTheBareStructure) {
   for (double f : {1.0, 3.0, 7.0}) {
     const frf::HarmonicBalanceResult r =
         frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 1e-9, f, std::vector<int>{c.eq(7)});
-    ASSERT_TRUE(r.converged);
+    ASSERT_TRUE(r.status.ok());
     const frf::Stability s = frf::floquet_stability(c.H, js, c.system.dofs, r, {});
     ASSERT_TRUE(s.stable.has_value()) << s.note;
     EXPECT_TRUE(*s.stable);
@@ -160,7 +161,7 @@ TEST(Continuation, HardeningCubicFoldsAndStability) {
     // Fixed-frequency Newton started at the point stays there.
     const frf::HarmonicBalance at(c.H, js, c.system.dofs, {c.eq(7)}, {c.eq(7)}, p.hb.frequency_hz);
     const frf::HarmonicBalanceResult r = at.solve(js, frf::sine_force(F0), &p.hb.Y);
-    ASSERT_TRUE(r.converged) << i;
+    ASSERT_TRUE(r.status.ok()) << i;
     EXPECT_LE((r.Y - p.hb.Y).norm(), 1e-9 * p.hb.Y.norm()) << i;
     const bool between = static_cast<int>(i) > up && static_cast<int>(i) < down;
     const bool at_fold = static_cast<int>(i) == up || static_cast<int>(i) == down;
@@ -185,7 +186,7 @@ TEST(Continuation, HardeningCubicFoldsAndStability) {
   std::vector<frf::HarmonicBalanceResult> three;
   for (const Eigen::MatrixXcd* start : {&lower, &middle, &upper}) {
     three.push_back(at.solve(js, frf::sine_force(F0), start));
-    ASSERT_TRUE(three.back().converged);
+    ASSERT_TRUE(three.back().status.ok());
   }
   EXPECT_GT(std::abs(three[1].X(1, 0)), 1.3 * std::abs(three[0].X(1, 0)));
   EXPECT_GT(std::abs(three[2].X(1, 0)), 1.02 * std::abs(three[1].X(1, 0)));
@@ -201,7 +202,7 @@ TEST(Continuation, HardeningCubicFoldsAndStability) {
   o.tolerance = 1e-9;
   const std::vector<int> outputs{c.eq(7)};
   const fem::SteadyState s = fem::steady_state(c.system, C, &forces, {c.eq(7), F0, f}, outputs, o);
-  ASSERT_EQ(s.status, fem::SteadyStateStatus::converged);
+  ASSERT_TRUE(s.status.ok());
   const Complex T1 = harmonic(s.u.col(0), s.t, w, 1);
   EXPECT_LT(std::abs(T1 - three[0].X(1, 0)), 1e-4 * std::abs(three[0].X(1, 0)));
 }
@@ -261,7 +262,7 @@ TEST(Continuation, ExactFrictionPointsAreFixedFrequencySteadyStates) {
     EXPECT_FALSE(p.stable.has_value());
     const frf::HarmonicBalanceResult r = frf::harmonic_balance(
         c.H, js, c.system.dofs, c.eq(7), 10.0, p.hb.frequency_hz, std::vector<int>{c.eq(7)});
-    ASSERT_TRUE(r.converged) << i;
+    ASSERT_TRUE(r.status.ok()) << i;
     EXPECT_LE((r.X - p.hb.X).norm(), 1e-8 * r.X.norm()) << i << " at " << p.hb.frequency_hz;
   }
 }
@@ -418,4 +419,15 @@ TEST(Continuation, IwanResponseCurveIsTracedWithItsStability) {
     EXPECT_TRUE(*p.stable) << p.hb.frequency_hz;
     EXPECT_LT(p.max_multiplier, 1.0);
   }
+}
+
+TEST(Continuation, AModalAnalysisThatFailsIsTheCurvesStatus) {
+  // tests/support/failing_substructure.hpp: its dense modal analysis fails. No curve
+  // is traced; the status says why.
+  const frf::Substructure sub = test::failing_substructure();
+  joints::Joint j{"a", 2, 0, Dof::ux, {Term::k3}, {1e6}, {true}, {}};
+  const frf::ResponseCurves curves = frf::response_curves(sub, {j}, {3, Dof::ux}, {1.0}, 1.0, 2.0);
+  EXPECT_EQ(curves.status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(curves.status.reason, "the modal analysis failed: " + test::failing_modes_reason);
+  EXPECT_TRUE(curves.curves.empty());
 }

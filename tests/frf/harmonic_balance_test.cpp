@@ -58,7 +58,7 @@ TEST(HarmonicBalance, LinearJointToGroundEqualsTheExactSolution) {
     const double w = two_pi * f;
     const frf::HarmonicBalanceResult r =
         frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), F0, f, outputs);
-    ASSERT_TRUE(r.converged) << f;
+    ASSERT_TRUE(r.status.ok()) << f;
     const Complex Htt = c.H.receptance(w, tip, tip)(0, 0);
     const Complex Hmt = c.H.receptance(w, std::vector<int>{c.eq(4)}, tip)(0, 0);
     const Complex denominator = 1.0 + Htt * Complex(k, w * cv);
@@ -86,7 +86,7 @@ TEST(HarmonicBalance, LinearJointBetweenNodesEqualsTheDirectSolveOfTheJoinedStru
   const std::vector<int> outputs{c.eq(7), c.eq(3), c.eq(6)};
   const frf::HarmonicBalanceResult r =
       frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), F0, f, outputs);
-  ASSERT_TRUE(r.converged);
+  ASSERT_TRUE(r.status.ok());
 
   fem::Model joined = c.model;
   joined.springs.push_back({3, 6, Dof::uy, k});
@@ -98,7 +98,7 @@ TEST(HarmonicBalance, LinearJointBetweenNodesEqualsTheDirectSolveOfTheJoinedStru
   C.coeffRef(a, b) -= cv;
   C.coeffRef(b, a) -= cv;
   const std::vector<int> force{c.eq(7)};
-  const frf::CMatrix H = frf::direct_receptance(s, C, w, outputs, force);
+  const frf::CMatrix H = frf::direct_receptance(s, C, w, outputs, force).value;
   for (int o = 0; o < 3; ++o) {
     const Complex expected = H(o, 0) * Complex(0.0, -F0);
     EXPECT_LE(std::abs(r.X(1, o) - expected), 1e-8 * std::abs(H(0, 0) * F0)) << "output " << o;
@@ -122,7 +122,7 @@ TEST(HarmonicBalance, CubicJointAgreesWithTimeIntegration) {
   const std::vector<int> outputs{c.eq(7)};
   const frf::HarmonicBalanceResult hb =
       frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), F0, f, outputs);
-  ASSERT_TRUE(hb.converged);
+  ASSERT_TRUE(hb.status.ok());
   const Complex X1 = hb.X(1, 0), X3 = hb.X(3, 0);
   ASSERT_GT(std::abs(X3), 0.01 * std::abs(X1)); // genuinely non-linear
 
@@ -135,7 +135,7 @@ TEST(HarmonicBalance, CubicJointAgreesWithTimeIntegration) {
     o.tolerance = 1e-9; // transient left ≈ 1e-9 / (1 − e^{−2πζ}) ≈ 2e-8 relative
     const fem::SteadyState s =
         fem::steady_state(c.system, C, &forces, {c.eq(7), F0, f}, outputs, o);
-    EXPECT_EQ(s.status, fem::SteadyStateStatus::converged);
+    EXPECT_TRUE(s.status.ok());
     return s;
   };
   const fem::SteadyState fine = integrate(4096);
@@ -177,15 +177,16 @@ TEST(HarmonicBalance, NonConvergenceSaysWhy) {
   o.continuation_steps = 2;
   const frf::HarmonicBalanceResult r = frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0,
                                                              3.0, std::vector<int>{c.eq(7)}, o);
-  ASSERT_FALSE(r.converged);
+  ASSERT_FALSE(r.status.ok());
   EXPECT_GT(r.residual, o.tolerance);
-  EXPECT_NE(r.reason.find("no convergence: relative residual"), std::string::npos) << r.reason;
-  EXPECT_NE(r.reason.find("from the linear response"), std::string::npos) << r.reason;
-  EXPECT_NE(r.reason.find("of 2"), std::string::npos) << r.reason;
+  EXPECT_NE(r.status.reason.find("no convergence: relative residual"), std::string::npos)
+      << r.status.reason;
+  EXPECT_NE(r.status.reason.find("from the linear response"), std::string::npos) << r.status.reason;
+  EXPECT_NE(r.status.reason.find("of 2"), std::string::npos) << r.status.reason;
   const frf::HarmonicBalanceResult ok =
       frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0, 3.0, std::vector<int>{c.eq(7)});
-  ASSERT_TRUE(ok.converged);
-  EXPECT_TRUE(ok.reason.empty());
+  ASSERT_TRUE(ok.status.ok());
+  EXPECT_TRUE(ok.status.reason.empty());
 }
 
 TEST(HarmonicBalance, BadOptionsThrow) {
@@ -217,7 +218,7 @@ fem::SteadyState integrate(const PaperCantilever& c, const std::vector<joints::J
   o.output_periods = periods;
   const std::vector<int> outputs{c.eq(7)};
   const fem::SteadyState s = fem::steady_state(c.system, C, &forces, {c.eq(7), F0, f}, outputs, o);
-  EXPECT_EQ(s.status, fem::SteadyStateStatus::converged);
+  EXPECT_TRUE(s.status.ok());
   return s;
 }
 
@@ -240,7 +241,7 @@ TEST(HarmonicBalance, EvenTermAgreesWithTimeIntegration) {
   const std::vector<int> outputs{c.eq(7)};
   const frf::HarmonicBalanceResult hb =
       frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), F0, f, outputs);
-  ASSERT_TRUE(hb.converged);
+  ASSERT_TRUE(hb.status.ok());
   ASSERT_GT(std::abs(hb.X(0, 0)), 0.01 * std::abs(hb.X(1, 0))); // the even term matters
   ASSERT_GT(std::abs(hb.X(2, 0)), 0.01 * std::abs(hb.X(1, 0)));
   // The mean is a static deflection against the joint: the joint pulls towards −y (k2 > 0).
@@ -301,7 +302,7 @@ TEST(HarmonicBalance, ExactFrictionConvergesTowardsTimeIntegration) {
       o.harmonics = i == 0 ? 15 : 31;
       const frf::HarmonicBalanceResult hb =
           frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), t.F0, t.f, outputs, o);
-      ASSERT_TRUE(hb.converged) << "K = " << o.harmonics;
+      ASSERT_TRUE(hb.status.ok()) << "K = " << o.harmonics;
       error[i] = std::abs(hb.X(1, 0) - T1) / std::abs(T1);
       // The joint force obeys the friction law: |G − k Y − c Ẏ| ≤ fc in the time domain, so
       // each harmonic of the friction part is at most 2 fc... its fundamental at most 4 fc/π
@@ -322,7 +323,7 @@ TEST(HarmonicBalance, ExactFrictionConvergesTowardsTimeIntegration) {
     o.exact_friction = false;
     const frf::HarmonicBalanceResult hb =
         frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), t.F0, t.f, outputs, o);
-    ASSERT_TRUE(hb.converged);
+    ASSERT_TRUE(hb.status.ok());
     EXPECT_LT(std::abs(hb.X(1, 0) - T1) / std::abs(T1), t.bound_tanh);
   }
 }
@@ -365,8 +366,8 @@ TEST(HarmonicBalance, HalfWaveSymmetricSolveEqualsTheFullOne) {
         frf::harmonic_balance(c.H, t.joints, c.system.dofs, c.eq(7), t.F0, t.f, outputs, half);
     const frf::HarmonicBalanceResult b =
         frf::harmonic_balance(c.H, t.joints, c.system.dofs, c.eq(7), t.F0, t.f, outputs, full);
-    ASSERT_TRUE(a.converged) << a.reason;
-    ASSERT_TRUE(b.converged) << b.reason;
+    ASSERT_TRUE(a.status.ok()) << a.status.reason;
+    ASSERT_TRUE(b.status.ok()) << b.status.reason;
     EXPECT_EQ(a.iterations, b.iterations);
     ASSERT_EQ(a.X.rows(), 12);
     const double scale = std::abs(b.X(1, 0));
@@ -390,7 +391,7 @@ TEST(HarmonicBalance, HalfWaveSymmetricSolveEqualsTheFullOne) {
   Eigen::MatrixXcd F = frf::sine_force(80.0);
   F(0, 0) = 30.0;
   const frf::HarmonicBalanceResult m = problem.solve(cubic, F);
-  ASSERT_TRUE(m.converged) << m.reason;
+  ASSERT_TRUE(m.status.ok()) << m.status.reason;
   EXPECT_GT(m.X(0, 0).real(), 0.0);
   EXPECT_GT(std::abs(m.X(2, 0)), 1e-3 * std::abs(m.X(1, 0)));
   EXPECT_GT(std::abs(m.G(2, 0)), 1e-3 * std::abs(m.G(1, 0)));
@@ -420,8 +421,8 @@ TEST(HarmonicBalance, ProblemIsReusableForManyValuesAndLevels) {
         const frf::HarmonicBalanceResult a = problem.solve(joint(k3, fc), frf::sine_force(F0));
         const frf::HarmonicBalanceResult b =
             frf::harmonic_balance(c.H, joint(k3, fc), c.system.dofs, c.eq(7), F0, f, outputs, o);
-        ASSERT_TRUE(a.converged);
-        ASSERT_TRUE(b.converged);
+        ASSERT_TRUE(a.status.ok());
+        ASSERT_TRUE(b.status.ok());
         const double scale = std::abs(b.X(1, 0));
         EXPECT_LE((a.X - b.X).cwiseAbs().maxCoeff(), 1e-10 * scale);
         EXPECT_LE((a.Y - b.Y).cwiseAbs().maxCoeff(), 1e-10 * scale);
@@ -432,13 +433,13 @@ TEST(HarmonicBalance, ProblemIsReusableForManyValuesAndLevels) {
   const frf::HarmonicBalanceResult cold = problem.solve(joint(1.6e8, 3.0), frf::sine_force(80.0));
   const frf::HarmonicBalanceResult again =
       problem.solve(joint(1.6e8, 3.0), frf::sine_force(80.0), &cold.Y);
-  ASSERT_TRUE(again.converged);
+  ASSERT_TRUE(again.status.ok());
   EXPECT_LE(again.iterations, 2);
   EXPECT_LE((again.X - cold.X).cwiseAbs().maxCoeff(), 1e-9 * std::abs(cold.X(1, 0)));
   const frf::HarmonicBalanceResult low = problem.solve(joint(1.6e8, 3.0), frf::sine_force(60.0));
   const frf::HarmonicBalanceResult warm =
       problem.solve(joint(1.6e8, 3.0), frf::sine_force(80.0), &low.Y);
-  ASSERT_TRUE(warm.converged);
+  ASSERT_TRUE(warm.status.ok());
   EXPECT_LE((warm.X - cold.X).cwiseAbs().maxCoeff(), 1e-9 * std::abs(cold.X(1, 0)));
   const Eigen::MatrixXcd wrong_shape = Eigen::MatrixXcd::Zero(3, 1);
   EXPECT_THROW(problem.solve(joint(1.6e8, 3.0), frf::sine_force(80.0), &wrong_shape),
@@ -473,7 +474,7 @@ TEST(HarmonicBalance, RegularisedFrictionFollowsItsLaw) {
   o.friction_width = width;
   const frf::HarmonicBalanceResult hb =
       frf::harmonic_balance(c.H, js, c.system.dofs, c.eq(7), 80.0, f, outputs, o);
-  ASSERT_TRUE(hb.converged);
+  ASSERT_TRUE(hb.status.ok());
   const int N = 4096;
   Eigen::VectorXd t(N), g(N);
   for (int n = 0; n < N; ++n) {
@@ -556,7 +557,7 @@ TEST(HarmonicBalance, AnAsymmetricStartFindsTheSymmetryBreakingSteadyState) {
   const frf::HarmonicBalance problem(c.H, js, c.system.dofs, {c.eq(7)}, outputs, f, o);
   const frf::HarmonicBalance all(c.H, js, c.system.dofs, {c.eq(7)}, outputs, f, full);
   const frf::HarmonicBalanceResult sym = problem.solve(js, frf::sine_force(F0));
-  ASSERT_TRUE(sym.converged) << sym.reason;
+  ASSERT_TRUE(sym.status.ok()) << sym.status.reason;
   EXPECT_EQ(sym.X(0, 0), 0.0);
   EXPECT_EQ(sym.X(2, 0), 0.0);
   Eigen::MatrixXcd start = sym.Y;
@@ -564,8 +565,8 @@ TEST(HarmonicBalance, AnAsymmetricStartFindsTheSymmetryBreakingSteadyState) {
   start(2, 0) = 0.09 * std::abs(sym.Y(1, 0));
   const frf::HarmonicBalanceResult asym = problem.solve(js, frf::sine_force(F0), &start);
   const frf::HarmonicBalanceResult reference = all.solve(js, frf::sine_force(F0), &start);
-  ASSERT_TRUE(asym.converged) << asym.reason;
-  ASSERT_TRUE(reference.converged) << reference.reason;
+  ASSERT_TRUE(asym.status.ok()) << asym.status.reason;
+  ASSERT_TRUE(reference.status.ok()) << reference.status.reason;
   const double X1 = std::abs(asym.X(1, 0));
   EXPECT_GT(std::abs(asym.X(0, 0)), 0.01 * X1);
   EXPECT_GT(std::abs(asym.X(2, 0)), 0.05 * X1);

@@ -76,7 +76,7 @@ TEST(Receptance, AllModesEqualTheDirectSolve) {
     const frf::ModalSynthesis H(c.system, modes, d, c.dofs);
     for (double w : {0.0, 0.5 * modes.omega(0), 0.5 * (modes.omega(0) + modes.omega(1)),
                      modes.omega(1), 1.3 * modes.omega(4)}) {
-      const frf::CMatrix direct = frf::direct_receptance(c.system, C, w, c.dofs, c.dofs);
+      const frf::CMatrix direct = frf::direct_receptance(c.system, C, w, c.dofs, c.dofs).value;
       EXPECT_LE(relative_difference(H.receptance(w, c.dofs, c.dofs), direct), 1e-9)
           << "ω = " << w << ", damping kind " << static_cast<int>(d.kind);
     }
@@ -103,7 +103,7 @@ TEST(Receptance, AtManyFrequenciesWithRepeatedDofsEqualsTheDirectSolveEntryByEnt
   ASSERT_EQ(all.cols(), 4 * 4);
   for (std::size_t k = 0; k < omegas.size(); ++k) {
     const auto block = all.middleCols(static_cast<Eigen::Index>(4 * k), 4);
-    const frf::CMatrix direct = frf::direct_receptance(c.system, C, omegas[k], rows, cols);
+    const frf::CMatrix direct = frf::direct_receptance(c.system, C, omegas[k], rows, cols).value;
     EXPECT_LE(relative_difference(block, direct), 1e-9) << "ω = " << omegas[k];
     EXPECT_EQ((block - H.receptance(omegas[k], rows, cols)).cwiseAbs().maxCoeff(), 0.0);
     for (Eigen::Index i = 0; i < 5; ++i)
@@ -129,14 +129,14 @@ TEST(Receptance, ResidualFlexibilityCorrectsTruncation) {
   o.num_modes = 4;
   o.engine = fem::ModalEngine::sparse;
   const fem::Modes four = fem::modal_analysis(c.system, o);
-  ASSERT_EQ(four.status, fem::ModalStatus::success);
+  ASSERT_TRUE(four.status.ok());
   const frf::ModalSynthesis with(c.system, four, d, c.dofs);
   const frf::ModalSynthesis without(c.system, four, d, c.dofs, {.residual_flexibility = false});
   EXPECT_TRUE(with.has_residual());
   EXPECT_FALSE(without.has_residual());
   for (double w : {0.3 * four.omega(0), 0.5 * (four.omega(0) + four.omega(1)),
                    0.5 * (four.omega(1) + four.omega(2))}) {
-    const frf::CMatrix direct = frf::direct_receptance(c.system, C, w, c.dofs, c.dofs);
+    const frf::CMatrix direct = frf::direct_receptance(c.system, C, w, c.dofs, c.dofs).value;
     const double error_with = relative_difference(with.receptance(w, c.dofs, c.dofs), direct);
     const double error_without = relative_difference(without.receptance(w, c.dofs, c.dofs), direct);
     EXPECT_LT(error_with, error_without / 10) << "ω = " << w;
@@ -181,7 +181,7 @@ TEST(Receptance, IsReciprocal) {
   for (double w : {0.7 * modes.omega(0), 1.01 * modes.omega(2)}) {
     const frf::CMatrix modal = H.receptance(w, c.dofs, c.dofs);
     EXPECT_LE((modal - modal.transpose()).norm(), 1e-14 * modal.norm());
-    const frf::CMatrix direct = frf::direct_receptance(c.system, C, w, c.dofs, c.dofs);
+    const frf::CMatrix direct = frf::direct_receptance(c.system, C, w, c.dofs, c.dofs).value;
     EXPECT_LE((direct - direct.transpose()).norm(), 1e-9 * direct.norm());
     // Not Hermitian: a damped receptance has a genuine imaginary part.
     EXPECT_GT(modal.imag().norm(), 1e-3 * modal.norm());
@@ -229,7 +229,7 @@ TEST(Receptance, FreeStructureMatchesTheDirectSolveWithRigidModes) {
     EXPECT_FALSE(H.has_residual());
     const fem::SparseMatrix C = fem::damping_matrix(s, d);
     for (double w : {10.0, 0.5 * modes.omega(3), 1.5 * modes.omega(4)}) {
-      const frf::CMatrix direct = frf::direct_receptance(s, C, w, dofs, dofs);
+      const frf::CMatrix direct = frf::direct_receptance(s, C, w, dofs, dofs).value;
       const double tol = 1e-9 + 10 * std::pow(modes.omega(2) / w, 2);
       EXPECT_LE(relative_difference(H.receptance(w, dofs, dofs), direct), tol)
           << "ω = " << w << ", α = " << d.alpha;
@@ -245,25 +245,35 @@ TEST(Receptance, BadInputThrows) {
   const std::vector<int> other{c.dofs[2]};
   EXPECT_THROW(H.receptance(1.0, other, other), std::invalid_argument);
   EXPECT_THROW(frf::ModalSynthesis(c.system, modes, d, {999}), std::invalid_argument);
-  fem::Modes failed = modes;
-  failed.status = fem::ModalStatus::not_converging;
-  EXPECT_THROW(frf::ModalSynthesis(c.system, failed, d, c.dofs), std::invalid_argument);
-  // Undamped, at its natural frequency (1 rad/s), a 1 kg, 1 N/m oscillator has no receptance.
-  const fem::Assembled one = fem::assemble(test::oscillator(1.0, 1.0));
-  const std::vector<int> dof{0};
-  try {
-    frf::direct_receptance(one, fem::SparseMatrix(1, 1), 1.0, dof, dof);
-    FAIL() << "a singular dynamic stiffness accepted";
-  } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(), "direct receptance: K - w^2 M + i w C is singular at w = 1.000000 "
-                           "rad/s (0.159155 Hz): an undamped natural frequency, or a DOF with "
-                           "neither stiffness nor mass");
-  }
+  // Bad input throws even with modes that failed.
+  fem::Modes failed;
+  failed.status = fem::Status::failure(fem::Status::Code::numerical_issue, "a test's failure");
+  EXPECT_THROW(frf::ModalSynthesis(c.system, failed, d, {999}), std::invalid_argument);
 }
 
-TEST(Receptance, ModesThatDidNotConvergeAreRefused) {
+TEST(Receptance, ASingularDynamicStiffnessIsAStatus) {
+  // Undamped, at its natural frequency (1 rad/s), a 1 kg, 1 N/m oscillator has no receptance: a
+  // numerical outcome, not bad input.
+  const fem::Assembled one = fem::assemble(test::oscillator(1.0, 1.0));
+  const std::vector<int> dof{0};
+  const fem::Outcome<frf::CMatrix> at_resonance =
+      frf::direct_receptance(one, fem::SparseMatrix(1, 1), 1.0, dof, dof);
+  EXPECT_EQ(at_resonance.status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(at_resonance.status.reason,
+            "direct receptance: K - w^2 M + i w C is singular at w = 1.000000 rad/s (0.159155 "
+            "Hz): an undamped natural frequency, or a DOF with neither stiffness nor mass");
+  EXPECT_EQ(at_resonance.value.size(), 0);
+  // Beside it, 1 / (k − ω² m) = 1 / (1 − 0.25) m/N at 0.5 rad/s.
+  const fem::Outcome<frf::CMatrix> below =
+      frf::direct_receptance(one, fem::SparseMatrix(1, 1), 0.5, dof, dof);
+  ASSERT_TRUE(below.status.ok()) << below.status.reason;
+  EXPECT_NEAR(std::abs(below.value(0, 0) - 1.0 / 0.75), 0.0, 1e-14);
+}
+
+TEST(Receptance, ModesThatDidNotConvergeGiveASynthesisWithTheirStatus) {
   // The sparse engine allowed one Lanczos restart and a tolerance of 0: 10 modes of a
-  // 400-equation cantilever do not converge, which the status says; a synthesis refuses them.
+  // 400-equation cantilever do not converge, which the status says; the synthesis carries that
+  // status and refuses to be used.
   const fem::Damping d = modal(0.01);
   const Cantilever c(200, d);
   fem::ModalOptions o;
@@ -272,19 +282,21 @@ TEST(Receptance, ModesThatDidNotConvergeAreRefused) {
   o.max_iterations = 1;
   o.tolerance = 0.0;
   const fem::Modes modes = fem::modal_analysis(c.system, o);
-  ASSERT_EQ(modes.status, fem::ModalStatus::not_converging);
+  ASSERT_EQ(modes.status.code, fem::Status::Code::not_converging);
+  const frf::ModalSynthesis H(c.system, modes, d, c.dofs);
+  EXPECT_EQ(H.status().code, fem::Status::Code::not_converging);
+  const std::string reason = "the modal analysis failed: block shift-invert Lanczos did not "
+                             "converge to 10 modes in 1 restarts";
+  EXPECT_EQ(H.status().reason.rfind(reason, 0), 0u) << H.status().reason;
   try {
-    frf::ModalSynthesis(c.system, modes, d, c.dofs);
-    FAIL() << "modes that did not converge accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("modal synthesis: the modal analysis failed (block "
-                                          "shift-invert Lanczos did not converge to 10 modes in 1 "
-                                          "restarts",
-                                          0),
-              0u)
+    (void)H.receptance(1.0, c.dofs, c.dofs);
+    FAIL() << "a failed synthesis gave a receptance";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("check status() first): " + reason), std::string::npos)
         << e.what();
-    EXPECT_NE(std::string(e.what()).find("): no modes to synthesise from"), std::string::npos);
   }
+  EXPECT_THROW((void)H.shapes(c.dofs), std::logic_error);
+  EXPECT_THROW((void)H.natural_frequencies(), std::logic_error);
 }
 
 // A substructure given by its modes (frf::ModalModel): the paper cantilever's FE modes at two
@@ -351,7 +363,8 @@ TEST(ReceptanceOfAModalModel, AllModesEqualTheDirectSolve) {
   const std::vector<int> served{0, 1};
   for (double w : {0.0, two_pi * 1.0, p.modes.omega(0), two_pi * 10.0, p.modes.omega(1),
                    1.7 * p.modes.omega(5)}) {
-    const frf::CMatrix direct = frf::direct_receptance(p.system, C, w, p.equations, p.equations);
+    const frf::CMatrix direct =
+        frf::direct_receptance(p.system, C, w, p.equations, p.equations).value;
     EXPECT_LE(relative_difference(modal.receptance(w, served, served), direct), 1e-9)
         << "ω = " << w;
   }

@@ -3,6 +3,7 @@
 #include "frf/sweep.hpp"
 
 #include "support/beam_models.hpp"
+#include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
 
@@ -58,11 +59,11 @@ TEST(FrfSweep, CantileverEqualsTheDirectSolve) {
             slope = sub.dofs().equation({11, Dof::rz});
   const std::vector<double> freq{0.0, 2.0, 3.0, 18.0, 60.0};
   const frf::FrfSweep s = frf::frf_sweep(sub, tip, {mid, tip, slope}, freq);
-  const fem::SparseMatrix C = sub.damping_matrix();
+  const fem::SparseMatrix C = sub.damping_matrix().value;
   const std::vector<int> rows{mid, tip, slope}, cols{tip};
   for (std::size_t i = 0; i < freq.size(); ++i) {
     const frf::CMatrix direct =
-        frf::direct_receptance(*sub.system(), C, two_pi * freq[i], rows, cols);
+        frf::direct_receptance(*sub.system(), C, two_pi * freq[i], rows, cols).value;
     const Eigen::VectorXcd got = s.values.row(static_cast<Eigen::Index>(i)).transpose();
     EXPECT_LE((got - direct.col(0)).norm(), 1e-9 * direct.norm()) << freq[i] << " Hz";
   }
@@ -95,3 +96,11 @@ TEST(FrfSweep, BadArgumentsAreRefused) {
 }
 
 } // namespace
+
+TEST(FrfSweep, AModalAnalysisThatFailsIsTheSweepStatus) {
+  // tests/support/failing_substructure.hpp: its dense modal analysis fails.
+  const frf::FrfSweep s = frf::frf_sweep(test::failing_substructure(), 0, {1, 2}, {1.0, 2.0});
+  EXPECT_EQ(s.status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(s.status.reason, "the modal analysis failed: " + test::failing_modes_reason);
+  EXPECT_EQ(s.values.size(), 0);
+}

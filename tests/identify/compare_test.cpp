@@ -6,6 +6,7 @@
 #include "fem/excitation.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
 
@@ -138,4 +139,21 @@ TEST(Compare, BadBandOrSegmentIsRefused) {
   no_response.channels.resize(1);
   EXPECT_THROW(compare_spectra(cantilever(), {joint(4800.0)}, no_response, {}),
                std::invalid_argument);
+}
+
+TEST(Compare, APredictionThatFailsIsTheComparisonsStatus) {
+  // tests/support/failing_substructure.hpp: its dense modal analysis fails, so the
+  // prediction (modal route) cannot be made: the comparison's status, naming the record.
+  Record r;
+  r.source = "rig.csv";
+  const Eigen::VectorXd force = fem::band_limited_random({2.0, 40.0, 1.0, 3}, {16.0, 256.0});
+  const Eigen::Index n = force.size();
+  r.t = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) / 256.0);
+  r.channels.push_back({Quantity::force, {1, fem::Dof::ux}, force});
+  r.channels.push_back({Quantity::displacement, {2, fem::Dof::ux}, Eigen::VectorXd::Ones(n)});
+  const Comparison c = compare_spectra(test::failing_substructure(), {}, r, band_2_40());
+  EXPECT_EQ(c.status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(c.status.reason,
+            "rig.csv: time simulation: the modal analysis failed: " + test::failing_modes_reason);
+  EXPECT_TRUE(c.channels.empty());
 }

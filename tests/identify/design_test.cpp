@@ -5,6 +5,7 @@
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "support/cantilever.hpp"
+#include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
 
@@ -237,5 +238,21 @@ TEST(Design, TestsWhereFrictionSticksAreLeftOut) {
   for (const auto& c : identify::predict_candidates(sub, model_I(), tip, grid)) {
     EXPECT_TRUE(c.usable) << c.reason;
     EXPECT_LT(c.misfit, 0.01) << c.plan.frequency_hz << " Hz " << c.plan.amplitude << " N";
+  }
+}
+
+TEST(Design, AModalAnalysisThatFailsLeavesEveryCandidateOutWithTheReason) {
+  // tests/support/failing_substructure.hpp: its dense modal analysis fails, so no
+  // candidate can be predicted; each says why.
+  const frf::Substructure failing = test::failing_substructure();
+  joints::Joint j{"a", 2, 0, fem::Dof::ux, {Term::k}, {1.0}, {false}, {}};
+  const auto candidates =
+      identify::predict_candidates(failing, {j}, {3, fem::Dof::ux}, {{1.0, 1.0}, {2.0, 1.0}});
+  ASSERT_EQ(candidates.size(), 2u);
+  for (const auto& c : candidates) {
+    EXPECT_FALSE(c.usable);
+    EXPECT_NE(c.reason.find("the modal analysis failed: " + test::failing_modes_reason),
+              std::string::npos)
+        << c.reason;
   }
 }

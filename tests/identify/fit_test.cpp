@@ -8,6 +8,7 @@
 #include "frf/harmonic_balance.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
 
@@ -209,15 +210,15 @@ TEST_F(FitTest, InseparableTermsAreAClearError) {
   // A numerical outcome, not bad input: a status with its reason, and no value is returned as
   // if it were determined.
   const identify::FitResult r = identify::fit(H, system.dofs, js, tests);
-  EXPECT_EQ(r.status, identify::FitStatus::not_separable);
-  EXPECT_NE(r.reason.find("cannot be separated"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.status.code, fem::Status::Code::not_separable);
+  EXPECT_NE(r.status.reason.find("cannot be separated"), std::string::npos) << r.status.reason;
   EXPECT_GE(r.condition_number, 1e13);
   for (const auto& te : r.joints.at(0).terms) {
     EXPECT_TRUE(std::isnan(te.value));
     EXPECT_FALSE(te.determined);
   }
   ASSERT_FALSE(r.identifiability.empty());
-  EXPECT_EQ(r.identifiability[0], r.reason);
+  EXPECT_EQ(r.identifiability[0], r.status.reason);
   EXPECT_THROW(r.identified(js), std::invalid_argument);
 }
 
@@ -256,7 +257,7 @@ TEST_F(FitTest, IllConditionedAndUnderdeterminedFitsWarn) {
     return Eigen::VectorXcd((2.0 + 1e-9 * (f - 3.0)) * g);
   });
   const identify::FitResult r = identify::fit(H, system.dofs, js, near);
-  ASSERT_EQ(r.status, identify::FitStatus::ok) << r.reason;
+  ASSERT_TRUE(r.status.ok()) << r.status.reason;
   EXPECT_GT(r.condition_number, 1e8);
   EXPECT_LT(r.condition_number, 1e13);
   EXPECT_TRUE(has(r, "Q is ill-conditioned (condition number "))
@@ -271,7 +272,7 @@ TEST_F(FitTest, IllConditionedAndUnderdeterminedFitsWarn) {
     return Eigen::VectorXcd(std::complex<double>(0.5, 0.5) * g);
   });
   const identify::FitResult exact = identify::fit(H, system.dofs, js, one);
-  ASSERT_EQ(exact.status, identify::FitStatus::ok) << exact.reason;
+  ASSERT_TRUE(exact.status.ok()) << exact.status.reason;
   EXPECT_EQ(exact.equations, 2);
   EXPECT_TRUE(has(exact, "as many equations as unknowns: no uncertainty estimate"))
       << ::testing::PrintToString(exact.warnings);
@@ -611,4 +612,20 @@ TEST(Identifiability, DampingAndFrictionAtOneVelocityAmplitudeAreNotSeparated) {
   EXPECT_NE(all.find("fc of 'tip'"), std::string::npos) << all;
   EXPECT_NE(all.find("same velocity amplitude"), std::string::npos) << all;
   EXPECT_FALSE(r.joints[0].terms[1].determined && r.joints[0].terms[2].determined);
+}
+
+TEST(FitWithSubstructure, AModalAnalysisThatFailsIsTheFitsStatus) {
+  // tests/support/failing_substructure.hpp: its dense modal analysis fails, so there
+  // is no receptance to fit with: the status and its reason, no estimates.
+  const frf::Substructure failing = test::failing_substructure();
+  joints::Joint j{"a", 2, 0, fem::Dof::ux, {Term::k}, {1.0}, {false}, {}};
+  identify::Measurement m;
+  m.source = "test.csv";
+  m.frequency_hz = 1.0;
+  m.force_at = {{3, fem::Dof::ux}};
+  const identify::FitResult r = identify::fit(failing, {j}, {m});
+  EXPECT_EQ(r.status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(r.status.reason, "the modal analysis failed: " + test::failing_modes_reason);
+  EXPECT_TRUE(r.joints.empty());
+  EXPECT_THROW(r.identified({j}), std::invalid_argument);
 }

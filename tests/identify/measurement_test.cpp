@@ -367,11 +367,15 @@ TEST(Measure, ErrorsNameTheSource) {
   no_force.channels.erase(no_force.channels.begin());
   std::string e = error_of(no_force);
   EXPECT_NE(e.find("synthetic.csv"), std::string::npos) << e;
-  EXPECT_NE(e.find("no force channel"), std::string::npos) << e;
+  // Worded for every format a record comes from (no CSV "column" in a UFF58 record's message).
+  EXPECT_NE(e.find("no force channel among its channels (x@7:uy)"), std::string::npos) << e;
+  EXPECT_EQ(e.find("column"), std::string::npos) << e;
 
   e = error_of(make_record(256, 2, {}));
   EXPECT_NE(e.find("synthetic.csv"), std::string::npos) << e;
-  EXPECT_NE(e.find("no response channel"), std::string::npos) << e;
+  EXPECT_NE(e.find("no response channel among its channels (f@7:uy)"), std::string::npos) << e;
+  EXPECT_NE(e.find("e.g. x@7:uy"), std::string::npos) << e;
+  EXPECT_EQ(e.find("column"), std::string::npos) << e;
 
   // 16 samples a period: Nyquist at 8 f; harmonic 9 lies above it.
   e = error_of(make_record(16, 4, {Quantity::displacement}), {.harmonics = 9});

@@ -58,7 +58,7 @@ TEST(OutputError, ConvergesFromAWrongStartToTheTruth) {
   const Study s;
   const auto tests = s.noisy(1e-6, 1);
   identify::FitResult start = identify::fit(s.sub, s.truth, tests, equation_error);
-  ASSERT_EQ(start.status, identify::FitStatus::ok);
+  ASSERT_TRUE(start.status.ok());
   start.joints[0].terms[0].value *= 1.05;
   start.joints[0].terms[1].value *= 0.8;
   start.joints[0].terms[2].value *= 1.2;
@@ -125,6 +125,44 @@ TEST(OutputError, TablesWithoutNoiseAreRefused) {
     EXPECT_STREQ(e.what(), "table.csv:4: output error needs the record's noise (a stepped-sine "
                            "table's is unknown)");
   }
+}
+
+} // namespace
+} // namespace jointid
+
+namespace jointid {
+namespace {
+
+TEST(OutputError, AHarmonicBalanceThatFailsAtTheStartIsAStatusNamingTheTest) {
+  // One Newton iteration and one load step cannot solve the hardening cubic's harmonic balance
+  // at the equation-error estimate: a numerical outcome, the status not_converging naming the
+  // first test, with the harmonic balance's reason and no estimates.
+  const Study s;
+  const auto tests = s.noisy(1e-6, 1);
+  const identify::FitResult start = identify::fit(s.sub, s.truth, tests, equation_error);
+  ASSERT_TRUE(start.status.ok()) << start.status.reason;
+  identify::OutputErrorOptions o;
+  o.balance.max_iterations = 1;
+  o.balance.continuation_steps = 1;
+  const std::vector<int> equations{s.sub.dofs().equation({7, fem::Dof::uy})};
+  const frf::ModalSynthesis H = s.sub.synthesis(equations, 200.0);
+  const identify::FitResult r = identify::output_error(H, s.sub.dofs(), s.truth, tests, start, o);
+  EXPECT_EQ(r.status.code, fem::Status::Code::not_converging);
+  EXPECT_EQ(r.status.reason.rfind(tests[0].source +
+                                      ": output error: the harmonic balance does not converge at "
+                                      "the equation-error estimate: no convergence: relative "
+                                      "residual ",
+                                  0),
+            0u)
+      << r.status.reason;
+  EXPECT_TRUE(r.joints.empty());
+  // A start whose status is not ok is passed up as it is.
+  identify::FitResult failed;
+  failed.status = fem::Status::failure(fem::Status::Code::not_separable, "k and k3 together");
+  const identify::FitResult passed =
+      identify::output_error(H, s.sub.dofs(), s.truth, tests, failed, o);
+  EXPECT_EQ(passed.status.code, fem::Status::Code::not_separable);
+  EXPECT_EQ(passed.status.reason, "k and k3 together");
 }
 
 } // namespace

@@ -5,6 +5,7 @@
 #include "fem/excitation.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
 
@@ -198,4 +199,41 @@ TEST(RandomTests, ErrorsNameWhatIsWrong) {
   EXPECT_THROW(simulate_forced(cantilever(), {}, in, o), std::invalid_argument);
   in.sample_rate_hz = -1.0;
   EXPECT_THROW(simulate_forced(cantilever(), {}, in, {}), std::invalid_argument);
+}
+
+TEST(RandomTests, NumericalFailuresAreTheTestsStatusWithTheirReason) {
+  // A softening cubic (k3 < 0) under 300 N RMS faded in over 0.2 s: the tip runs away, the
+  // joint force overflows and its Newton iteration fails at a step (the command-line test's
+  // case, `jointid simulate` fading in over 5 % of the 4 s).
+  joints::Joint soft = model_one();
+  soft.values = {4800.0, 20.0, 0.0, -1.6e8};
+  const ForceInput hard =
+      generated_force({Excitation::random, 2.0, 10.0, 300.0, 1, 4.0, 128.0}, tip);
+  ForcedOptions faded;
+  faded.fade_in_s = 0.2;
+  const ForcedTest runaway = simulate_forced(cantilever(), {soft}, hard, faded);
+  EXPECT_EQ(runaway.status.code, fem::Status::Code::not_converging);
+  EXPECT_EQ(runaway.status.reason.rfind(
+                "time simulation: the joints' Newton iteration failed after t = ", 0),
+            0u)
+      << runaway.status.reason;
+  EXPECT_TRUE(runaway.record.channels.empty());
+  // A substructure whose modal analysis fails (tests/support/failing_substructure.hpp): the
+  // modal route needs its modes, the full route its modal damping matrix.
+  const frf::Substructure failing = test::failing_substructure();
+  ForceInput in;
+  in.at = {{1, fem::Dof::ux}};
+  in.sample_rate_hz = 64.0;
+  in.samples = Eigen::MatrixXd::Ones(16, 1);
+  const ForcedTest modal = simulate_forced(failing, {}, in, {});
+  EXPECT_EQ(modal.status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(modal.status.reason,
+            "time simulation: the modal analysis failed: " + test::failing_modes_reason);
+  ForcedOptions full;
+  full.route = TransientRoute::full;
+  const ForcedTest direct = simulate_forced(failing, {}, in, full);
+  EXPECT_EQ(direct.status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(direct.status.reason,
+            "time simulation: modal damping needs every mode, and the modal analysis failed: " +
+                test::failing_modes_reason);
 }

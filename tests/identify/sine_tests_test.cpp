@@ -4,6 +4,7 @@
 
 #include "fem/modal.hpp"
 #include "support/cantilever.hpp"
+#include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
 
@@ -234,7 +235,7 @@ TEST(SimulateSineTests, AccelerationIsTheDerivativeOfTheVelocity) {
   const frf::ModalSynthesis H = cantilever().synthesis(outputs, 100.0);
   const frf::HarmonicBalanceResult hb = frf::harmonic_balance(
       H, js, cantilever().dofs(), eq, plan.amplitude, plan.frequency_hz, outputs, o.balance);
-  ASSERT_TRUE(hb.converged);
+  ASSERT_TRUE(hb.status.ok());
   Eigen::VectorXd expected(r.t.size());
   for (Eigen::Index i = 0; i < r.t.size(); ++i) {
     expected(i) = 0.0;
@@ -419,30 +420,45 @@ TEST(SimulateSineTests, HarmonicBalanceWithoutASolutionSaysWhichTestAndWhy) {
   o.steps_per_period = 64;
   o.balance.max_iterations = 2;
   o.balance.continuation_steps = 2;
-  try {
-    simulate_sine_tests(cantilever(), js, tip, {{3.0, 80.0}}, o);
-    FAIL() << "an unconverged harmonic balance accepted";
-  } catch (const std::runtime_error& e) {
-    const std::string m = e.what();
-    EXPECT_EQ(m.rfind("harmonic balance at 3 Hz, 80 N: no periodic solution found (no "
-                      "convergence: relative residual ",
-                      0),
-              0u)
-        << m;
-    EXPECT_NE(m.find("); simulate this test by time integration"), std::string::npos) << m;
-  }
-  // design asks to skip such a test, with the reason, and keep the others.
-  o.skip_unconverged = true;
+  // A numerical outcome: that test's status, with the reason and no record; the others are
+  // simulated all the same.
   const auto tests = simulate_sine_tests(cantilever(), js, tip, {{3.0, 80.0}, {3.0, 1e-6}}, o);
   ASSERT_EQ(tests.size(), 2u);
-  ASSERT_EQ(tests[0].warnings.size(), 1u);
-  EXPECT_EQ(tests[0].warnings[0].rfind("sine_f3Hz_F80N.csv: no periodic solution found (no "
-                                       "convergence: relative residual ",
-                                       0),
+  EXPECT_EQ(tests[0].status.code, fem::Status::Code::not_converging);
+  const std::string& m = tests[0].status.reason;
+  EXPECT_EQ(m.rfind("harmonic balance at 3 Hz, 80 N: no periodic solution found (no "
+                    "convergence: relative residual ",
+                    0),
             0u)
-      << tests[0].warnings[0];
+      << m;
+  EXPECT_NE(m.find("); simulate this test by time integration"), std::string::npos) << m;
+  EXPECT_EQ(tests[0].record.source, "sine_f3Hz_F80N.csv");
+  EXPECT_TRUE(tests[0].record.channels.empty());
+  EXPECT_TRUE(tests[1].status.ok()) << tests[1].status.reason;
   EXPECT_TRUE(tests[1].warnings.empty()) << ::testing::PrintToString(tests[1].warnings);
   EXPECT_EQ(tests[1].record.t.size(), o.periods * o.steps_per_period);
+}
+
+TEST(SimulateSineTests, TimeIntegrationWhoseJointIterationFailsSaysWhichTestAndWhen) {
+  // A softening cubic (k3 < 0) driven hard: the tip runs away from rest, the joint force
+  // overflows and its Newton iteration fails in the first period. That test's status says so,
+  // naming the test, the period and the time; the gentle one beside it is simulated.
+  const std::vector<joints::Joint> soft{
+      make_joint({Term::k, Term::c, Term::k3}, {4800.0, 20.0, -1.6e8})};
+  SimulationOptions o;
+  o.periods = 2;
+  o.steps_per_period = 64;
+  const auto failed = simulate_sine_tests(cantilever(), soft, tip, {{3.0, 80.0}, {3.0, 1.0}}, o);
+  ASSERT_EQ(failed.size(), 2u);
+  EXPECT_EQ(failed[0].status.code, fem::Status::Code::not_converging);
+  EXPECT_EQ(failed[0].status.reason.rfind("time integration at 3 Hz, 80 N: the joints' Newton "
+                                          "iteration failed in period 1 (t = ",
+                                          0),
+            0u)
+      << failed[0].status.reason;
+  EXPECT_TRUE(failed[0].record.channels.empty());
+  EXPECT_TRUE(failed[1].status.ok()) << failed[1].status.reason;
+  EXPECT_FALSE(failed[1].record.channels.empty());
 }
 
 TEST(SimulateSineTests, ProgressCountsEveryTestOnceUpToOne) {
@@ -470,4 +486,30 @@ TEST(SimulateSineTests, TestNamesUseTheShortestExactNumbers) {
   EXPECT_EQ(sine_test_name({3.4, 80.0}), "sine_f3.4Hz_F80N.csv");
   EXPECT_EQ(sine_test_name({0.1 + 0.2, 12.5}), "sine_f0.30000000000000004Hz_F12.5N.csv");
   EXPECT_NE(sine_test_name({3.0, 80.0}), sine_test_name({3.0000000000000004, 80.0}));
+}
+
+TEST(SimulateSineTests, AModalAnalysisThatFailsIsEveryTestsStatus) {
+  // tests/support/failing_substructure.hpp: its dense modal analysis fails. Harmonic
+  // balance needs its synthesis, time integration its modal damping matrix: every test has
+  // that status, naming the test, and no record.
+  const frf::Substructure failing = test::failing_substructure();
+  joints::Joint j{"a", 2, 0, fem::Dof::ux, {Term::k3}, {1e6}, {true}, {}};
+  SimulationOptions o;
+  o.method = SimulationMethod::harmonic_balance;
+  o.steps_per_period = 64;
+  const auto hb = simulate_sine_tests(failing, {j}, {3, fem::Dof::ux}, {{1.0, 1.0}, {2.0, 1.0}}, o);
+  ASSERT_EQ(hb.size(), 2u);
+  EXPECT_EQ(hb[1].status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(hb[1].status.reason, "harmonic balance at 2 Hz, 1 N: the modal analysis failed: " +
+                                     test::failing_modes_reason);
+  EXPECT_EQ(hb[1].record.source, "sine_f2Hz_F1N.csv");
+  EXPECT_TRUE(hb[1].record.channels.empty());
+  o.method = SimulationMethod::time_integration;
+  const auto ti = simulate_sine_tests(failing, {j}, {3, fem::Dof::ux}, {{1.0, 1.0}}, o);
+  ASSERT_EQ(ti.size(), 1u);
+  EXPECT_EQ(ti[0].status.code, fem::Status::Code::numerical_issue);
+  EXPECT_EQ(ti[0].status.reason, "time integration at 1 Hz, 1 N: modal damping needs every mode, "
+                                 "and the modal analysis failed: " +
+                                     test::failing_modes_reason);
+  EXPECT_TRUE(ti[0].record.channels.empty());
 }
