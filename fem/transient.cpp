@@ -60,6 +60,16 @@ public:
     inner_.evaluate(y, ydot, g, dg_dy, dg_dydot);
   }
   Eigen::VectorXd friction_limits() const override { return inner_.friction_limits(); }
+  int state_size() const override { return inner_.state_size(); }
+  void evaluate_from(std::span<const double> state, const Eigen::VectorXd& y,
+                     const Eigen::VectorXd& ydot, Eigen::VectorXd& g, Eigen::VectorXd& dg_dy,
+                     Eigen::VectorXd& dg_dydot) const override {
+    inner_.evaluate_from(state, y, ydot, g, dg_dy, dg_dydot);
+  }
+  void advance(std::span<double> state, const Eigen::VectorXd& y) const override {
+    inner_.advance(state, y);
+  }
+  bool piecewise_smooth() const override { return inner_.piecewise_smooth(); }
 
 private:
   const LocalForces& inner_;
