@@ -3,6 +3,7 @@
 #include "io/arguments.hpp"
 
 #include "frf/time_model.hpp"
+#include "identify/fit.hpp"
 #include "io/files.hpp"
 
 #include <fmt/format.h>
@@ -122,6 +123,20 @@ identify::TransientRoute parse_route(const std::string& text) {
 Model::Model(const fs::path& path, Engine engine)
     : file(io::read_model(path)), sub(file.substructure()) {
   use_engine(sub, engine);
+}
+
+void check_identifiable(const Model& model) {
+  const auto& joints = model.file.joints;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    try {
+      identify::check_identifiable({joints[i]});
+    } catch (const std::invalid_argument& e) {
+      const auto& lines = model.file.joint_lines;
+      const int line = i < lines.size() && lines.size() == joints.size() ? lines[i] : 0;
+      throw io::Error(line > 0 ? fmt::format("{}:{}: {}", model.name(), line, e.what())
+                               : fmt::format("{}: {}", model.name(), e.what()));
+    }
+  }
 }
 
 fem::NodeDof Model::dof(const std::string& option, const std::string& text) const {

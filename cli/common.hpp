@@ -74,6 +74,11 @@ struct Model {
   frf::Substructure sub;
 };
 
+/// identify (and its output error) and design identify the coefficients of the terms k … fc: a
+/// joint whose parametric term (jenkins, iwan, gap) is not fixed is refused, io::Error naming
+/// the model file, the joint's line and the term's parameters.
+void check_identifiable(const Model& model);
+
 /// Runs `compute()`; a std::invalid_argument from the library (the model's data or the
 /// options refused) becomes io::Error after the model file's name, its reason intact.
 template <class Compute>

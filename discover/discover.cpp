@@ -265,6 +265,12 @@ private:
 
 Result discover(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,
                 const std::vector<identify::Measurement>& tests, const Options& options) {
+  for (const joints::Term t : options.terms)
+    if (joints::has_parameters(t))
+      throw std::invalid_argument("discover: term '" + std::string(joints::term_name(t)) +
+                                  "' is not a candidate: the terms with named parameters (" +
+                                  "jenkins, iwan, gap) are simulated, and may be held fixed in "
+                                  "the model, but are not yet discovered");
   // A periodic broadband test would need a harmonic balance over every line of its period (or a
   // time integration per candidate): not supported, said with the test's name.
   for (const auto& m : tests)

@@ -64,8 +64,10 @@ struct Options {
   std::vector<int> harmonics{1, 2, 3};
   /// The re-simulations' harmonic balance.
   frf::HarmonicBalanceOptions balance{.harmonics = 15};
-  /// Terms tried at every joint (those a joint already has are skipped).
-  std::vector<joints::Term> terms{joints::all_terms.begin(), joints::all_terms.end()};
+  /// Terms tried at every joint (those a joint already has are skipped): the coefficient terms
+  /// k … fc; the parametric ones (jenkins, iwan, gap) are not candidates yet (refused).
+  std::vector<joints::Term> terms{joints::coefficient_terms.begin(),
+                                  joints::coefficient_terms.end()};
   /// Also try a scale factor on the substructure's modal damping (a linear model error).
   bool substructure_damping = true;
   int max_steps = 6;

@@ -77,6 +77,7 @@ void Newmark::factorise() {
   y_ = lambda_ = g_total_ = Eigen::VectorXd::Zero(nc);
   stuck_.assign(nc, 0);
   stuck_before_.assign(nc, 0);
+  history_.assign(forces_ ? static_cast<std::size_t>(forces_->state_size()) : 0, 0.0);
 }
 
 // The coordinates stuck after this step and the last one have ẏ = 0 over the step, so their
@@ -135,7 +136,8 @@ void Newmark::set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v,
     const SparseMatrix& B = forces_->coordinates();
     y_ = B.transpose() * u;
     Eigen::VectorXd g, gy, gv;
-    forces_->evaluate(y_, B.transpose() * v, g, gy, gv);
+    forces_->advance(history_, y_);
+    forces_->evaluate_from(history_, y_, B.transpose() * v, g, gy, gv);
     g_total_ = g;
     rhs -= B * g;
   }
@@ -197,9 +199,18 @@ bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& 
   Eigen::MatrixXd J(2 * nc, 2 * nc);
   Eigen::VectorXd R(2 * nc);
   const double scale = std::max({y_pred.cwiseAbs().maxCoeff(), y_.cwiseAbs().maxCoeff(), 1e-300});
+  // Forces with a history are piecewise smooth in y (a slider sticks or slides, a gap opens or
+  // closes): their steps are halved until the smooth residual decreases.
+  const bool damped = forces_->piecewise_smooth();
+  Eigen::VectorXd d, y_trial, g_trial, gy_trial, gv_trial;
+  double r_norm = 0.0;
+  if (damped) {
+    forces_->evaluate_from(history_, y, a1_ * y + e, g, gy, gv);
+    r_norm = (y - y_pred + W_ * (g + lambda)).norm();
+  }
   for (int it = 0; it < o_.max_newton; ++it) {
     const Eigen::VectorXd ydot = a1_ * y + e;
-    forces_->evaluate(y, ydot, g, gy, gv);
+    if (!damped) forces_->evaluate_from(history_, y, ydot, g, gy, gv);
     R.head(nc) = y - y_pred + W_ * (g + lambda);
     J.setZero();
     J.topLeftCorner(nc, nc) = Eigen::MatrixXd::Identity(nc, nc) + W_ * (gy + a1_ * gv).asDiagonal();
@@ -233,9 +244,27 @@ bool Newmark::solve_local(const Eigen::VectorXd& y_pred, const Eigen::VectorXd& 
       g_total_ = g + lambda;
       return true;
     }
-    const Eigen::VectorXd d = J.partialPivLu().solve(-R);
-    y += d.head(nc);
-    lambda += d.tail(nc);
+    d = J.partialPivLu().solve(-R);
+    if (!damped) {
+      y += d.head(nc);
+      lambda += d.tail(nc);
+      continue;
+    }
+    // Damped: the smooth rows' residual (friction rows are piecewise linear in λ, exact in one
+    // step) must decrease; the full step is taken when nothing decreases (a corner).
+    double t = 1.0;
+    bool decreased = false;
+    for (int halving = 0; halving < 30 && !decreased; ++halving) {
+      if (halving > 0) t *= 0.5;
+      y_trial = y + t * d.head(nc);
+      forces_->evaluate_from(history_, y_trial, a1_ * y_trial + e, g_trial, gy_trial, gv_trial);
+      decreased = (y_trial - y_pred + W_ * (g_trial + lambda + t * d.tail(nc))).norm() < r_norm;
+    }
+    if (!decreased) t = 1.0; // nothing decreases (a corner, or rounding): the full step
+    y += t * d.head(nc);
+    lambda += t * d.tail(nc);
+    forces_->evaluate_from(history_, y, a1_ * y + e, g, gy, gv);
+    r_norm = (y - y_pred + W_ * (g + lambda)).norm();
   }
   return false;
 }
@@ -275,6 +304,7 @@ Status Newmark::advance(const Eigen::VectorXd& f_next, const Eigen::VectorXd* z_
       status = Status::failure(Status::Code::not_converging,
                                "the joints' Newton iteration did not converge in " +
                                    std::to_string(o_.max_newton) + " iterations");
+    if (status.ok()) forces_->advance(history_, y_);
     u_next -= S_ * g_total_;
   }
   Eigen::VectorXd a_next = a0_ * (u_next - u_) - a2_ * v_ - a3_ * a_;

@@ -26,6 +26,13 @@
 /// stick–slip transition. A coordinate with static flexibility is not held as above: its
 /// friction force follows from the positions (the static part is a spring), and Bᵀü = 0 would
 /// be the wrong condition; one without (W_s's row zero) is held as in the finite element model.
+///
+/// Forces with a history (hysteresis: the positions of a joint's sliders) carry a state from
+/// step to step (LocalForces::state_size()): within a step the force is evaluated from the last
+/// step's state at the trial y (for sliders the return map, exact for a deformation linear over
+/// the step — no regularisation), and the state is advanced once the step has converged. Their
+/// Newton steps are damped (halved until the residual decreases): such forces are only
+/// piecewise smooth in y.
 #include "fem/assembly.hpp"
 #include "fem/status.hpp"
 
@@ -51,6 +58,21 @@ public:
                         Eigen::VectorXd& dg_dy, Eigen::VectorXd& dg_dydot) const = 0;
   /// Dry-friction force limits F_i >= 0 (0 where a coordinate has no dry friction).
   virtual Eigen::VectorXd friction_limits() const = 0;
+  /// History variables carried from step to step (e.g. slider positions), 0 for memoryless
+  /// forces. They start at 0.
+  virtual int state_size() const { return 0; }
+  /// The smooth part at (y, ẏ) reached from `state` (the end of the last step), without
+  /// changing it; by default evaluate().
+  virtual void evaluate_from(std::span<const double> /*state*/, const Eigen::VectorXd& y,
+                             const Eigen::VectorXd& ydot, Eigen::VectorXd& g,
+                             Eigen::VectorXd& dg_dy, Eigen::VectorXd& dg_dydot) const {
+    evaluate(y, ydot, g, dg_dy, dg_dydot);
+  }
+  /// Moves `state` to the end of a converged step at y.
+  virtual void advance(std::span<double> /*state*/, const Eigen::VectorXd& /*y*/) const {}
+  /// The smooth part is only piecewise smooth in y (sliders, a contact): Newton's steps are
+  /// damped.
+  virtual bool piecewise_smooth() const { return state_size() > 0; }
 };
 
 struct NewmarkOptions {
@@ -75,7 +97,8 @@ public:
   /// numerical_issue when the effective stiffness could not be factorised: then neither
   /// set_state() nor step() may be called.
   const Status& status() const { return status_; }
-  /// Sets u, u̇ and computes ü from the equation of motion with force f (friction taken as 0).
+  /// Sets u, u̇ and computes ü from the equation of motion with force f (friction taken as 0);
+  /// a history (sliders) is moved from its state to u, as if the joints were deformed to it.
   void set_state(const Eigen::VectorXd& u, const Eigen::VectorXd& v, const Eigen::VectorXd& f);
   /// The same with a static correction: z is the applied force's static deflection at the
   /// coordinates (n_c); y = Bᵀu + z − W_s g(y, Bᵀv) is solved for y (the static part at rest).
@@ -96,6 +119,8 @@ public:
   /// Local coordinates and their total force (g + λ) after the last step.
   const Eigen::VectorXd& y() const { return y_; }
   const Eigen::VectorXd& local_force() const { return g_total_; }
+  /// The local forces' history variables (LocalForces::state_size()) after the last step.
+  const std::vector<double>& history() const { return history_; }
   double h() const { return h_; }
 
 private:
@@ -119,6 +144,7 @@ private:
   Eigen::VectorXd friction_;
   Eigen::VectorXd u_, v_, a_, y_, lambda_, g_total_;
   std::vector<char> stuck_, stuck_before_; ///< per coordinate: sticking after this / last step
+  std::vector<double> history_;            ///< the local forces' state (sliders)
   Eigen::MatrixXd mass_b_;     ///< M⁻¹ B, computed at the first stick (empty: not yet)
   bool mass_singular_ = false; ///< M has no inverse (massless DOFs): no projection
   // Static correction (none unless the second constructor).

@@ -47,42 +47,38 @@ void check_outputs(std::span<const int> outputs, int n_eq) {
                                   " is not one of the model's " + std::to_string(n_eq));
 }
 
-// The forces expressed on the reduced coordinates: B_w = basisᵀ B.
-class ProjectedForces final : public LocalForces {
-public:
-  ProjectedForces(const LocalForces& inner, const Eigen::MatrixXd& basis) : inner_(inner) {
-    const Eigen::MatrixXd B = basis.transpose() * Eigen::MatrixXd(inner.coordinates());
-    B_ = B.sparseView(0.0, 0.0);
-  }
-  const SparseMatrix& coordinates() const override { return B_; }
-  void evaluate(const Eigen::VectorXd& y, const Eigen::VectorXd& ydot, Eigen::VectorXd& g,
-                Eigen::VectorXd& dg_dy, Eigen::VectorXd& dg_dydot) const override {
-    inner_.evaluate(y, ydot, g, dg_dy, dg_dydot);
-  }
-  Eigen::VectorXd friction_limits() const override { return inner_.friction_limits(); }
-
-private:
-  const LocalForces& inner_;
-  SparseMatrix B_;
-};
-
-// The forces expressed on the integrated coordinates of a TimeModel: B_w = Tᵀ B.
+// The same local forces (and their history, for hysteresis) acting through other
+// coordinates: B_w = Pᵀ B for the reduced basis or a TimeModel's T as P.
 class MappedForces final : public LocalForces {
 public:
-  MappedForces(const LocalForces& inner, const SparseMatrix& T) : inner_(inner) {
-    B_ = SparseMatrix(T.transpose()) * inner.coordinates();
-  }
+  MappedForces(const LocalForces& inner, SparseMatrix B) : inner_(inner), B_(std::move(B)) {}
   const SparseMatrix& coordinates() const override { return B_; }
   void evaluate(const Eigen::VectorXd& y, const Eigen::VectorXd& ydot, Eigen::VectorXd& g,
                 Eigen::VectorXd& dg_dy, Eigen::VectorXd& dg_dydot) const override {
     inner_.evaluate(y, ydot, g, dg_dy, dg_dydot);
   }
   Eigen::VectorXd friction_limits() const override { return inner_.friction_limits(); }
+  int state_size() const override { return inner_.state_size(); }
+  void evaluate_from(std::span<const double> state, const Eigen::VectorXd& y,
+                     const Eigen::VectorXd& ydot, Eigen::VectorXd& g, Eigen::VectorXd& dg_dy,
+                     Eigen::VectorXd& dg_dydot) const override {
+    inner_.evaluate_from(state, y, ydot, g, dg_dy, dg_dydot);
+  }
+  void advance(std::span<double> state, const Eigen::VectorXd& y) const override {
+    inner_.advance(state, y);
+  }
+  bool piecewise_smooth() const override { return inner_.piecewise_smooth(); }
 
 private:
   const LocalForces& inner_;
   SparseMatrix B_;
 };
+
+// The forces' coordinates on a reduced basis: basisᵀ B.
+SparseMatrix projected_coordinates(const LocalForces& forces, const Eigen::MatrixXd& basis) {
+  const Eigen::MatrixXd B = basis.transpose() * Eigen::MatrixXd(forces.coordinates());
+  return B.sparseView(0.0, 0.0);
+}
 
 // Newmark on a TimeModel's coordinates w with its static correction, and its outputs on x:
 // u = T w + s, v = T ẇ + ṡ, a = T ẅ + s̈ with s = R F at the outputs, its derivatives by
@@ -111,7 +107,7 @@ public:
     pick.setFromTriplets(ones.begin(), ones.end());
     T_out_ = pick * m.T;
     static_ = m.has_static_correction();
-    if (forces) mapped_.emplace(*forces, m.T);
+    if (forces) mapped_.emplace(*forces, SparseMatrix(m.T.transpose()) * forces->coordinates());
     if (static_) {
       R_out_ = pick * m.R;
       if (forces) {
@@ -421,8 +417,8 @@ TransientResponse transient_response(const ModalReduction& red, const LocalForce
   Eigen::MatrixXd at_outputs(outputs.size(), red.basis.cols());
   for (std::size_t j = 0; j < outputs.size(); ++j)
     at_outputs.row(static_cast<Eigen::Index>(j)) = red.basis.row(outputs[j]);
-  std::optional<ProjectedForces> projected;
-  if (forces) projected.emplace(*forces, red.basis);
+  std::optional<MappedForces> projected;
+  if (forces) projected.emplace(*forces, projected_coordinates(*forces, red.basis));
   auto load = [&](const Eigen::VectorXd& f) { return Eigen::VectorXd(to_w * f); };
   auto record = [&](const Newmark& m, TransientResponse& r, Eigen::Index i) {
     r.u.row(i) = (at_outputs * m.u()).transpose();

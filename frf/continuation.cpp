@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -102,6 +103,128 @@ Eigen::VectorXd solve_bordered(const Eigen::MatrixXd& A, const Eigen::VectorXd& 
   return cod.solve(b);
 }
 
+// The Floquet multipliers with hysteretic joints (sliders). A slider that sticks from the
+// instant t_a of its last slide on has the force k (y − y(t_a) ± φ): its perturbation is
+// k (δy(t) − δy(t_a)), and 0 while it slides (±f). So the joint's hysteretic force perturbation
+// at t is K_st(t) δy(t) − Σ_a K_a(t) s_a, K_st the stiffness of the elements stuck at t, K_a
+// that of those stuck since anchor a, and s_a = δy(t_a) a state of the variational equations
+// (ṡ_a = 0, reset to δy at t_a). This is the exact linearisation of the sliders (the memory of
+// the stick phase kept), not the tangent stiffness alone, which would forget where the stick
+// phase began. The loop is taken on the step grid (t_n = n h, two passes from rest, as the
+// harmonic balance does on its samples): the stuck set and anchors of a step are those of its
+// end, an O(h) error at the few steps where a slider switches. With the flexibility R of the
+// modes left out in series: δy = (I + R G_y')⁻¹ (P δq − R G_ẏ P δq̇ − R h0),
+// δg = G_y' δy + G_ẏ P δq̇ + h0, G_y' = G_y + K_st, h0 = −Σ_a K_a s_a.
+template <class Sample>
+Eigen::VectorXcd hysteretic_monodromy(const std::vector<joints::Joint>& joints,
+                                      const std::vector<joints::Sliders>& sliders,
+                                      const HarmonicBalanceResult& r, const Eigen::VectorXd& om,
+                                      const Eigen::VectorXd& d, const Eigen::MatrixXd& P,
+                                      const Eigen::MatrixXd& R, long steps, Sample& sample,
+                                      Eigen::VectorXd& gy, Eigen::VectorXd& gv) {
+  const int nj = static_cast<int>(joints.size()), n = static_cast<int>(om.size());
+  const int K = static_cast<int>(r.Y.rows()) - 1;
+  const double omega = two_pi * r.frequency_hz, h = two_pi / omega / static_cast<double>(steps);
+  const auto N = static_cast<std::size_t>(steps);
+  // Per hysteretic joint: the stuck stiffness per sample, and the anchors' weights (−K_a) in
+  // rows by sample (start[i] … start[i + 1]), each naming its state (slot).
+  struct Loop {
+    std::vector<double> stuck;
+    std::vector<std::size_t> start;
+    std::vector<std::pair<int, double>> weights;     // (state index, −K_a)
+    std::vector<std::pair<std::size_t, int>> resets; // (sample, state index), sorted by sample
+  };
+  std::vector<Loop> loops(static_cast<std::size_t>(nj));
+  int states = 0;
+  for (int j = 0; j < nj; ++j) {
+    const joints::Sliders& sl = sliders[static_cast<std::size_t>(j)];
+    if (sl.empty()) continue;
+    std::vector<double> y(N), g(N);
+    for (std::size_t i = 0; i < N; ++i) {
+      const double t = h * static_cast<double>(i);
+      double v = r.Y(0, j).real();
+      for (int k = 1; k <= K; ++k)
+        v += (r.Y(k, j) * std::polar(1.0, k * omega * t)).real();
+      y[i] = v;
+    }
+    std::vector<joints::LoopEntry> entries;
+    joints::LoopWork work;
+    joints::steady_loop(sl, y, false, g, &entries, work);
+    std::sort(entries.begin(), entries.end(),
+              [](const joints::LoopEntry& a, const joints::LoopEntry& b) { return a.n < b.n; });
+    Loop& L = loops[static_cast<std::size_t>(j)];
+    L.stuck.assign(N, 0.0);
+    L.start.assign(N + 1, 0);
+    std::map<int, int> slot; // anchor sample → state index
+    for (const joints::LoopEntry& e : entries) {
+      if (e.m == e.n) {
+        L.stuck[static_cast<std::size_t>(e.n)] += e.value;
+        continue;
+      }
+      auto [it, added] = slot.emplace(e.m, states);
+      if (added) ++states;
+      L.weights.emplace_back(it->second, e.value);
+      ++L.start[static_cast<std::size_t>(e.n) + 1];
+    }
+    for (std::size_t i = 0; i < N; ++i)
+      L.start[i + 1] += L.start[i];
+    for (const auto& [sample, state] : slot)
+      L.resets.emplace_back(static_cast<std::size_t>(sample), state);
+  }
+  const int dim = 2 * n + states;
+  // The joints' force perturbation δg (nj × columns) at time t, grid sample i, for states X.
+  Eigen::VectorXd gyt(nj);
+  Eigen::MatrixXd H0(nj, dim), dy(nj, dim), dg(nj, dim);
+  auto perturbation = [&](double t, std::size_t i, const Eigen::MatrixXd& X, bool want_force) {
+    sample(t);
+    gyt = gy;
+    H0.setZero();
+    for (int j = 0; j < nj; ++j) {
+      const Loop& L = loops[static_cast<std::size_t>(j)];
+      if (L.stuck.empty()) continue;
+      gyt(j) += L.stuck[i];
+      for (std::size_t e = L.start[i]; e < L.start[i + 1]; ++e)
+        H0.row(j) += L.weights[e].second * X.row(2 * n + L.weights[e].first);
+    }
+    const Eigen::MatrixXd Pv = P * X.middleRows(n, n);
+    const Eigen::MatrixXd A =
+        Eigen::MatrixXd::Identity(nj, nj) + R * gyt.asDiagonal(); // I + R G_y'
+    dy = A.partialPivLu().solve(P * X.topRows(n) - R * (gv.asDiagonal() * Pv) - R * H0);
+    if (want_force) dg = gyt.asDiagonal() * dy + gv.asDiagonal() * Pv + H0;
+  };
+  auto rate = [&](double t, std::size_t i, const Eigen::MatrixXd& X) {
+    perturbation(t, i, X, true);
+    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(dim, dim);
+    const auto q = X.topRows(n), v = X.middleRows(n, n);
+    Y.topRows(n) = v;
+    Y.middleRows(n, n) =
+        -(om.array().square().matrix().asDiagonal() * q) - d.asDiagonal() * v - P.transpose() * dg;
+    return Y;
+  };
+  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(dim, dim);
+  for (long s = 0; s < steps; ++s) {
+    const double t = static_cast<double>(s) * h;
+    const auto i0 = static_cast<std::size_t>(s), i1 = static_cast<std::size_t>(s + 1) % N;
+    const Eigen::MatrixXd k1 = rate(t, i0, W);
+    const Eigen::MatrixXd k2 = rate(t + 0.5 * h, i1, W + 0.5 * h * k1);
+    const Eigen::MatrixXd k3 = rate(t + 0.5 * h, i1, W + 0.5 * h * k2);
+    const Eigen::MatrixXd k4 = rate(t + h, i1, W + h * k3);
+    W += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    // the anchors at the step's end take δy there
+    bool any = false;
+    for (const Loop& L : loops)
+      for (const auto& reset : L.resets)
+        any = any || reset.first == i1;
+    if (!any) continue;
+    perturbation(t + h, i1, W, false);
+    for (int j = 0; j < nj; ++j)
+      for (const auto& [sample, state] : loops[static_cast<std::size_t>(j)].resets)
+        if (sample == i1) W.row(2 * n + state) = dy.row(j);
+  }
+  if (!W.allFinite()) return Eigen::VectorXcd::Constant(1, std::nan(""));
+  return Eigen::EigenSolver<Eigen::MatrixXd>(W, false).eigenvalues();
+}
+
 } // namespace
 
 Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
@@ -191,6 +314,18 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
     gy_max = std::max(gy_max, gy.cwiseAbs().maxCoeff());
     gv_max = std::max(gv_max, gv.cwiseAbs().maxCoeff());
   }
+  // Hysteretic joints: their elements, and the largest stiffness they add (all stuck).
+  std::vector<joints::Sliders> sliders(static_cast<std::size_t>(nj));
+  bool hysteretic = false;
+  double slider_stiffness = 0.0;
+  for (int j = 0; j < nj; ++j)
+    if (joints[j].has_hysteretic_terms()) {
+      sliders[static_cast<std::size_t>(j)] = joints::JointLaw(joints[j]).sliders();
+      slider_stiffness =
+          std::max(slider_stiffness, sliders[static_cast<std::size_t>(j)].stiffness_sum());
+      hysteretic = true;
+    }
+  gy_max += slider_stiffness;
   const double p2 = P.squaredNorm();
   const double w_est = std::max(
       {std::sqrt(om.array().square().maxCoeff() + gy_max * p2), d.maxCoeff() + gv_max * p2, omega});
@@ -201,6 +336,16 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
     return out;
   }
   const double h = T / static_cast<double>(steps);
+  if (hysteretic) {
+    out.multipliers = hysteretic_monodromy(joints, sliders, r, om, d, P, R, steps, sample, gy, gv);
+    if (!out.multipliers.allFinite()) {
+      out.note = "not determined: the check diverged";
+      out.multipliers.resize(0);
+      return out;
+    }
+    out.stable = out.multipliers.cwiseAbs().maxCoeff() < 1.0 + 1e-6;
+    return out;
+  }
   // W = [δq; δq̇] for the 2n unit initial conditions; Ẇ = A(t) W.
   Eigen::MatrixXd W = Eigen::MatrixXd::Identity(2 * n, 2 * n);
   auto rate = [&](double t, const Eigen::MatrixXd& X) {

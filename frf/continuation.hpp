@@ -26,7 +26,16 @@
 /// over one period by the classical Runge–Kutta method (h ω_est ≤ 0.5). Stable when every
 /// |μ| < 1 + 1e-6. On the tests' cantilever |μ|max at a fold is 1 to 6e-5 (1 − 2e-2 without R).
 /// With exact dry friction the force is set-valued and has no derivative while a joint sticks:
-/// stability is then not determined (reported as such, never guessed).
+/// stability is then not determined (reported as such, never guessed). A gap's force is
+/// continuous and piecewise linear: its slope (kg in contact, 0 open) is G_y. Hysteretic joints
+/// (jenkins, iwan) are linearised exactly, memory included: an element stuck since its last
+/// slide at t_a has the force perturbation k (δy(t) − δy(t_a)) (0 while it slides), so each
+/// anchor t_a of the loop adds a state s_a = δy(t_a) to the variational equations (reset at
+/// t_a, constant between) — the stuck elements' tangent stiffness alone would forget where the
+/// stick phase began and miss the loop's damping (on a Jenkins oscillator it gives |μ| of the
+/// undamped joint, 0.92, where the time integrator's perturbations decay by 0.42 a period). The
+/// loop is taken on the check's time steps, from rest over two periods (as the harmonic balance
+/// does on its samples).
 #include "frf/harmonic_balance.hpp"
 #include "frf/substructure.hpp"
 

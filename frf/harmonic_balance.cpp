@@ -282,10 +282,18 @@ HarmonicBalance::equations(const std::vector<joints::Joint>& joints, const Eigen
     const double c = std::max(std::abs(Hyy_[1](j, j)), 1e-300);
     friction.push_back({j, limit, 1.0 / (omega_ * c), c});
   }
-  return std::make_unique<Equations>(Equations{
+  // The parametric terms: their parameters checked (a joint without one in range cannot be
+  // simulated), the hysteretic ones' elements built once (an iwan's quadrature).
+  std::vector<joints::Sliders> sliders(static_cast<std::size_t>(nj_));
+  for (int j = 0; j < nj_; ++j)
+    if (joints[j].has_parametric_terms())
+      sliders[static_cast<std::size_t>(j)] = joints::JointLaw(joints[j]).sliders();
+  auto P = std::make_unique<Equations>(Equations{
       K_, nj_, static_cast<int>(tables.dy.rows()), tables.harmonics, Hyy_, std::move(HyF_F),
       std::move(Fk), joints, exact ? 0.0 : options_.friction_width, std::move(friction), tables.dy,
       tables.dv_unit, tables.dyv_unit, tables.forward_t, tables.trig, omega_});
+  P->sliders = std::move(sliders);
+  return P;
 }
 
 namespace {
@@ -313,6 +321,14 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
         Complex lin = 0.0;
         for (std::size_t t = 0; t < joints[j].terms.size(); ++t) {
           const joints::TermInfo& info = joints::term_info(joints[j].terms[t]);
+          if (info.parameters.size() > 0) { // the stiffness at small amplitude
+            const joints::Term term = joints[j].terms[t];
+            if (term == joints::Term::jenkins || term == joints::Term::iwan)
+              lin += joints[j].parameter(t, "kt");
+            else if (term == joints::Term::gap && joints[j].parameter(t, "delta") == 0.0)
+              lin += joints[j].parameter(t, "kg");
+            continue;
+          }
           if (info.degree != 1) continue;
           lin += info.nature == joints::Nature::conservative
                      ? Complex(joints[j].values[t])
@@ -461,7 +477,8 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
                      t1.dyv_unit,
                      t1.forward_t,
                      t1.trig,
-                     omega_};
+                     omega_,
+                     P.sliders};
   Eigen::VectorXd z1 = start_from(P1, nullptr);
   // The linear response can be far off in amplitude (a stiffening joint near resonance: 9×)
   // and phase; Newton then creeps (by 2/3 a step for a cubic; by 1/2 with friction, 10 steps on

@@ -14,6 +14,16 @@
 /// semi-smooth Newton. With `exact_friction = false` friction is regularised instead:
 /// sign(ẏ) ≈ tanh(ẏ/width). Complex amplitudes are peak values with
 /// x(t) = Re Σ_k X_k e^{ikωt}; units SI.
+///
+/// The parametric terms (joints/basis.hpp): a gap is a piecewise-linear force of y, sampled as
+/// the others. A hysteretic term (jenkins, iwan: elements in parallel, joints/hysteresis.hpp)
+/// gives the steady loop at the samples: its elements start at rest at zero deformation and run
+/// over the period (over both halves, the second −y of the first, when half-wave symmetric)
+/// until their state at the period's end repeats; the Jacobian is the loop's exact derivative
+/// (an element stuck at sample n since its last slide at sample m gives k at (n, n) and −k at
+/// (n, m)), so Newton converges as for a smooth force. An element that never slides keeps its
+/// rest position: where time integration from rest left it elsewhere (a slide during the
+/// transient only), the two steady states differ by a mean, not in their harmonics k ≥ 1.
 #include "fem/assert.hpp"
 #include "fem/status.hpp"
 #include "frf/receptance.hpp"

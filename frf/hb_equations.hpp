@@ -17,15 +17,21 @@ namespace jointid::frf::detail {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
 
-// A joint's smooth force g and its derivatives at one time (the stability check's). Coulomb
-// friction is left out when it is handled exactly (`width` = 0), else regularised as
-// fc·tanh(ẏ/width), as in add_joint_forces() below.
+// A joint's smooth force g and its derivatives at one time (the stability check's), but for
+// its hysteretic terms (sliders: they need a history). Coulomb friction is left out when it is
+// handled exactly (`width` = 0), else regularised as fc·tanh(ẏ/width), as in add_joint_forces()
+// below.
 inline void joint_force(const joints::Joint& j, double y, double v, double width, double& g,
                         double& gy, double& gv) {
   g = gy = gv = 0.0;
   for (std::size_t t = 0; t < j.terms.size(); ++t) {
     const double b = j.values[t];
-    if (joints::is_dry_friction(j.terms[t])) {
+    if (joints::has_parameters(j.terms[t])) {
+      if (j.terms[t] != joints::Term::gap) continue;
+      double slope;
+      g += joints::gap_force(j.parameter(t, "delta"), j.parameter(t, "kg"), y, &slope);
+      gy += slope;
+    } else if (joints::is_dry_friction(j.terms[t])) {
       if (width == 0.0) continue;
       const double th = std::tanh(v / width);
       g += b * th;
@@ -38,8 +44,9 @@ inline void joint_force(const joints::Joint& j, double y, double v, double width
   }
 }
 
-// A joint's smooth force g and its derivatives at the n time samples y, ẏ, added to the
-// columns of g (n × 3: g, ∂g/∂y, ∂g/∂ẏ). Coulomb friction is left out when it is handled
+// A joint's memoryless force g and its derivatives at the n time samples y, ẏ, added to the
+// columns of g (n × 3: g, ∂g/∂y, ∂g/∂ẏ): its coefficient terms and gaps; the hysteretic terms
+// are the equations' (Equations::sliders). Coulomb friction is left out when it is handled
 // exactly (`width` = 0), else regularised as fc·tanh(ẏ/width).
 inline void add_joint_forces(const joints::Joint& j, const double* y, const double* v, int n,
                              double width, Eigen::Map<Eigen::MatrixXd>& g) {
@@ -49,6 +56,16 @@ inline void add_joint_forces(const joints::Joint& j, const double* y, const doub
       gvs(g.col(2).data(), size);
   for (std::size_t t = 0; t < j.terms.size(); ++t) {
     const double b = j.values[t];
+    if (joints::has_parameters(j.terms[t])) {
+      if (j.terms[t] != joints::Term::gap) continue;
+      const double delta = j.parameter(t, "delta"), kg = j.parameter(t, "kg");
+      for (std::size_t i = 0; i < size; ++i) {
+        double slope;
+        gs[i] += joints::gap_force(delta, kg, ys[i], &slope);
+        gys[i] += slope;
+      }
+      continue;
+    }
     if (!joints::is_dry_friction(j.terms[t])) {
       joints::add_samples(j.terms[t], b, ys, vs, gs, gys, gvs);
       continue;
@@ -112,6 +129,12 @@ struct Equations {
   // harmonics make (s = 1, or 2 when symmetric): the harmonics of sample weights.
   const Eigen::MatrixXd& trig;
   double omega;
+  // Per joint, the elements of its hysteretic terms (jenkins, iwan), all in parallel; empty for
+  // a joint without. Their force at the samples is the steady loop (joints::steady_loop): the
+  // elements start at rest at zero deformation and run over the period (both halves when
+  // symmetric) until it closes; its exact derivative with respect to the samples is kept for
+  // jacobian().
+  std::vector<joints::Sliders> sliders{};
 
   bool symmetric() const { return harmonics.front() != 0; }
   int count() const { return static_cast<int>(harmonics.size()); }
@@ -140,6 +163,12 @@ struct Equations {
     Eigen::MatrixXcd G;      // (K+1) × nj: the joint forces' harmonics at `last`
     Vector last{nullptr, 0}; // the unknowns of the last residual(), if `has_last`
     bool has_last = false;
+    // The hysteretic forces: per joint, ∂g_n/∂y_m of its loop at the last residual(); the
+    // loop's work arrays, its force at the samples and (jacobian()) the derivative times dy.
+    std::vector<std::vector<joints::LoopEntry>> loop;
+    joints::LoopWork loop_work;
+    std::vector<double> loop_force;
+    Eigen::MatrixXd loop_dy;
 
     Scratch() = default;
     Scratch(const Scratch&) : Scratch() {}
@@ -177,6 +206,9 @@ struct Equations {
     new (&w.last) Scratch::Vector(take(size()), size());
     w.has_last = false;
     w.G.setZero(K + 1, nj);
+    w.loop.assign(static_cast<std::size_t>(nj), {});
+    w.loop_force.assign(static_cast<std::size_t>(n), 0.0);
+    w.loop_dy.setZero(n, M);
     return w;
   }
 
@@ -281,6 +313,14 @@ struct Equations {
     samples(z.data() + j * m(), s.yv.data());
     g.setZero();
     add_joint_forces(joints[j], s.yv.data(), s.yv.data() + Nt, Nt, width, g);
+    const auto u = static_cast<std::size_t>(j);
+    if (u < sliders.size() && !sliders[u].empty()) {
+      // (A loop that does not close within the passes keeps its last pass: it differs from the
+      // next one only by elements that slide once more, a case met with a drifting mean only.)
+      joints::steady_loop(sliders[u], {s.yv.data(), static_cast<std::size_t>(Nt)}, symmetric(),
+                          s.loop_force, &s.loop[u], s.loop_work);
+      g.col(0) += Eigen::Map<const Eigen::VectorXd>(s.loop_force.data(), Nt);
+    }
     multiply_transposed(forward_t, g.data(), harmonics_out);
   }
 
@@ -395,6 +435,14 @@ struct Equations {
       s.D.setZero();
       add_product(s.weights.col(0), false, s.D);
       add_product(s.weights.col(1), true, s.D);
+      const auto u = static_cast<std::size_t>(b);
+      if (u < sliders.size() && !sliders[u].empty()) {
+        // The loop's ∂g_n/∂y_m (a few entries a sample), through y_m = dy_m · z, then forward.
+        s.loop_dy.setZero();
+        for (const joints::LoopEntry& e : s.loop[u])
+          s.loop_dy.row(e.n) += e.value * dy.row(e.m);
+        s.D.noalias() += forward_t.transpose() * s.loop_dy;
+      }
       for (int a = 0; a < nj; ++a)
         add_coupling(J, a, b, b * m(), s.D);
     }

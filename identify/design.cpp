@@ -68,6 +68,7 @@ Eigen::MatrixXd total_information(const std::vector<CandidateTest>& candidates,
 } // namespace
 
 std::vector<DesignUnknown> design_unknowns(const std::vector<joints::Joint>& joints) {
+  check_identifiable(joints);
   std::vector<DesignUnknown> out;
   for (const auto& j : joints)
     for (std::size_t t = 0; t < j.terms.size(); ++t)

@@ -55,7 +55,68 @@ Eigen::MatrixXcd basis_lines(const joints::Joint& joint, const Eigen::VectorXd& 
   return period_harmonics(g, t0, omega, K);
 }
 
+// The force of parametric term t of joint j (parameters checked) at the samples y: a gap's
+// directly, a hysteretic term's steady loop over the samples taken as one period. Its
+// derivative ∂g/∂y at the samples (the stuck elements' stiffness for sliders) into `slope` if
+// given.
+template <class Out>
+void parametric_force(const joints::Joint& j, std::size_t t, const Eigen::VectorXd& y, Out&& g,
+                      Eigen::VectorXd* slope = nullptr) {
+  joints::check_parameters(j);
+  const Eigen::Index n = y.size();
+  if (slope) slope->setZero(n);
+  if (j.terms[t] == joints::Term::gap) {
+    const double delta = j.parameter(t, "delta"), kg = j.parameter(t, "kg");
+    for (Eigen::Index r = 0; r < n; ++r) {
+      double d;
+      g(r) = joints::gap_force(delta, kg, y(r), &d);
+      if (slope) (*slope)(r) = d;
+    }
+    return;
+  }
+  const joints::Sliders sliders =
+      j.terms[t] == joints::Term::jenkins
+          ? joints::jenkins_sliders(j.parameter(t, "kt"), j.parameter(t, "fs"))
+          : joints::iwan_sliders(j.parameter(t, "fs"), j.parameter(t, "kt"), j.parameter(t, "chi"),
+                                 j.parameter(t, "beta"), j.iwan_sliders);
+  std::vector<double> ys(y.data(), y.data() + n), gs(static_cast<std::size_t>(n));
+  std::vector<joints::LoopEntry> entries;
+  joints::LoopWork work;
+  joints::steady_loop(sliders, ys, false, gs, slope ? &entries : nullptr, work);
+  for (Eigen::Index r = 0; r < n; ++r)
+    g(r) = gs[static_cast<std::size_t>(r)];
+  if (slope)
+    for (const joints::LoopEntry& e : entries)
+      if (e.n == e.m) (*slope)(e.n) += e.value;
+}
+
 } // namespace
+
+void check_identifiable(const std::vector<joints::Joint>& joints) {
+  for (const joints::Joint& j : joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      if (!joints::has_parameters(j.terms[t]) || j.fixed[t]) continue;
+      const std::string name(joints::term_name(j.terms[t]));
+      throw std::invalid_argument(
+          "joint '" + j.name + "': the parameters of term '" + name + "' (" +
+          joints::parameter_names(j.terms[t]) +
+          ") enter its force non-linearly; they are identified by output error, which is "
+          "coming — to identify the joint's other terms with this one known, give all of its "
+          "parameters in 'values' and list \"" +
+          name + "\" in 'fixed'");
+    }
+}
+
+std::vector<ParameterEstimate> parameters_of(const joints::Joint& j, std::size_t t) {
+  std::vector<ParameterEstimate> out;
+  const auto list = j.parameters_of(t);
+  const auto& info = joints::term_info(j.terms[t]).parameters;
+  for (std::size_t p = 0; p < list.size() && p < info.size(); ++p) {
+    const double v = list[p].value;
+    out.push_back({std::string(info[p].name), v, 0.0, v, v, list[p].fixed, true});
+  }
+  return out;
+}
 
 TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
                       const std::vector<joints::Joint>& joints,
@@ -70,6 +131,7 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
                fem::to_string(m.response_at[i]);
     return names;
   };
+  check_identifiable(joints);
   TestSpectrum s;
   s.source = m.source;
   s.frequency_hz = m.frequency_hz;
@@ -132,12 +194,25 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
             " of the record; the Coulomb basis sign(ydot) does not describe the force while stuck");
     }
     if (periodic) {
+      for (const joints::Term t : j.terms)
+        if (joints::has_parameters(t))
+          throw std::invalid_argument(
+              m.source + ": joint '" + j.name + "' has the term '" +
+              std::string(joints::term_name(t)) +
+              "' (named parameters): periodic broadband tests are identified with the "
+              "coefficient terms only; give sine tests or stepped-sine tables");
       s.G.push_back(basis_lines(j, y, ydot, m.t(0), omega, K));
     } else {
       Eigen::MatrixXd g(n, static_cast<Eigen::Index>(j.terms.size()));
-      for (std::size_t term = 0; term < j.terms.size(); ++term)
+      for (std::size_t term = 0; term < j.terms.size(); ++term) {
+        const auto c = static_cast<Eigen::Index>(term);
+        if (joints::has_parameters(j.terms[term])) { // its force (fixed): the right-hand side's
+          parametric_force(j, term, y, g.col(c));
+          continue;
+        }
         for (Eigen::Index r = 0; r < n; ++r)
-          g(r, static_cast<Eigen::Index>(term)) = joints::basis(j.terms[term], y(r), ydot(r));
+          g(r, c) = joints::basis(j.terms[term], y(r), ydot(r));
+      }
       s.G.push_back(fit_harmonics(m.t, g, omega, K));
     }
     s.y.col(static_cast<Eigen::Index>(i)) = y;
@@ -306,9 +381,16 @@ Eigen::MatrixXd equation_covariance(const TestSpectrum& ts, const std::vector<Ro
           (std::isfinite(ts.v_variance[dd]) ? ts.v_variance[dd]
                                             : ts.x_variance[dd] * op.gain(1 - ts.x_power[dd], N));
     }
+    for (std::size_t t = 0; t < J.terms.size(); ++t)
+      if (joints::has_parameters(J.terms[t])) { // (fixed) its slope, stuck elements' for sliders
+        Eigen::VectorXd g(N), slope;
+        parametric_force(J, t, ts.y.col(j), g, &slope);
+        gy.col(j) += slope;
+      }
     for (Eigen::Index n = 0; n < N; ++n) {
       const double y = ts.y(n, j), v = ts.ydot(n, j);
       for (std::size_t t = 0; t < J.terms.size(); ++t) {
+        if (joints::has_parameters(J.terms[t])) continue;
         if (joints::is_dry_friction(J.terms[t])) {
           const double pflip =
               var_rate > 0.0 ? 0.5 * std::erfc(std::abs(v) / std::sqrt(2.0 * var_rate)) : 0.0;
@@ -675,6 +757,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
               const FitOptions& o, std::vector<std::string> warnings) {
   if (joints.empty()) throw std::invalid_argument("identify: the model has no joints");
   if (tests.empty()) throw std::invalid_argument("identify: no tests");
+  check_identifiable(joints);
   const std::vector<int> set2 = joint_dof_set(joints, dofs);
   // Unknowns: the non-fixed terms of every joint.
   struct Unknown {
@@ -788,6 +871,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
       for (std::size_t t = 0; t < joints[i].terms.size(); ++t) {
         TermEstimate te;
         te.term = joints[i].terms[t];
+        te.parameters = parameters_of(joints[i], t);
         te.fixed = joints[i].fixed[t];
         te.value = te.fixed ? joints[i].values[t] : nan;
         te.std = te.fixed ? 0.0 : nan;
@@ -884,6 +968,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     for (std::size_t t = 0; t < joints[i].terms.size(); ++t) {
       TermEstimate te;
       te.term = joints[i].terms[t];
+      te.parameters = parameters_of(joints[i], t);
       if (joints[i].fixed[t]) {
         te.value = joints[i].values[t];
         te.fixed = true;

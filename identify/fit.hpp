@@ -43,8 +43,24 @@ struct FitOptions {
   bool average_periods = true;
 };
 
+/// A named parameter of a parametric term as identified (or held).
+struct ParameterEstimate {
+  std::string name; ///< "fs"
+  /// NaN when the tests do not determine it (determined false): never a value then.
+  double value = 0.0;
+  double std = 0.0; ///< of the value; NaN when unknown
+  double ci_low = 0.0, ci_high = 0.0;
+  bool fixed = false;
+  /// False when the tests do not determine it apart from another parameter (FitResult::
+  /// identifiability says which combination they do determine) or its std is too large.
+  bool determined = true;
+};
+
 struct TermEstimate {
   joints::Term term = joints::Term::k;
+  /// A parametric term (jenkins, iwan, gap): its named parameters, in the table's order (empty
+  /// for a coefficient term; `value` is then its coefficient, 1).
+  std::vector<ParameterEstimate> parameters;
   double value = 0.0;
   double std = 0.0;    ///< standard deviation (FitResult::interval_method says how)
   double ci_low = 0.0; ///< 95 % confidence interval (Student's t)
@@ -129,9 +145,19 @@ struct TestSpectrum {
 /// The joints' DOFs (set 2), in the order used by TestSpectrum::X2.
 using joints::joint_dof_set;
 
+/// The equation-error route (and the output error, the design built on it) identifies the
+/// coefficients of the terms k … fc. A parametric term (jenkins, iwan, gap) enters its force
+/// non-linearly: it is used only with all of its parameters fixed (a known force). Throws
+/// std::invalid_argument naming the joint, the term and its parameters otherwise.
+void check_identifiable(const std::vector<joints::Joint>& joints);
+/// The parameters of term t of joint j for a TermEstimate (empty for a coefficient term).
+std::vector<ParameterEstimate> parameters_of(const joints::Joint& joint, std::size_t term);
+
 /// A measured test as the identification of these joints needs it: the forces on free DOFs of
 /// the model, the displacement at every joint DOF, and the harmonics of every joint term's
-/// basis function evaluated on the measured deformation y = x(node) − x(node_b). Throws
+/// basis function evaluated on the measured deformation y = x(node) − x(node_b) — for a
+/// parametric term its force with its (fixed) parameters, a hysteretic one's steady loop over
+/// the analysed span taken as one period (check_identifiable()). Throws
 /// std::invalid_argument naming the test and the missing or misplaced channel. Adds a warning
 /// when a dry-friction joint sticks in the record.
 TestSpectrum spectrum(const Measurement& measurement, const fem::DofMap& dofs,

@@ -1,6 +1,7 @@
 #include "identify/output_error.hpp"
 
 #include "identify/harmonics.hpp"
+#include "identify/parametric.hpp"
 #include "identify/statistics.hpp"
 #include "joints/basis.hpp"
 
@@ -8,6 +9,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -55,15 +57,31 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     throw std::invalid_argument("output error: the harmonic balance needs at least the " +
                                 std::to_string(K) + " harmonics compared");
   std::vector<joints::Joint> model = start.identified(joints);
+  for (const joints::Joint& j : model)
+    joints::check_parameters(j); // a parametric term's start: every parameter has a value
 
-  // The parameters: every non-fixed term, then Re and Im of each test's force fundamentals.
+  // The parameters: every non-fixed term (a parametric term's non-fixed parameters, each in
+  // its natural coordinate: identify/parametric.hpp), then Re and Im of each test's force
+  // fundamentals.
   struct Param {
     std::size_t joint, term;
+    int parameter = -1; // of a parametric term
   };
   std::vector<Param> params;
   for (std::size_t j = 0; j < model.size(); ++j)
-    for (std::size_t t = 0; t < model[j].terms.size(); ++t)
+    for (std::size_t t = 0; t < model[j].terms.size(); ++t) {
+      if (joints::has_parameters(model[j].terms[t])) {
+        const auto list = model[j].parameters_of(t);
+        for (std::size_t p = 0; p < list.size(); ++p)
+          if (!list[p].fixed) params.push_back({j, t, static_cast<int>(p)});
+        continue;
+      }
       if (!model[j].fixed[t]) params.push_back({j, t});
+    }
+  const auto info_of = [&](const Param& p) -> const joints::ParameterInfo& {
+    return joints::term_info(model[p.joint].terms[p.term])
+        .parameters[static_cast<std::size_t>(p.parameter)];
+  };
   const auto np = static_cast<Eigen::Index>(params.size());
 
   const std::vector<int> set2 = joint_dof_set(model, dofs);
@@ -164,6 +182,14 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
   std::vector<bool> dissipative(static_cast<std::size_t>(np));
   for (Eigen::Index q = 0; q < np; ++q) {
     const Param& p = params[static_cast<std::size_t>(q)];
+    if (p.parameter >= 0) {
+      theta(q) = parameter_to_u(
+          info_of(p),
+          model[p.joint].parameters[p.term][static_cast<std::size_t>(p.parameter)].value);
+      step(q) = 1e-6 * std::max(1.0, std::abs(theta(q)));
+      dissipative[static_cast<std::size_t>(q)] = false;
+      continue;
+    }
     theta(q) = model[p.joint].values[p.term];
     dissipative[static_cast<std::size_t>(q)] =
         joints::term_info(model[p.joint].terms[p.term]).nature == joints::Nature::dissipative;
@@ -188,9 +214,14 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
   }
   const auto joints_at = [&](const Eigen::VectorXd& th) {
     std::vector<joints::Joint> js = model;
-    for (Eigen::Index q = 0; q < np; ++q)
-      js[params[static_cast<std::size_t>(q)].joint]
-          .values[params[static_cast<std::size_t>(q)].term] = th(q);
+    for (Eigen::Index q = 0; q < np; ++q) {
+      const Param& p = params[static_cast<std::size_t>(q)];
+      if (p.parameter >= 0)
+        js[p.joint].parameters[p.term][static_cast<std::size_t>(p.parameter)].value =
+            parameter_from_u(info_of(p), th(q));
+      else
+        js[p.joint].values[p.term] = th(q);
+    }
     return js;
   };
   // The simulated outputs of test i at θ (nullopt when the harmonic balance fails; `failure`
@@ -359,16 +390,105 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
   }
   const double tq = dof > 0 ? student_t_quantile(0.975, static_cast<double>(dof)) : nan;
   const std::vector<joints::Joint> identified = joints_at(theta);
+  std::vector<std::string> poorly;
+  // An iwan that stayed in microslip in every test: its force there depends only on k + kt,
+  // chi and the slip density's scale R (joints/hysteresis.hpp), so kt apart from k and fs apart
+  // from beta are not determined: they are said so (no value), the combinations reported.
+  const auto combination = [&](const auto& f) { // value, std and 95 % interval of f(joints)
+    const double v = f(identified);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(n_theta);
+    for (Eigen::Index k = 0; k < np; ++k) {
+      Eigen::VectorXd tk = theta;
+      tk(k) += step(k);
+      g(k) = (f(joints_at(tk)) - v) / step(k);
+    }
+    const double sd = std::sqrt(std::max(g.dot(C * g), 0.0));
+    return std::array<double, 4>{v, sd, v - tq * sd, v + tq * sd};
+  };
+  const auto microslip = [&](std::size_t j, const joints::Joint& J, JointEstimate& je) {
+    const int t = J.term_index(joints::Term::iwan);
+    if (t < 0 || je.terms[static_cast<std::size_t>(t)].parameters.empty()) return;
+    auto& pars = je.terms[static_cast<std::size_t>(t)].parameters;
+    if (std::all_of(pars.begin(), pars.end(), [](const ParameterEstimate& p) { return p.fixed; }))
+      return;
+    const auto ti = static_cast<std::size_t>(t);
+    const auto density = [ti, j](const std::vector<joints::Joint>& js) {
+      return joints::iwan_density(js[j].parameter(ti, "fs"), js[j].parameter(ti, "kt"),
+                                  js[j].parameter(ti, "chi"), js[j].parameter(ti, "beta"));
+    };
+    const double phi_max = density(identified).phi_max;
+    double peak = 0.0; // the largest deformation of the joint over the tests (a bound: Σ|Y_k|)
+    for (const Test& test : tests)
+      peak = std::max(peak, test.Y.col(static_cast<Eigen::Index>(j)).cwiseAbs().sum());
+    if (peak >= phi_max) return;
+    const int k_index = J.term_index(joints::Term::k);
+    const bool k_open = k_index >= 0 && !J.fixed[static_cast<std::size_t>(k_index)];
+    std::vector<std::string> undetermined{"fs", "beta"};
+    if (k_open) undetermined.push_back("kt");
+    for (ParameterEstimate& p : pars)
+      if (!p.fixed &&
+          std::find(undetermined.begin(), undetermined.end(), p.name) != undetermined.end()) {
+        p.value = p.std = p.ci_low = p.ci_high = nan;
+        p.determined = false;
+        std::erase(poorly, fmt::format("iwan.{} of '{}'", p.name, je.name));
+      }
+    std::string said;
+    if (k_open) {
+      auto& kt = je.terms[static_cast<std::size_t>(k_index)];
+      kt.value = kt.std = kt.ci_low = kt.ci_high = nan;
+      kt.determined = false;
+      std::erase(poorly, fmt::format("k of '{}'", je.name));
+      const auto sum = combination([&](const std::vector<joints::Joint>& js) {
+        return js[j].values[static_cast<std::size_t>(k_index)] + js[j].parameter(ti, "kt");
+      });
+      said += fmt::format("k + iwan.kt = {:.5g} [{:.5g}, {:.5g}], ", sum[0], sum[2], sum[3]);
+    }
+    const auto R = combination([&](const std::vector<joints::Joint>& js) { return density(js).R; });
+    said += fmt::format("the slip density's scale R = {:.5g} [{:.5g}, {:.5g}] (N/m^(chi+2))", R[0],
+                        R[2], R[3]);
+    out.identifiability.push_back(fmt::format(
+        "joint '{}': its iwan stayed in microslip in every test (largest deformation {:.3g}, "
+        "below the largest slip displacement phi_max ≈ {:.3g}), where its force depends only on "
+        "k + kt, chi and the density's scale R: the tests determine {} and iwan.chi; {}iwan.fs "
+        "apart from iwan.beta are undetermined (no value is given for them): a test whose "
+        "deformation reaches beyond phi_max (macroslip) would determine them",
+        je.name, peak, phi_max, said, k_open ? "k apart from iwan.kt, and " : ""));
+  };
   out.joints.clear();
   Eigen::Index q = 0;
-  std::vector<std::string> poorly;
   for (std::size_t j = 0; j < identified.size(); ++j) {
     JointEstimate je{identified[j].name, {}};
     for (std::size_t t = 0; t < identified[j].terms.size(); ++t) {
       TermEstimate te;
       te.term = identified[j].terms[t];
+      te.parameters = parameters_of(identified[j], t);
       te.value = identified[j].values[t];
       te.fixed = identified[j].fixed[t];
+      if (!te.parameters.empty()) { // a parametric term: its parameters, intervals through u
+        te.std = 0.0, te.ci_low = te.ci_high = te.value;
+        const auto& info = joints::term_info(te.term).parameters;
+        for (std::size_t p = 0; p < te.parameters.size(); ++p) {
+          ParameterEstimate& pe = te.parameters[p];
+          if (pe.fixed) continue;
+          const double u = theta(q),
+                       su = std::isfinite(C(q, q)) ? std::sqrt(std::max(C(q, q), 0.0)) : nan;
+          const double h = 1e-6 * std::max(1.0, std::abs(u));
+          const double slope =
+              (parameter_from_u(info[p], u + h) - parameter_from_u(info[p], u - h)) / (2.0 * h);
+          pe.std = std::abs(slope) * su;
+          const double a = parameter_from_u(info[p], u - tq * su),
+                       b = parameter_from_u(info[p], u + tq * su);
+          pe.ci_low = std::min(a, b), pe.ci_high = std::max(a, b);
+          pe.determined =
+              std::isfinite(pe.std) && pe.std <= o.poorly_determined * std::abs(pe.value);
+          if (!pe.determined)
+            poorly.push_back(
+                fmt::format("{}.{} of '{}'", joints::term_name(te.term), pe.name, je.name));
+          ++q;
+        }
+        je.terms.push_back(te);
+        continue;
+      }
       if (te.fixed) {
         te.std = 0.0;
         te.ci_low = te.ci_high = te.value;
@@ -383,6 +503,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
       }
       je.terms.push_back(te);
     }
+    microslip(j, identified[j], je);
     out.joints.push_back(std::move(je));
   }
   double misfit = 0.0, size = 0.0; // of the displacement values (m)
@@ -430,7 +551,12 @@ FitResult output_error(const frf::Substructure& sub, const std::vector<joints::J
           m.source + ": a periodic broadband test: output error re-simulates each test by the "
                      "harmonic balance of one excitation frequency, which this test is not; "
                      "identify it by equation error (without --output-error)");
-  const FitResult start = fit(sub, joints, tests, fit_options);
+  // A parametric term's parameters start from a describing-function fit; the coefficient
+  // terms from the equation error with that term's force known.
+  std::vector<std::string> started;
+  const std::vector<joints::Joint> begin =
+      describing_function_start(sub, joints, tests, fit_options, started);
+  const FitResult start = fit(sub, with_parametric_fixed(begin), tests, fit_options);
   if (!start.status.ok()) return start;
   std::vector<std::string> left_out; // their warnings are in the fit's already
   const std::vector<Measurement> usable_tests = usable(tests, left_out);
@@ -455,7 +581,8 @@ FitResult output_error(const frf::Substructure& sub, const std::vector<joints::J
     failed.warnings = std::move(notes);
     return failed;
   }
-  FitResult out = output_error(H, sub.dofs(), joints, usable_tests, start, o);
+  FitResult out = output_error(H, sub.dofs(), begin, usable_tests, start, o);
+  out.warnings.insert(out.warnings.begin(), started.begin(), started.end());
   for (const std::string& note : notes) // those of the fit's own synthesis are there already
     if (std::find(out.warnings.begin(), out.warnings.end(), note) == out.warnings.end())
       out.warnings.push_back(note);

@@ -58,9 +58,18 @@ std::string joint_comment(const joints::Joint& j) {
   std::string text =
       fmt::format("joint '{}': {}:{} {}", j.name, j.node, fem::dof_name(j.dof),
                   j.to_ground() ? std::string("to ground") : fmt::format("to node {}", j.node_b));
-  for (std::size_t t = 0; t < j.terms.size(); ++t)
-    text += fmt::format("{} {} = {}", t == 0 ? ";" : ",", joints::term_name(j.terms[t]),
-                        compact(j.values[t]));
+  for (std::size_t t = 0; t < j.terms.size(); ++t) {
+    const auto& info = joints::term_info(j.terms[t]);
+    if (info.parameters.empty()) {
+      text += fmt::format("{} {} = {}", t == 0 ? ";" : ",", info.name, compact(j.values[t]));
+      continue;
+    }
+    const auto list = j.parameters_of(t); // "iwan.fs = 3, iwan.kt = 10000, …"
+    for (std::size_t p = 0; p < info.parameters.size(); ++p)
+      text += fmt::format("{} {}.{} = {}", t == 0 && p == 0 ? ";" : ",", info.name,
+                          info.parameters[p].name,
+                          p < list.size() ? compact(list[p].value) : std::string("?"));
+  }
   return text;
 }
 

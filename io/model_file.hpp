@@ -17,6 +17,7 @@ namespace jointid::io {
 struct ModelFile {
   fem::Model model; ///< the finite element model (left empty with [modal])
   std::vector<joints::Joint> joints;
+  std::vector<int> joint_lines;         ///< each joint's line in `path` (0: from a part's file)
   std::filesystem::path path;           ///< the file it was read from, for messages
   std::optional<GmshMesh> mesh;         ///< the mesh it references, if any (its named groups)
   std::optional<frf::ModalModel> modal; ///< the substructure given by its modes ([modal])

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace jointid::io::detail {
 
 namespace {
@@ -59,39 +61,128 @@ void read_joints(ModelReading& ctx, const Table& root) {
     const std::string listed = listed_terms(j);
     j.values.assign(j.terms.size(), 0.0); // a term without a value starts at 0
     j.fixed.assign(j.terms.size(), false);
+    j.iwan_sliders = ctx.iwan_sliders;
     std::vector<bool> has_value(j.terms.size(), false);
+    // A parametric term (jenkins, iwan, gap) holds its force whole (coefficient 1) and has its
+    // named parameters, "<term>.<parameter>" in values.
+    bool parametric = false;
+    for (std::size_t k = 0; k < j.terms.size(); ++k)
+      if (joints::has_parameters(j.terms[k])) {
+        parametric = true;
+        j.values[k] = 1.0;
+      }
+    if (parametric) {
+      j.parameters.resize(j.terms.size());
+      for (std::size_t k = 0; k < j.terms.size(); ++k)
+        j.parameters[k].resize(joints::term_info(j.terms[k]).parameters.size());
+    }
+    // "<term>.<parameter>" (a quoted key, or the dotted key's table): its index pair or fails.
+    auto parameter_at = [&](const toml::node& at, const std::string& label, std::string_view term,
+                            std::string_view name) {
+      const int index = term_position(j, term);
+      if (index < 0)
+        t.fail_at(at, label,
+                  "'" + std::string(term) + "' is not among the joint's terms (" + listed + ")");
+      const joints::Term tt = j.terms[static_cast<std::size_t>(index)];
+      const int p = joints::parameter_index(tt, name);
+      if (!joints::has_parameters(tt))
+        t.fail_at(at, label,
+                  "term '" + std::string(term) +
+                      "' has no named parameters (its value is written " + std::string(term) +
+                      " = ...)");
+      if (p < 0)
+        t.fail_at(at, label,
+                  "'" + std::string(name) + "' is not a parameter of '" + std::string(term) +
+                      "': expected one of " + joints::parameter_names(tt));
+      return std::pair<std::size_t, std::size_t>(index, p);
+    };
+    auto read_parameter = [&](const toml::node& value, const std::string& label,
+                              std::string_view term, std::string_view name) {
+      const auto [k, p] = parameter_at(value, label, term, name);
+      const joints::ParameterInfo& info = joints::term_info(j.terms[k]).parameters[p];
+      const double v = t.to_number(value, label);
+      if (!joints::in_range(info, v))
+        t.fail_at(value, label,
+                  "expected " + joints::range_text(info) + " (" + std::string(info.meaning) + ", " +
+                      std::string(info.unit) + "), got " + shown(value));
+      j.parameters[k][p].value = v;
+      j.parameters[k][p].given = true;
+    };
     if (const auto* n = t.get("values")) {
       const auto* values = n->as_table();
       if (!values)
         t.fail_at(*n, "key 'values'",
                   "expected a table such as { k = 4800.0, c = 20.0 }, got " + shown(*n));
       for (auto&& [key, value] : *values) {
-        const std::string label = "key 'values." + std::string(key.str()) + "'";
-        const int index = term_position(j, key.str());
+        const std::string name(key.str());
+        const std::string label = "key 'values." + name + "'";
+        if (const auto dot = name.find('.'); dot != std::string::npos) {
+          read_parameter(value, label, std::string_view(name).substr(0, dot),
+                         std::string_view(name).substr(dot + 1));
+          continue;
+        }
+        const int index = term_position(j, name);
         if (index < 0)
-          t.fail_at(value, label,
-                    "'" + std::string(key.str()) + "' is not among the joint's terms (" + listed +
-                        ")");
-        j.values[index] = t.to_number(value, label);
-        has_value[index] = true;
+          t.fail_at(value, label, "'" + name + "' is not among the joint's terms (" + listed + ")");
+        const joints::Term term = j.terms[static_cast<std::size_t>(index)];
+        if (joints::has_parameters(term)) {
+          // values = { iwan.fs = 3.0 } (a dotted key) is the table iwan = { fs = 3.0 }
+          const auto* sub = value.as_table();
+          if (!sub)
+            t.fail_at(value, label,
+                      "term '" + name + "' has named parameters: write \"" + name + "." +
+                          std::string(joints::term_info(term).parameters[0].name) +
+                          "\" = ... for each of " + joints::parameter_names(term));
+          for (auto&& [inner, v] : *sub)
+            read_parameter(v, "key 'values." + name + "." + std::string(inner.str()) + "'", name,
+                           inner.str());
+          continue;
+        }
+        j.values[static_cast<std::size_t>(index)] = t.to_number(value, label);
+        has_value[static_cast<std::size_t>(index)] = true;
       }
     }
+    for (std::size_t k = 0; k < j.terms.size(); ++k)
+      if (joints::has_parameters(j.terms[k]))
+        has_value[k] = std::all_of(j.parameters[k].begin(), j.parameters[k].end(),
+                                   [](const joints::Parameter& p) { return p.given; });
     if (const auto* n = t.get("fixed")) {
       const toml::array& fixed = t.to_array(*n, "key 'fixed'", "term names");
       for (const auto& f : fixed) {
         const std::string name = t.to_string(f, "key 'fixed'");
+        if (const auto dot = name.find('.'); dot != std::string::npos) {
+          const auto [k, p] = parameter_at(f, "key 'fixed'", std::string_view(name).substr(0, dot),
+                                           std::string_view(name).substr(dot + 1));
+          if (!j.parameters[k][p].given)
+            t.fail_at(f, "key 'fixed'",
+                      "'" + name + "' is held fixed but has no value in 'values'");
+          j.parameters[k][p].fixed = true;
+          continue;
+        }
         const int index = term_position(j, name);
         if (index < 0)
           t.fail_at(f, "key 'fixed'",
                     "'" + name + "' is not among the joint's terms (" + listed + ")");
         if (!has_value[index])
           t.fail_at(f, "key 'fixed'",
-                    "term '" + name + "' is held fixed but has no value in 'values'");
+                    joints::has_parameters(j.terms[static_cast<std::size_t>(index)])
+                        ? "term '" + name + "' is held fixed but not all of its parameters (" +
+                              joints::parameter_names(j.terms[static_cast<std::size_t>(index)]) +
+                              ") have a value in 'values'"
+                        : "term '" + name + "' is held fixed but has no value in 'values'");
         j.fixed[index] = true;
+        if (joints::has_parameters(j.terms[static_cast<std::size_t>(index)]))
+          for (joints::Parameter& p : j.parameters[static_cast<std::size_t>(index)])
+            p.fixed = true;
       }
     }
+    for (std::size_t k = 0; k < j.terms.size(); ++k)
+      if (joints::has_parameters(j.terms[k]))
+        j.fixed[k] = std::all_of(j.parameters[k].begin(), j.parameters[k].end(),
+                                 [](const joints::Parameter& p) { return p.fixed; });
     j.given = has_value;
     ctx.joint_lines.push_back(t.line());
+    ctx.out.joint_lines.push_back(t.line());
     ctx.out.joints.push_back(std::move(j));
   }
 }

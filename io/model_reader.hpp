@@ -112,10 +112,11 @@ struct ModelReading {
   int elements_line = 0;
   std::map<std::string, int> material_index, section_index;
   std::vector<int> joint_lines;
-  std::optional<frf::ModalModel> modal;   ///< [modal], while it is read
-  int modal_line = 0;                     ///< [modal]'s line
-  std::optional<fem::Assembled> matrices; ///< [matrices], while it is read
-  bool reading_frf = false;               ///< [frf], while it is read
+  int iwan_sliders = joints::default_iwan_sliders; ///< [options] iwan_sliders
+  std::optional<frf::ModalModel> modal;            ///< [modal], while it is read
+  int modal_line = 0;                              ///< [modal]'s line
+  std::optional<fem::Assembled> matrices;          ///< [matrices], while it is read
+  bool reading_frf = false;                        ///< [frf], while it is read
 
   /// A node id of the model, or the name of a Gmsh group of exactly one node; with
   /// `zero_is_ground`, 0 is the ground.

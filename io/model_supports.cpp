@@ -102,9 +102,18 @@ void read_damping(ModelReading& ctx, const Table& root) {
 void read_options(ModelReading& ctx, const Table& root) {
   const toml::table* o = table(root, "options");
   if (!o) return;
-  Table t(ctx.file, *o, "[options]", {"lumped_mass"});
+  Table t(ctx.file, *o, "[options]", {"lumped_mass", "iwan_sliders"});
   if (const auto lumped = t.optional_boolean("lumped_mass"))
     ctx.model().mass_options.lumped = *lumped;
+  if (const auto* n = t.get("iwan_sliders")) {
+    const int sliders = t.to_integer(*n, "key 'iwan_sliders'");
+    if (sliders < 2 || sliders > 100000)
+      t.fail_at(*n, "key 'iwan_sliders'",
+                "expected the number of Jenkins elements of an iwan's quadrature, from 2 to "
+                "100000, got " +
+                    shown(*n));
+    ctx.iwan_sliders = sliders;
+  }
 }
 
 } // namespace jointid::io::detail

@@ -25,6 +25,23 @@ std::string identify_result_json(const identify::FitResult& result,
       Json term;
       term["term"] = std::string(joints::term_name(t.term));
       term["effect"] = std::string(joints::term_effect(t.term));
+      if (!t.parameters.empty()) { // a parametric term: its named parameters
+        Json parameters = Json::object();
+        for (const auto& p : t.parameters) {
+          Json one; // an undetermined parameter has no value (null), never a number
+          one["value"] = number(p.value);
+          one["std"] = number(p.std);
+          one["ci95"] = Json::array({number(p.ci_low), number(p.ci_high)});
+          one["fixed"] = p.fixed;
+          one["determined"] = p.determined;
+          parameters[p.name] = std::move(one);
+        }
+        term["parameters"] = std::move(parameters);
+        term["fixed"] = t.fixed;
+        term["determined"] = t.determined;
+        terms.push_back(std::move(term));
+        continue;
+      }
       term["value"] = number(t.value);
       term["std"] = number(t.std);
       term["ci95"] = Json::array({number(t.ci_low), number(t.ci_high)});

@@ -1,6 +1,7 @@
 #include "joints/basis.hpp"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -15,7 +16,27 @@ double one(double, double) {
   return 1.0;
 }
 
-constexpr std::array<TermInfo, 7> table{{
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+// The parametric terms' parameters (docs/method.md, "Terms with named parameters").
+constexpr std::array<ParameterInfo, 2> jenkins_parameters{{
+    {"kt", "stiffness of the spring in series with the slider", "N/m", "N m/rad", 0.0, true, inf,
+     true},
+    {"fs", "slip force", "N", "N m", 0.0, true, inf, true},
+}};
+constexpr std::array<ParameterInfo, 4> iwan_parameters{{
+    {"fs", "macroslip force", "N", "N m", 0.0, true, inf, true},
+    {"kt", "stiffness before any slip", "N/m", "N m/rad", 0.0, true, inf, true},
+    {"chi", "microslip exponent", "1", "1", -1.0, true, 0.0, false},
+    {"beta", "strength of the density's Dirac at the macroslip end", "1", "1", 0.0, false, inf,
+     true},
+}};
+constexpr std::array<ParameterInfo, 2> gap_parameters{{
+    {"delta", "clearance on either side", "m", "rad", 0.0, false, inf, true},
+    {"kg", "contact stiffness beyond the clearance", "N/m", "N m/rad", 0.0, false, inf, true},
+}};
+
+constexpr std::array<TermInfo, 10> table{{
     {Term::k, "k", "linear stiffness", "N/m", "N m/rad", [](double y, double) { return y; }, one,
      zero, Nature::conservative, 1, false, false},
     {Term::c, "c", "viscous damping", "N s/m", "N m s/rad", [](double, double v) { return v; },
@@ -37,11 +58,42 @@ constexpr std::array<TermInfo, 7> table{{
                                    : v < 0.0 ? -1.0
                                              : 0.0; }, zero, zero,
      Nature::dissipative, 0, false, true},
+    {Term::jenkins, "jenkins", "elastic dry friction (Jenkins element)", "1", "1", nullptr, nullptr,
+     nullptr, Nature::hysteretic, -1, false, false, jenkins_parameters, true},
+    {Term::iwan, "iwan", "microslip (four-parameter Iwan model)", "1", "1", nullptr, nullptr,
+     nullptr, Nature::hysteretic, -1, false, false, iwan_parameters, true},
+    {Term::gap, "gap", "clearance (contact beyond a gap)", "1", "1", nullptr, nullptr, nullptr,
+     Nature::conservative, -1, false, false, gap_parameters, false},
 }};
+
+[[noreturn]] void refuse_parametric(Term t, const char* what) {
+  throw std::invalid_argument(std::string(what) + ": term '" + std::string(term_name(t)) +
+                              "' has named parameters (" + parameter_names(t) +
+                              ") and no basis function g(y, ydot)");
+}
 
 } // namespace
 
-const std::array<TermInfo, 7>& term_table() {
+bool in_range(const ParameterInfo& p, double v) {
+  if (!std::isfinite(v)) return false;
+  const bool above = p.low_open ? v > p.low : v >= p.low;
+  const bool below = p.high_open ? v < p.high : v <= p.high;
+  return above && below;
+}
+
+std::string range_text(const ParameterInfo& p) {
+  std::ostringstream s;
+  if (std::isinf(p.high)) {
+    s << (p.low_open ? "> " : ">= ") << p.low;
+  } else if (std::isinf(p.low)) {
+    s << (p.high_open ? "< " : "<= ") << p.high;
+  } else {
+    s << "in " << (p.low_open ? "(" : "[") << p.low << ", " << p.high << (p.high_open ? ")" : "]");
+  }
+  return s.str();
+}
+
+const std::array<TermInfo, 10>& term_table() {
   return table;
 }
 
@@ -73,15 +125,32 @@ Term parse_term(std::string_view name) {
                               term_names());
 }
 
+int parameter_index(Term t, std::string_view name) {
+  const auto& list = term_info(t).parameters;
+  for (std::size_t i = 0; i < list.size(); ++i)
+    if (list[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+std::string parameter_names(Term t) {
+  std::string names;
+  for (const ParameterInfo& p : term_info(t).parameters)
+    names += (names.empty() ? "" : ", ") + std::string(p.name);
+  return names;
+}
+
 double basis(Term t, double y, double v) {
+  if (has_parameters(t)) refuse_parametric(t, "basis");
   return term_info(t).g(y, v);
 }
 
 double basis_dy(Term t, double y, double v) {
+  if (has_parameters(t)) refuse_parametric(t, "basis_dy");
   return term_info(t).dg_dy(y, v);
 }
 
 double basis_dydot(Term t, double y, double v) {
+  if (has_parameters(t)) refuse_parametric(t, "basis_dydot");
   return term_info(t).dg_dydot(y, v);
 }
 
@@ -121,6 +190,10 @@ void add_samples(Term t, double b, std::span<const double> y, std::span<const do
     for (std::size_t i = 0; i < n; ++i)
       g[i] += b * (v[i] > 0.0 ? 1.0 : v[i] < 0.0 ? -1.0 : 0.0);
     return;
+  case Term::jenkins:
+  case Term::iwan:
+  case Term::gap:
+    refuse_parametric(t, "add_samples");
   }
   throw std::invalid_argument("add_samples: unknown term");
 }

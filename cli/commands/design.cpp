@@ -166,6 +166,7 @@ void Design::run() {
   const Model model(model_, engine());
   if (model.file.joints.empty())
     throw io::Error(model.name() + ": no [[joints]]: nothing to design tests for");
+  check_identifiable(model);
   const std::vector<identify::DesignUnknown> unknowns =
       identify::design_unknowns(model.file.joints);
   if (unknowns.empty())

@@ -40,7 +40,8 @@ public:
     for (const joints::Term t : joints::all_terms)
       names.emplace_back(joints::term_name(t));
     app()
-        .add_option("--terms", terms_, "Candidate terms tried at every joint (default: all)")
+        .add_option("--terms", terms_,
+                    "Candidate terms tried at every joint (default: k, c, k2, k3, c2, c3, fc)")
         ->check(choices(names))
         ->delimiter(',')
         ->allow_extra_args(false);
@@ -72,8 +73,20 @@ void Discover::run() {
   discover::Options options = options_;
   if (!terms_.empty()) {
     options.terms.clear();
-    for (const auto& t : terms_)
+    for (const auto& t : terms_) {
       options.terms.push_back(joints::parse_term(t)); // checked by --terms' choices
+      if (joints::has_parameters(options.terms.back()))
+        throw io::Error(fmt::format(
+            "--terms: '{}' is not a discovery candidate yet: jenkins, iwan and gap are "
+            "simulated, and may be held fixed in the model's joints, but their discovery is "
+            "coming; the candidates are {}",
+            t, [] {
+              std::string names;
+              for (const joints::Term c : joints::coefficient_terms)
+                names += (names.empty() ? "" : ", ") + std::string(joints::term_name(c));
+              return names;
+            }()));
+    }
   }
   check_output_dir(output_dir_);
 
@@ -81,6 +94,7 @@ void Discover::run() {
   const Model model(model_, engine());
   if (model.file.joints.empty())
     throw io::Error(model.name() + ": no [[joints]]: discovery starts from the joints' terms");
+  check_identifiable(model);
   const std::vector<identify::SineTest> tests = io::read_tests(records_);
   for (const char* name : {"discovery.json", "report.md"})
     io::check_not_an_input(output_dir_ / name);

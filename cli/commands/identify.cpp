@@ -91,6 +91,7 @@ void Identify::run() {
   // 2. The inputs.
   const Model model(model_, engine());
   if (model.file.joints.empty()) throw io::Error(model.name() + ": no [[joints]] to identify");
+  check_identifiable(model);
   const std::vector<identify::SineTest> tests = io::read_tests(records_);
   io::check_not_an_input(output_);
   for (const fs::path& png : {fit_png_, params_png_})
@@ -119,11 +120,24 @@ void Identify::print(const identify::FitResult& result) const {
   fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
              "95 % interval");
   for (const auto& j : result.joints)
-    for (const auto& t : j.terms)
+    for (const auto& t : j.terms) {
+      if (!t.parameters.empty()) { // a parametric term: one line per parameter
+        for (const auto& p : t.parameters)
+          fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", j.name,
+                     fmt::format("{}.{}", joints::term_name(t.term), p.name),
+                     joints::term_effect(t.term),
+                     p.determined ? fmt::format("{:.7g}", p.value) : std::string("undetermined"),
+                     p.fixed || !p.determined ? std::string() : fmt::format("{:.3g}", p.std),
+                     p.fixed        ? std::string("(fixed)")
+                     : p.determined ? fmt::format("[{:.7g}, {:.7g}]", p.ci_low, p.ci_high)
+                                    : std::string("(see below)"));
+        continue;
+      }
       fmt::print("{:<12} {:<5} {:<26} {:>14.7g} {:>11.3g}  {}\n", j.name, joints::term_name(t.term),
                  joints::term_effect(t.term), t.value, t.std,
                  t.fixed ? std::string("(fixed)")
                          : fmt::format("[{:.7g}, {:.7g}]", t.ci_low, t.ci_high));
+    }
   fmt::print("{} equations, {} unknowns, condition number {:.3g}, residual {:.3g} m rms ({:.3g} "
              "relative)\n",
              result.equations, result.unknowns, result.condition_number, result.residual_rms,

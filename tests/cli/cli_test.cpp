@@ -1992,7 +1992,8 @@ TEST_F(CliTest, EnumeratedOptionsListTheirChoices) {
       {"simulate", "--channels", "{x,v,a}", "x, v or a"},
       {"compare", "--route", "{modal,full}", "modal or full"},
       {"frf", "--kind", "{receptance,mobility,accelerance}", "receptance, mobility or accelerance"},
-      {"discover", "--terms", "{k,c,k2,k3,c2,c3,fc}", "k, c, k2, k3, c2, c3 or fc"},
+      {"discover", "--terms", "{k,c,k2,k3,c2,c3,fc,jenkins,iwan,gap}",
+       "k, c, k2, k3, c2, c3, fc, jenkins, iwan or gap"},
       {"modes", "--engine", "{auto,dense,sparse,slepc}", "auto, dense, sparse or slepc"},
       {"modal-fit", "--spectra", "{auto,welch,periods,whole}", "auto, welch, periods or whole"}};
   for (const char* command : {"simulate", "frf", "identify", "discover", "response", "design"})

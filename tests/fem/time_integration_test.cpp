@@ -365,3 +365,111 @@ TEST(Newmark, AJointIterationThatFailsIsAStatusSayingWhen) {
   const fem::SteadyState more = fem::steady_state(s, C, &cubic, {0, 1.0, 1.0}, out, o);
   EXPECT_NE(more.status.code, fem::Status::Code::not_converging) << more.status.reason;
 }
+
+TEST(Newmark, JenkinsSlidesExactlyAtItsSlipForce) {
+  // A nearly massless oscillator (spring k0 to ground) with a Jenkins joint (kt in series with a
+  // slider of slip force fs) under a force ramped by 0.13 N a step: quasi-static, k0 y + g = f.
+  // While it sticks, g = kt y exactly (the slider has not moved); it must start to slide at the
+  // first step where kt·f/(k0 + kt) exceeds fs (f* = fs (k0 + kt)/kt = 5.5 N, between steps 42
+  // and 43), and from then on g = fs exactly — no regularisation rounds the corner. Ramped back
+  // down it sticks at once (g falls with slope kt from fs) and slides the other way at −fs.
+  // Tolerances: the trapezoidal rule's inertia m ÿ against the stiffness is at most
+  // m (2/h)² / k0 = 4e-6 relative; g = kt y and g = ±fs hold to rounding.
+  const double m = 1e-9, k0 = 1000.0, kt = 1.0e4, fs = 5.0, h = 1e-3, rate = 0.13;
+  const fem::Assembled s = fem::assemble(test::oscillator(m, k0));
+  joints::Joint j{"jenkins", 1, 0, Dof::ux, {joints::Term::jenkins}, {1.0}, {true}, {}};
+  j.set_parameters(0, {kt, fs});
+  const joints::JointForces forces({j}, s.dofs);
+  ASSERT_EQ(forces.state_size(), 1);
+  const fem::SparseMatrix C(1, 1);
+  fem::Newmark integrator(s, C, &forces, h);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(1);
+  integrator.set_state(f, f, f);
+  int first_slide = -1;
+  double y_top = 0.0;
+  for (int n = 1; n <= 80; ++n) { // up to 10.4 N
+    f(0) = rate * n;
+    ASSERT_TRUE(integrator.step(f).ok()) << n;
+    const double y = integrator.y()(0), g = integrator.local_force()(0);
+    EXPECT_NEAR(k0 * y + g, f(0), 1e-5 * f(0)) << n; // quasi-static balance
+    if (std::abs(g - fs) <= 1e-12 * fs) {
+      if (first_slide < 0) first_slide = n;
+      EXPECT_NEAR(integrator.history()[0], y - fs / kt, 1e-15) << n; // the slider moved along
+    } else {
+      EXPECT_LT(g, fs) << n;
+      EXPECT_EQ(first_slide, -1) << "stuck again while loading, step " << n;
+      EXPECT_NEAR(g, kt * y, 1e-12 * fs) << n;
+      EXPECT_EQ(integrator.history()[0], 0.0) << n;
+    }
+    y_top = y;
+  }
+  EXPECT_EQ(first_slide, 43);
+  EXPECT_LT(kt * (rate * 42) / (k0 + kt), fs); // (the quasi-static transition: step 43)
+  EXPECT_GT(kt * (rate * 43) / (k0 + kt), fs);
+  // Unloading: sticks at once, g = fs − kt (y_top − y), until g reaches −fs.
+  bool slid_back = false;
+  for (int n = 79; n >= -80 && !slid_back; --n) {
+    f(0) = rate * n;
+    ASSERT_TRUE(integrator.step(f).ok()) << n;
+    const double y = integrator.y()(0), g = integrator.local_force()(0);
+    if (std::abs(g + fs) <= 1e-12 * fs) {
+      slid_back = true;
+      // it slides back where fs − kt (y_top − y) reaches −fs: f = k0 y − fs with y = y_top − 2fs/kt
+      EXPECT_GE(f(0), k0 * (y_top - 2.0 * fs / kt) - fs - rate * (1.0 + 1e-9)) << n;
+    } else {
+      EXPECT_NEAR(g, fs - kt * (y_top - y), 1e-12 * fs * 10.0) << n;
+    }
+  }
+  EXPECT_TRUE(slid_back);
+}
+
+TEST(Newmark, ClearanceOscillatorKeepsItsAnalyticPeriod) {
+  // A mass m on a spring k0 with a clearance (gap δ, contact stiffness kg) released from rest at
+  // A > δ: in contact it swings about x_e = kg δ/(k0 + kg) at ω2 = √((k0 + kg)/m), reaching δ
+  // after t1 = arccos((δ − x_e)/(A − x_e))/ω2 at speed v1 = ω2 √((A − x_e)² − (δ − x_e)²); free,
+  // it swings about 0 at ω1 = √(k0/m) and reaches 0 after t2 = atan(ω1 δ / v1)/ω1: the period is
+  // 4 (t1 + t2), and the energy ½mv² + ½k0x² + ½kg(|x| − δ)₊² is conserved. The contact is taken
+  // exactly at each step's end (no penalty smoothing, no event location): the force has a kink
+  // in time there, the trapezoidal rule errs by O(h² kg |ẏ|) at that step, so the method stays
+  // second order — halving h divides the period's error by ≈ 4 (asserted: 3 to 5) — and the
+  // energy is kept to O(h²) with no drift.
+  const double m = 1.0, k0 = 1000.0, kg = 9000.0, delta = 1e-3, A = 3e-3;
+  const double w1 = std::sqrt(k0 / m), w2 = std::sqrt((k0 + kg) / m), xe = kg * delta / (k0 + kg);
+  const double t1 = std::acos((delta - xe) / (A - xe)) / w2;
+  const double v1 = w2 * std::sqrt(std::pow(A - xe, 2) - std::pow(delta - xe, 2));
+  const double t2 = std::atan(w1 * delta / v1) / w1, period = 4.0 * (t1 + t2);
+  const fem::Assembled s = fem::assemble(test::oscillator(m, k0));
+  joints::Joint j{"gap", 1, 0, Dof::ux, {joints::Term::gap}, {1.0}, {true}, {}};
+  j.set_parameters(0, {delta, kg});
+  const joints::JointForces forces({j}, s.dofs);
+  EXPECT_EQ(forces.state_size(), 0);
+  const fem::SparseMatrix C(1, 1);
+  auto energy = [&](double x, double v) {
+    const double pen = std::max(std::abs(x) - delta, 0.0);
+    return 0.5 * m * v * v + 0.5 * k0 * x * x + 0.5 * kg * pen * pen;
+  };
+  const double E0 = energy(A, 0.0);
+  auto run = [&](int steps) { // the mean period over 4 periods from downward zero crossings
+    const double h = period / steps;
+    fem::Newmark integrator(s, C, &forces, h);
+    Eigen::VectorXd u(1), zero = Eigen::VectorXd::Zero(1);
+    u << A;
+    integrator.set_state(u, zero, zero);
+    std::vector<double> crossings;
+    double x_before = A, worst = 0.0;
+    for (int n = 1; n <= 5 * steps; ++n) {
+      EXPECT_TRUE(integrator.step(zero).ok());
+      const double x = integrator.u()(0);
+      worst = std::max(worst, std::abs(energy(x, integrator.v()(0)) - E0) / E0);
+      if (x_before > 0.0 && x <= 0.0) crossings.push_back(h * (n - 1 + x_before / (x_before - x)));
+      x_before = x;
+    }
+    EXPECT_LT(worst, 2.0 * std::pow(w2 * h, 2)) << steps; // O(h²), no drift over 5 periods
+    return (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  };
+  const double coarse = run(200), fine = run(400);
+  const double e_coarse = std::abs(coarse - period), e_fine = std::abs(fine - period);
+  EXPECT_LT(e_fine, 1e-3 * period);
+  EXPECT_GT(e_coarse / e_fine, 3.0);
+  EXPECT_LT(e_coarse / e_fine, 5.0);
+}

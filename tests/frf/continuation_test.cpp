@@ -322,6 +322,108 @@ TEST(Continuation, BadArgumentsThrow) {
   EXPECT_THROW(trace(c, js, 1.0, 2.0, 3.0, o), std::invalid_argument);
 }
 
+TEST(Continuation, FloquetOfAJenkinsOscillatorMatchesTheDecayInTime) {
+  // A mass (1 kg) on a spring (1e4 N/m, 1 % modal damping: c = 2 N s/m) with a Jenkins joint
+  // (kt = 1e4 N/m, fs = 1 N) under F0 sin ωt at 12 Hz. Stuck all the time (0.5 N) it is a linear
+  // oscillator of stiffness 2e4 N/m: |μ| = exp(−c T / 2m) exactly (to the check's Runge–Kutta,
+  // ≪ 1e-6). Sliding part of the period (3 N, 10 N) the multipliers must be those the
+  // time integrator shows: two integrations from rest, one of them nudged (1e-6 of the
+  // amplitude) at period 60, differ afterwards by M^p times the nudge, so their difference's
+  // norm falls by |μ|max a period (its fluctuation, the pair's rotation, is averaged by a
+  // least-squares fit of its logarithm over periods 3 … 12, the difference still ≫ rounding:
+  // ±2 % met, 4 % asserted).
+  // A check that took the stuck elements' stiffness alone (δg = K_st δy, forgetting where the
+  // stick phase began) would find the linear 0.920 at every level — far outside.
+  fem::Model model = test::oscillator(1.0, 1.0e4);
+  model.damping.kind = fem::Damping::Kind::modal;
+  model.damping.modal_ratio = 0.01;
+  const fem::Assembled system = fem::assemble(model);
+  const fem::Modes modes =
+      fem::modal_analysis(system, {.num_modes = 0, .engine = fem::ModalEngine::dense});
+  const frf::ModalSynthesis H(system, modes, model.damping, test::all_equations(system));
+  const fem::SparseMatrix C = fem::damping_matrix(system, model.damping, &modes);
+  const double f = 12.0, T = 1.0 / f;
+  joints::Joint j{"j", 1, 0, Dof::ux, {Term::jenkins}, {1.0}, {true}, {}};
+  j.set_parameters(0, {1.0e4, 1.0});
+  const std::vector<joints::Joint> js{j};
+  const joints::JointForces forces(js, system.dofs);
+  frf::HarmonicBalanceOptions ho;
+  ho.harmonics = 31;
+  for (double F0 : {0.5, 3.0, 10.0}) {
+    SCOPED_TRACE(std::to_string(F0) + " N");
+    const frf::HarmonicBalanceResult r =
+        frf::harmonic_balance(H, js, system.dofs, 0, F0, f, std::vector<int>{0}, ho);
+    ASSERT_TRUE(r.status.ok());
+    const frf::Stability s = frf::floquet_stability(H, js, system.dofs, r, ho);
+    ASSERT_TRUE(s.stable.has_value()) << s.note;
+    EXPECT_TRUE(*s.stable);
+    const double mu = s.multipliers.cwiseAbs().maxCoeff();
+    if (F0 == 0.5) {
+      EXPECT_NEAR(mu, std::exp(-2.0 * T / 2.0), 1e-6);
+      continue;
+    }
+    const int N = 1024;
+    fem::Newmark a(system, C, &forces, T / N), b(system, C, &forces, T / N);
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(1);
+    a.set_state(load, load, load);
+    b.set_state(load, load, load);
+    long step = 0;
+    auto advance = [&](int count) {
+      for (int i = 1; i <= count; ++i) {
+        load(0) = F0 * std::sin(two_pi * f * static_cast<double>(step + i) * T / N);
+        ASSERT_TRUE(a.step(load).ok());
+        ASSERT_TRUE(b.step(load).ok());
+      }
+      step += count;
+    };
+    advance(60 * N);
+    Eigen::VectorXd u = b.u();
+    u(0) += 1e-4 * std::abs(r.X(1, 0));
+    b.set_state(u, b.v(), load);
+    std::vector<double> p, logs;
+    for (int period = 1; period <= 12; ++period) {
+      advance(N);
+      const double du = b.u()(0) - a.u()(0), dv = (b.v()(0) - a.v()(0)) / 100.0;
+      if (period > 2) p.push_back(period), logs.push_back(0.5 * std::log(du * du + dv * dv));
+    }
+    const Eigen::Map<const Eigen::VectorXd> x(p.data(), static_cast<Eigen::Index>(p.size())),
+        l(logs.data(), static_cast<Eigen::Index>(logs.size()));
+    const double xm = x.mean(), lm = l.mean();
+    const double slope =
+        ((x.array() - xm) * (l.array() - lm)).sum() / (x.array() - xm).square().sum();
+    EXPECT_NEAR(mu, std::exp(slope), 0.04 * mu);
+    EXPECT_LT(mu, 0.85); // the sliding dissipates: well below the linear 0.920
+  }
+}
+
+TEST(Continuation, IwanResponseCurveIsTracedWithItsStability) {
+  // The paper's cantilever with k, c and an iwan at the tip, 2 N (microslip) across the first
+  // resonance: the branch is complete, every point a fixed-frequency steady state, and every
+  // point's stability determined (a passive joint under a harmonic force: stable).
+  const PaperCantilever c;
+  joints::Joint j = make("tip", 7, {Term::k, Term::c, Term::iwan}, {4800.0, 20.0, 1.0});
+  j.set_parameters(2, {3.0, 1.0e4, -0.5, 0.1});
+  const std::vector<joints::Joint> js{j};
+  frf::ContinuationOptions o;
+  o.hb.harmonics = 7;
+  const frf::ResponseBranch b = trace(c, js, 2.0, 2.5, 3.5, o);
+  ASSERT_TRUE(b.complete);
+  ASSERT_GE(b.points.size(), 10u);
+  for (std::size_t i = 0; i < b.points.size(); i += 5) {
+    const frf::ResponsePoint& p = b.points[i];
+    const frf::HarmonicBalance at(c.H, js, c.system.dofs, {c.eq(7)}, {c.eq(7)}, p.hb.frequency_hz,
+                                  o.hb);
+    const frf::HarmonicBalanceResult r = at.solve(js, frf::sine_force(2.0), &p.hb.Y);
+    ASSERT_TRUE(r.status.ok()) << i;
+    EXPECT_LE((r.Y - p.hb.Y).norm(), 1e-8 * p.hb.Y.norm()) << i;
+  }
+  for (const frf::ResponsePoint& p : b.points) {
+    ASSERT_TRUE(p.stable.has_value()) << p.hb.frequency_hz;
+    EXPECT_TRUE(*p.stable) << p.hb.frequency_hz;
+    EXPECT_LT(p.max_multiplier, 1.0);
+  }
+}
+
 TEST(Continuation, AModalAnalysisThatFailsIsTheCurvesStatus) {
   // tests/support/failing_substructure.hpp: its dense modal analysis fails. No curve
   // is traced; the status says why.

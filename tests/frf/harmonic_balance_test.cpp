@@ -6,6 +6,7 @@
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
 #include "support/beam_models.hpp"
+#include "support/error_of.hpp"
 #include "support/synthesised_cantilever.hpp"
 
 #include <gtest/gtest.h>
@@ -637,4 +638,108 @@ TEST(HarmonicBalance, ResidualSplitsByTheTermsDegree) {
     Eigen::MatrixXd h;
     EXPECT_FALSE(P->homogeneous_parts(problem.first_guess(*P, nullptr), h));
   }
+}
+
+namespace {
+
+// A joint with the paper's k and c and one parametric term with its parameters (fixed).
+joints::Joint parametric(Term term, std::vector<double> parameters) {
+  joints::Joint j = make("tip", 7, 0, {Term::k, Term::c, term}, {4800.0, 20.0, 1.0});
+  j.set_parameters(2, parameters);
+  return j;
+}
+
+} // namespace
+
+TEST(HarmonicBalance, ParametricTermsAgreeWithTimeIntegration) {
+  // k y + c ẏ (the paper's 4800 N/m, 20 N s/m) and one parametric term at the tip, at the first
+  // resonance (3 Hz): a Jenkins element and an Iwan (microslip, and macroslip), each solved with
+  // its exact steady loop, and a clearance (contact beyond ±5 mm). Time integration (Newmark,
+  // exact slider states and contact, from rest) is independent. The fundamentals must agree to
+  //   tol = 2 · |X1|/F0 · 2L · (|X_K| K/2 + a (π/Nt)²/2) + 2 |T(2048) − T(1024)| / 3,
+  // the harmonic balance's own error bounded through the structure's response to the joint
+  // force (|X1|/F0) times the change of that force's fundamental under a change δy of the
+  // deformation (at most 2 L max|δy|, L the term's largest slope: kt or kg). δy: the harmonics
+  // beyond K (falling at least like k⁻² past the last one kept, odd ones only: their sum is at
+  // most |X_K| K/2) and the peaks the AFT samples miss (a (1 − cos π/Nt)); doubled for the
+  // aliasing of the force's harmonics of the same order. The integrator's error is its O(h²)
+  // (Richardson from two step sizes, doubled). The time integration's mean may differ (sliders
+  // left where the transient moved them, stuck since: their forces' mean only), so the
+  // fundamentals are compared, and a term left out must not agree.
+  const PaperCantilever c;
+  struct Case {
+    const char* name;
+    joints::Joint joint;
+    double F0, L;
+  };
+  const double f = 3.0, w = two_pi * f;
+  const std::vector<Case> cases{
+      {"jenkins", parametric(Term::jenkins, {1.0e4, 3.0}), 20.0, 1.0e4},
+      {"iwan, microslip", parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}), 2.0, 1.0e4},
+      {"iwan, macroslip", parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}), 20.0, 1.0e4},
+      {"gap", parametric(Term::gap, {5e-3, 2e4}), 40.0, 2e4},
+  };
+  for (const Case& t : cases) {
+    SCOPED_TRACE(t.name);
+    const std::vector<joints::Joint> js{t.joint};
+    frf::HarmonicBalanceOptions o;
+    o.harmonics = 15;
+    const frf::HarmonicBalanceResult hb = frf::harmonic_balance(
+        c.H, js, c.system.dofs, c.eq(7), t.F0, f, std::vector<int>{c.eq(7)}, o);
+    ASSERT_TRUE(hb.status.ok()) << hb.status.reason;
+    const Complex X1 = hb.X(1, 0);
+    const fem::SteadyState fine = integrate(c, js, t.F0, f, 2048),
+                           coarse = integrate(c, js, t.F0, f, 1024);
+    const Complex T1 = harmonic(fine.u.col(0), fine.t, w, 1),
+                  T1_coarse = harmonic(coarse.u.col(0), coarse.t, w, 1);
+    const int Nt = 16 * (o.harmonics + 1);
+    const double a = std::abs(X1), XK = std::abs(hb.X(o.harmonics, 0));
+    const double tol = 2.0 * a / t.F0 * 2.0 * t.L *
+                           (XK * o.harmonics / 2.0 + a * std::pow(std::numbers::pi / Nt, 2) / 2.0) +
+                       2.0 * std::abs(T1 - T1_coarse) / 3.0;
+    EXPECT_LT(std::abs(X1 - T1), tol);
+    EXPECT_LT(tol, 1e-2 * a); // a meaningful bound (the differences met: 4e-5 |X1| at most)
+    // the term matters here: without it the response differs by far more than the bound
+    const std::vector<joints::Joint> linear{make("tip", 7, 0, {Term::k, Term::c}, {4800.0, 20.0})};
+    const frf::HarmonicBalanceResult without = frf::harmonic_balance(
+        c.H, linear, c.system.dofs, c.eq(7), t.F0, f, std::vector<int>{c.eq(7)}, o);
+    EXPECT_GT(std::abs(without.X(1, 0) - T1), 10.0 * tol);
+  }
+}
+
+TEST(HarmonicBalance, HysteresisHalfWaveSymmetricSolveEqualsTheFullOne) {
+  // The steady loop over half the period (y(t + T/2) = −y(t), the second half's samples the
+  // first's negated) and over the whole period give one steady state: the exact derivative's
+  // sign-turned entries included (else Newton would stall or converge slowly, not to 1e-12).
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1})};
+  frf::HarmonicBalanceOptions o;
+  o.harmonics = 9;
+  const frf::HarmonicBalanceResult half = frf::harmonic_balance(
+      c.H, js, c.system.dofs, c.eq(7), 6.0, 3.0, std::vector<int>{c.eq(7)}, o);
+  o.half_wave_symmetry = false;
+  const frf::HarmonicBalanceResult full = frf::harmonic_balance(
+      c.H, js, c.system.dofs, c.eq(7), 6.0, 3.0, std::vector<int>{c.eq(7)}, o);
+  ASSERT_TRUE(half.status.ok() && full.status.ok());
+  EXPECT_LE(half.iterations, 6);
+  EXPECT_LE(full.iterations, 6);
+  for (int k = 0; k <= o.harmonics; ++k)
+    EXPECT_LE(std::abs(half.X(k, 0) - full.X(k, 0)), 1e-9 * std::abs(full.X(1, 0))) << k;
+  // odd loop, odd load: no even harmonics, none in the full solve either
+  EXPECT_LE(std::abs(full.X(2, 0)), 1e-9 * std::abs(full.X(1, 0)));
+}
+
+TEST(HarmonicBalance, ParametricTermsOutOfRangeAreRefusedNamingTheKey) {
+  const PaperCantilever c;
+  joints::Joint j = parametric(Term::iwan, {3.0, 1.0e4, 0.5, 0.1});
+  const std::string message = test::error_of([&] {
+    frf::harmonic_balance(c.H, {j}, c.system.dofs, c.eq(7), 6.0, 3.0, std::vector<int>{c.eq(7)});
+  });
+  EXPECT_NE(message.find("'iwan.chi'"), std::string::npos) << message;
+  EXPECT_NE(message.find("in (-1, 0]"), std::string::npos) << message;
+  j.parameters[2][0].given = false; // fs not given
+  const std::string missing = test::error_of([&] {
+    frf::harmonic_balance(c.H, {j}, c.system.dofs, c.eq(7), 6.0, 3.0, std::vector<int>{c.eq(7)});
+  });
+  EXPECT_NE(missing.find("'iwan.fs' has no value"), std::string::npos) << missing;
 }

@@ -365,6 +365,95 @@ TEST_F(ModelFileTest, UnknownMaterialNameListsTheKnownOnes) {
                {"key 'material'", "\"steel\"", "\"steal\""});
 }
 
+TEST_F(ModelFileTest, ReadsNamedParametersOfTheParametricTerms) {
+  // "<term>.<parameter>" keys in values (quoted, or dotted: the same table), each given, fixed
+  // one by one or as a whole term; the coefficient of such a term is 1; [options] iwan_sliders
+  // reaches every joint.
+  std::string text = test::replaced(
+      cantilever_toml(),
+      "terms = [\"k\", \"c\", \"k3\"]\nvalues = { k = 4800.0, c = 20.0, k3 = 1.6e8 }",
+      "terms = [\"k\", \"iwan\", \"gap\"]\n"
+      "values = { k = 4800.0, \"iwan.fs\" = 3.0, \"iwan.kt\" = 1.0e4, \"iwan.chi\" = -0.5, "
+      "\"iwan.beta\" = 0.1, gap.delta = 1e-3 }\n"
+      "fixed = [\"iwan\", \"gap.delta\"]");
+  text += "\n[[joints]]\nname = \"j2\"\nnode = 4\ndof = \"uy\"\nterms = [\"jenkins\"]\n"
+          "values = { \"jenkins.kt\" = 2e4, \"jenkins.fs\" = 1.5 }\n"
+          "\n[options]\niwan_sliders = 40\n";
+  const ModelFile file = read_model(write(text));
+  ASSERT_EQ(file.joints.size(), 2u);
+  const joints::Joint& tip = file.joints[0];
+  EXPECT_EQ(tip.terms,
+            (std::vector<joints::Term>{joints::Term::k, joints::Term::iwan, joints::Term::gap}));
+  EXPECT_EQ(tip.values, (std::vector<double>{4800.0, 1.0, 1.0}));
+  EXPECT_EQ(tip.parameter(1, "fs"), 3.0);
+  EXPECT_EQ(tip.parameter(1, "kt"), 1.0e4);
+  EXPECT_EQ(tip.parameter(1, "chi"), -0.5);
+  EXPECT_EQ(tip.parameter(1, "beta"), 0.1);
+  EXPECT_EQ(tip.parameter(2, "delta"), 1e-3);
+  EXPECT_FALSE(tip.parameters_of(2)[1].given); // kg not given
+  EXPECT_TRUE(tip.parameters_of(2)[0].fixed);
+  EXPECT_EQ(tip.fixed, (std::vector<bool>{false, true, false}));
+  EXPECT_EQ(tip.given, (std::vector<bool>{true, true, false}));
+  EXPECT_EQ(tip.iwan_sliders, 40);
+  const joints::Joint& j2 = file.joints[1];
+  EXPECT_EQ(j2.parameter(0, "kt"), 2e4);
+  EXPECT_EQ(j2.parameter(0, "fs"), 1.5);
+  EXPECT_EQ(j2.fixed, (std::vector<bool>{false}));
+  EXPECT_EQ(j2.iwan_sliders, 40);
+}
+
+TEST_F(ModelFileTest, ParametersOutOfRangeOrMisnamedAreRefusedAtTheirLine) {
+  const std::string base = test::replaced(
+      cantilever_toml(),
+      "terms = [\"k\", \"c\", \"k3\"]\nvalues = { k = 4800.0, c = 20.0, k3 = 1.6e8 }",
+      "terms = [\"k\", \"iwan\", \"gap\"]\n"
+      "values = { k = 4800.0, \"iwan.fs\" = 3.0, \"iwan.kt\" = 1.0e4, \"iwan.chi\" = -0.5, "
+      "\"iwan.beta\" = 0.1, \"gap.delta\" = 1e-3, \"gap.kg\" = 2e4 }");
+  ASSERT_NO_THROW(read_model(write(base)));
+  struct Bad {
+    std::string from, to;
+    std::vector<std::string> parts;
+  };
+  const std::vector<Bad> bad{
+      {"\"iwan.chi\" = -0.5", "\"iwan.chi\" = 0.5", {"'values.iwan.chi'", "in (-1, 0]", "0.5"}},
+      {"\"iwan.chi\" = -0.5", "\"iwan.chi\" = -1.0", {"in (-1, 0]"}},
+      {"\"iwan.fs\" = 3.0", "\"iwan.fs\" = 0.0", {"'values.iwan.fs'", "> 0", "slip force"}},
+      {"\"iwan.kt\" = 1.0e4", "\"iwan.kt\" = -1.0e4", {"'values.iwan.kt'", "> 0"}},
+      {"\"iwan.beta\" = 0.1", "\"iwan.beta\" = -0.1", {"'values.iwan.beta'", ">= 0"}},
+      {"\"gap.delta\" = 1e-3",
+       "\"gap.delta\" = -1e-3",
+       {"'values.gap.delta'", ">= 0", "clearance"}},
+      {"\"gap.kg\" = 2e4", "\"gap.kg\" = -2e4", {"'values.gap.kg'", ">= 0"}},
+      {"\"iwan.beta\" = 0.1",
+       "\"iwan.phi\" = 0.1",
+       {"'phi' is not a parameter of 'iwan'", "fs, kt, chi, beta"}},
+      {"\"gap.kg\" = 2e4", "\"jenkins.kt\" = 2e4", {"'jenkins' is not among the joint's terms"}},
+      {"\"gap.kg\" = 2e4", "\"k.kt\" = 2e4", {"term 'k' has no named parameters"}},
+      {"\"gap.kg\" = 2e4", "iwan = 2e4", {"'values.iwan'", "named parameters", "\"iwan.fs\""}},
+  };
+  for (const Bad& b : bad) {
+    SCOPED_TRACE(b.to);
+    const std::string text = test::replaced(base, b.from, b.to);
+    expect_error(text, test::line_of(text, "values ="), std::initializer_list<std::string>{});
+    for (const auto& part : b.parts) {
+      try {
+        read_model(write(text));
+        ADD_FAILURE() << "accepted";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+      }
+    }
+  }
+  // fixed: a parameter without a value, a term with parameters missing
+  std::string text = test::replaced(base, ", \"gap.kg\" = 2e4 }", " }\nfixed = [\"gap.kg\"]");
+  expect_error(text, test::line_of(text, "fixed ="), {"key 'fixed'", "'gap.kg'", "no value"});
+  text = test::replaced(base, ", \"gap.kg\" = 2e4 }", " }\nfixed = [\"gap\"]");
+  expect_error(text, test::line_of(text, "fixed ="),
+               {"key 'fixed'", "not all of its parameters (delta, kg)"});
+  text = base + "\n[options]\niwan_sliders = 1\n";
+  expect_error(text, test::line_of(text, "iwan_sliders"), {"key 'iwan_sliders'", "from 2"});
+}
+
 TEST_F(ModelFileTest, JointValuesAndFixedMustNameListedTerms) {
   std::string text = test::replaced(cantilever_toml(), "k3 = 1.6e8 }", "k3 = 1.6e8, c2 = 1.0 }");
   expect_error(text, test::line_of(text, "c2 = 1.0"),

@@ -30,6 +30,10 @@ double table(Term t, double y, double v) {
     return std::pow(v, 3);
   case Term::fc:
     return v == 0.0 ? 0.0 : std::copysign(1.0, v);
+  case Term::jenkins: // parametric: no g(y, ẏ)
+  case Term::iwan:
+  case Term::gap:
+    break;
   }
   return NAN;
 }
@@ -48,7 +52,7 @@ std::string error_of(std::string_view name) {
 } // namespace
 
 TEST(Basis, ValuesFollowTheMethodTable) {
-  for (Term t : all_terms)
+  for (Term t : coefficient_terms)
     for (double y : samples)
       for (double v : samples)
         EXPECT_DOUBLE_EQ(basis(t, y, v), table(t, y, v)) << term_name(t) << " " << y << " " << v;
@@ -61,7 +65,7 @@ TEST(Basis, DerivativesMatchCentralDifferences) {
   // Central differences with step δ = 1e-5 (1 + |x|): truncation δ²|g'''|/6 ≤ 1e-10 (1+|x|)²·
   // (at most 6 for the cubics), cancellation eps|g|/δ ≈ 1e-10; 1e-7 (1 + |g'|) leaves margin
   // while a wrong factor (e.g. 2y for 3y²) is off by order 1.
-  for (Term t : all_terms)
+  for (Term t : coefficient_terms)
     for (double y : samples)
       for (double v : samples) {
         const double dy = 1e-5 * (1 + std::abs(y)), dv = 1e-5 * (1 + std::abs(v));
@@ -89,7 +93,7 @@ TEST(Basis, SamplesAddTheTableValuesAndDerivativesTimesTheCoefficient) {
       y.push_back(a), v.push_back(b);
   y.push_back(0.5), v.push_back(0.0);
   const std::size_t n = y.size();
-  for (Term t : all_terms) {
+  for (Term t : coefficient_terms) {
     const double b = -2.75;
     std::vector<double> g(n, 1.0), gy(n, 2.0), gv(n, 3.0);
     add_samples(t, b, y, v, g, gy, gv);
@@ -122,7 +126,7 @@ TEST(Basis, NamesEffectsAndUnitsFollowTheMethodTable) {
       {Term::c3, "c3", {"cubic", "damping"}, "N s^3/m^3"},
       {Term::fc, "fc", {"Coulomb", "friction"}, "N"},
   };
-  ASSERT_EQ(rows.size(), all_terms.size());
+  ASSERT_EQ(rows.size(), coefficient_terms.size());
   for (const auto& row : rows) {
     EXPECT_EQ(term_name(row.term), row.name);
     EXPECT_EQ(parse_term(row.name), row.term);
@@ -155,7 +159,7 @@ TEST(Basis, TableEntriesAreInEnumOrder) {
 // The properties the table declares (degree, parity, nature) are checked on g itself, so a
 // wrong entry — which would mislead discovery's diagnosis — fails here.
 TEST(Basis, DeclaredPropertiesHoldForTheForceLaw) {
-  for (Term t : all_terms) {
+  for (Term t : coefficient_terms) {
     const TermInfo& info = term_info(t);
     for (double y : samples)
       for (double v : samples) {
@@ -179,5 +183,64 @@ TEST(Basis, DeclaredPropertiesHoldForTheForceLaw) {
 }
 
 TEST(Basis, NameListComesFromTheTable) {
-  EXPECT_EQ(term_names(), "k, c, k2, k3, c2, c3, fc");
+  EXPECT_EQ(term_names(), "k, c, k2, k3, c2, c3, fc, jenkins, iwan, gap");
+}
+
+TEST(Basis, ParametricTermsNameTheirParametersUnitsAndRanges) {
+  // The rows of issue 32: jenkins (kt, fs), iwan (fs, kt, chi, beta), gap (delta, kg), each
+  // with the SI unit of a translational joint and the range a value must lie in.
+  struct Row {
+    Term term;
+    std::string name;
+    std::vector<std::string> parameters, units;
+    bool hysteretic;
+  };
+  const std::vector<Row> rows{
+      {Term::jenkins, "jenkins", {"kt", "fs"}, {"N/m", "N"}, true},
+      {Term::iwan, "iwan", {"fs", "kt", "chi", "beta"}, {"N", "N/m", "1", "1"}, true},
+      {Term::gap, "gap", {"delta", "kg"}, {"m", "N/m"}, false},
+  };
+  ASSERT_EQ(rows.size(), parametric_terms.size());
+  for (const Row& row : rows) {
+    EXPECT_EQ(term_name(row.term), row.name);
+    EXPECT_EQ(parse_term(row.name), row.term);
+    EXPECT_TRUE(has_parameters(row.term));
+    EXPECT_EQ(is_hysteretic(row.term), row.hysteretic);
+    const TermInfo& info = term_info(row.term);
+    ASSERT_EQ(info.parameters.size(), row.parameters.size()) << row.name;
+    for (std::size_t p = 0; p < row.parameters.size(); ++p) {
+      EXPECT_EQ(info.parameters[p].name, row.parameters[p]);
+      EXPECT_EQ(info.parameters[p].unit, row.units[p]) << row.parameters[p];
+      EXPECT_EQ(parameter_index(row.term, row.parameters[p]), static_cast<int>(p));
+    }
+    // no basis function: basis() refuses, naming the term
+    try {
+      basis(row.term, 0.1, 0.2);
+      ADD_FAILURE() << row.name << ": basis() accepted a parametric term";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("'" + row.name + "'"), std::string::npos);
+    }
+    EXPECT_EQ(info.degree, -1) << row.name; // not homogeneous: a slip force or a gap sets a scale
+    EXPECT_FALSE(info.even) << row.name;    // odd: no even harmonics under a symmetric load
+  }
+  for (Term t : coefficient_terms)
+    EXPECT_FALSE(has_parameters(t)) << term_name(t);
+  EXPECT_EQ(parameter_index(Term::iwan, "k"), -1);
+  // The ranges the model reader enforces (docs/formats/model_file.md).
+  auto range = [](Term t, const char* name) {
+    return term_info(t).parameters[static_cast<std::size_t>(parameter_index(t, name))];
+  };
+  EXPECT_TRUE(in_range(range(Term::iwan, "chi"), 0.0));
+  EXPECT_TRUE(in_range(range(Term::iwan, "chi"), -0.99));
+  EXPECT_FALSE(in_range(range(Term::iwan, "chi"), -1.0));
+  EXPECT_FALSE(in_range(range(Term::iwan, "chi"), 0.01));
+  EXPECT_EQ(range_text(range(Term::iwan, "chi")), "in (-1, 0]");
+  EXPECT_FALSE(in_range(range(Term::iwan, "fs"), 0.0));
+  EXPECT_EQ(range_text(range(Term::iwan, "fs")), "> 0");
+  EXPECT_TRUE(in_range(range(Term::iwan, "beta"), 0.0));
+  EXPECT_FALSE(in_range(range(Term::jenkins, "kt"), -1.0));
+  EXPECT_TRUE(in_range(range(Term::gap, "delta"), 0.0));
+  EXPECT_FALSE(in_range(range(Term::gap, "delta"), -1e-6));
+  EXPECT_EQ(range_text(range(Term::gap, "delta")), ">= 0");
+  EXPECT_FALSE(in_range(range(Term::gap, "kg"), std::nan("")));
 }

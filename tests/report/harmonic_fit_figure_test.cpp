@@ -80,9 +80,9 @@ TEST(ParameterFigure, RatiosAndIntervalsOfTheTermsTheModelGives) {
                       {true, true, false}};
   identify::FitResult r;
   r.joints.push_back({"tip",
-                      {{joints::Term::k, 4896.0, 24.0, 4848.0, 4944.0, false, true},
-                       {joints::Term::c, 20.0, 0.0, 20.0, 20.0, true, true},
-                       {joints::Term::k3, 1.7e8, 1e6, 1.68e8, 1.72e8, false, true}}});
+                      {{joints::Term::k, {}, 4896.0, 24.0, 4848.0, 4944.0, false, true},
+                       {joints::Term::c, {}, 20.0, 0.0, 20.0, 20.0, true, true},
+                       {joints::Term::k3, {}, 1.7e8, 1e6, 1.68e8, 1.72e8, false, true}}});
   const report::Figure f = report::parameter_figure(r, {model});
   ASSERT_EQ(f.charts.size(), 1u);
   const report::Chart& c = f.charts[0];

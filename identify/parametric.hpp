@@ -1,0 +1,53 @@
+#pragma once
+/// The parametric terms' parameters (jenkins, iwan, gap: joints/basis.hpp) enter the joint's
+/// force non-linearly, so the equation-error route Q b = p cannot estimate them. They are
+/// identified by output error (identify/output_error.hpp), started here from a
+/// describing-function fit:
+///  1. each test alone, the joint with the parametric term replaced by a linear spring and
+///     damper (k, c, its fixed terms kept) is fitted by equation error: its equivalent dynamic
+///     stiffness Z = k_eq + iω c_eq at the amplitude a of its deformation's fundamental;
+///  2. the term's describing function N(a) = G₁(a)/a (the first harmonic of its force under
+///     y = a cos ωt: its steady loop for a slider) plus the joint's non-fixed k and iω c is
+///     fitted to those Z(a) by Levenberg–Marquardt in the parameters' natural coordinates
+///     (logarithms of the positive ones), from a few starts read off the data (the stiffness
+///     lost between the smallest and largest amplitude, the dissipation's size).
+/// Amplitude-independent information only enters through Z(a): the start is as good as the
+/// amplitudes the tests span.
+#include "frf/substructure.hpp"
+#include "identify/fit.hpp"
+#include "identify/measurement.hpp"
+
+#include <complex>
+#include <string>
+#include <vector>
+
+namespace jointid::identify {
+
+/// N(a) of term t of the joint (its parameters checked): G₁/a under y = a cos θ.
+std::complex<double> describing_function(const joints::Joint& joint, std::size_t term,
+                                         double amplitude, int samples = 128);
+
+/// The amplitude of joint j's deformation fundamental in a test (|Y₁|, m), NaN when a DOF of
+/// the joint is not measured.
+double joint_amplitude(const Measurement& m, const joints::Joint& joint);
+
+/// Coordinates the fits move a parameter in: u = log p for a positive parameter (> 0 or >= 0
+/// unbounded above), chi = −1/(1 + e^{−u}) for an exponent in (−1, 0]; else p itself.
+double parameter_to_u(const joints::ParameterInfo& info, double p);
+double parameter_from_u(const joints::ParameterInfo& info, double u);
+
+/// The joints with every non-fixed parameter of a parametric term set (given, not fixed) to its
+/// describing-function estimate; `notes` gets one line per term (the amplitudes used, the
+/// relative misfit). At most one non-fixed parametric term per joint. Throws
+/// std::invalid_argument naming the joint when no test gives its equivalent stiffness.
+std::vector<joints::Joint> describing_function_start(const frf::Substructure& substructure,
+                                                     const std::vector<joints::Joint>& joints,
+                                                     const std::vector<Measurement>& tests,
+                                                     const FitOptions& fit_options,
+                                                     std::vector<std::string>& notes);
+
+/// The joints with every parametric term marked fixed (its parameters as they are): the
+/// equation-error fit then identifies the coefficient terms with these forces known.
+std::vector<joints::Joint> with_parametric_fixed(std::vector<joints::Joint> joints);
+
+} // namespace jointid::identify
