@@ -71,7 +71,7 @@ TEST(Diagnosis, AReceptanceThatFallsWithLevelIsNonLinearConservativeAtTheJoint) 
   const std::vector<discover::Candidate> ranking{explaining(std::nullopt, 0.10, 400.0),
                                                  explaining(Term::k3, 0.97, 20.0, 1.6e8),
                                                  explaining(Term::c2, 0.20, 300.0)};
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr, {});
   ASSERT_TRUE(d.level_dependent.has_value());
   EXPECT_TRUE(*d.level_dependent);
   EXPECT_EQ(d.joint, "tip");
@@ -109,7 +109,7 @@ TEST(Diagnosis, AReceptanceTheSameAtBothLevelsIsALinearModelError) {
   const Compared c = compared_values(measured, 2);
   const std::vector<discover::Candidate> ranking{explaining(std::nullopt, 0.95, 50.0),
                                                  explaining(Term::k3, 0.96, 49.0, 1e7)};
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.1), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.1), ranking, nullptr, {});
   ASSERT_TRUE(d.level_dependent.has_value());
   EXPECT_FALSE(*d.level_dependent);
   EXPECT_EQ(d.joint, "substructure");
@@ -141,7 +141,7 @@ TEST(Diagnosis, EvenHarmonicsInEveryTestPointToAnAsymmetricForce) {
   const Compared c = compared_values(measured, 2);
   const std::vector<discover::Candidate> ranking{explaining(std::nullopt, 0.10, 400.0),
                                                  explaining(Term::k2, 0.90, 20.0, 5e4)};
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr, {});
   EXPECT_TRUE(d.even_harmonics);
   EXPECT_TRUE(d.asymmetric);
   EXPECT_NEAR(d.even_content, 0.05, 1e-12);
@@ -157,7 +157,7 @@ TEST(Diagnosis, NothingAdmissibleSaysNothingIsMissing) {
   const Compared c = compared_values(measured, 2);
   std::vector<discover::Candidate> ranking{explaining(Term::k3, 0.01, 60.0)};
   ranking[0].rejected = "explains too little";
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.001), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.001), ranking, nullptr, {});
   EXPECT_FALSE(d.level_dependent.has_value());
   EXPECT_TRUE(says(d, "No candidate explains a significant share of the disagreement: nothing is "
                       "missing that these tests can reveal."))
