@@ -62,6 +62,7 @@ ResponseCurve sweep(const Problem& problem, const State& state,
   std::optional<Eigen::MatrixXcd> previous;
   std::optional<frf::HarmonicBalance> fixed_frequency;
   for (int p = 0; p < points; ++p) {
+    if (problem.options().checkpoint) problem.options().checkpoint();
     const double u = static_cast<double>(down ? points - 1 - p : p) / (points - 1);
     const double x = over_frequency ? lo + (hi - lo) * u : lo * std::pow(hi / lo, u);
     const double f = over_frequency ? x : s.means[g], amplitude = over_frequency ? s.means[g] : x;

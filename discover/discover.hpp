@@ -52,6 +52,7 @@
 #include "identify/measurement.hpp"
 #include "joints/joint.hpp"
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,6 +78,11 @@ struct Options {
   int finalists = 3;
   /// Points of each state's response curves for the report (0: none).
   int curve_points = 30;
+  /// Called before every re-simulation of a test (a harmonic balance, or a time integration
+  /// for the simulation's own error), from the threads the candidates run on, possibly at the
+  /// same time: an exception thrown from it stops the run and leaves discover() (e.g. an
+  /// interrupt of a caller that checks for one). Empty: nothing is called.
+  std::function<void()> checkpoint;
 };
 
 /// A term whose value, identified from each test alone (the other terms held), changes between

@@ -52,12 +52,10 @@ Problem::Problem(const frf::Substructure& sub, const std::vector<joints::Joint>&
 
 int Problem::equation(const identify::Measurement& m, const std::string& what,
                       const fem::NodeDof& at) {
-  try {
-    return dofs_.equation(at);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(m.source + ": channel " + what + fem::to_string(at) + ": " +
-                                e.what());
-  }
+  // The record's channel is at fault, not the model: say what the model has.
+  if (const std::string why = dofs_.why_not_free(at); !why.empty())
+    throw std::invalid_argument(m.source + ": " + what + fem::to_string(at) + ": " + why);
+  return dofs_.equation(at);
 }
 
 // Equations: the joints' DOFs, every force and every response of every test; the band the
@@ -74,8 +72,9 @@ void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
     for (const auto& at : m.force_at)
       forces.push_back(equation(m, "force channel f@", at));
     for (std::size_t j = 0; j < m.response_at.size(); ++j)
-      responses.push_back(equation(
-          m, std::string(1, identify::quantity_letter(m.measured_as[j])) + "@", m.response_at[j]));
+      responses.push_back(
+          equation(m, std::string("channel ") + identify::quantity_letter(m.measured_as[j]) + "@",
+                   m.response_at[j]));
     for (int e : forces)
       add_unique(synthesis_dofs_, e);
     for (int e : responses)
@@ -298,6 +297,7 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
 frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,
                                           const std::vector<joints::Joint>& joints,
                                           const Eigen::MatrixXcd* warm) const {
+  if (o_.checkpoint) o_.checkpoint();
   if (!friction_problem(joints).empty()) { // fc < 0: no steady state to speak of
     frf::HarmonicBalanceResult none;
     none.X = Eigen::MatrixXcd::Constant(sim.harmonics + 1, response_eq_[i].size(), nan);

@@ -39,6 +39,7 @@ void Problem::propagate_force_noise(const State& s, const Simulator& sim) {
   for (auto& e : compared_.entries)
     e.force = 0.0;
   for (std::size_t i = 0; i < tests_.size(); ++i) {
+    if (o_.checkpoint) o_.checkpoint();
     const auto& m = tests_[i];
     for (Eigen::Index c = 0; c < drive_[i].cols(); ++c) {
       const double v = m.F_variance.size() > 0 ? m.F_variance(1, c) : nan;
@@ -70,6 +71,7 @@ double Problem::estimate_simulation_error(State& s) {
   if (has_friction(s.joints)) exact = time_integrated(s);
   double E = 0.0;
   for (std::size_t i = 0; i < tests_.size(); ++i) {
+    if (o_.checkpoint) o_.checkpoint();
     Eigen::MatrixXcd reference;
     double factor = 1.0;
     // Time integration from rest may settle on another branch than the measured one (a jump):
@@ -125,6 +127,7 @@ std::vector<Eigen::MatrixXcd> Problem::time_integrated(const State& s) const {
   std::vector<std::function<Eigen::MatrixXcd()>> jobs;
   for (std::size_t i = 0; i < tests_.size(); ++i)
     jobs.push_back([&, i]() -> Eigen::MatrixXcd {
+      if (o_.checkpoint) o_.checkpoint();
       const auto& m = tests_[i];
       // One force, a pure sine: what the integrator's load can be.
       if (force_eq_[i].size() != 1) return {};

@@ -22,12 +22,7 @@ using Eigen::VectorXd;
 
 constexpr double eps = std::numeric_limits<double>::epsilon();
 
-// Coefficients of an orthonormalisation: Z_in = V C + Z_out R (V the basis it was made
-// orthogonal to).
-struct Projection {
-  MatrixXd C; // m × q
-  MatrixXd R; // kept × q
-};
+using detail::Projection;
 
 // Y = Z S for an n × q block Z and a small q × k matrix S, on the system BLAS (every core),
 // into Y's storage when it already has the size: at 10⁶ DOFs a new n × 8 block costs more in
@@ -127,6 +122,8 @@ MatrixXd basis_times(const MatrixXd& V, Index m, const MatrixXd& S) {
   return Y;
 }
 
+} // namespace
+
 // Makes Z M-orthonormal and M-orthogonal to the first m columns of V: `passes` passes of
 // block classical Gram–Schmidt (two for a block never projected before; one after a first
 // projection the caller made, the Lanczos step against the last blocks), then SVQB, repeated
@@ -135,9 +132,10 @@ MatrixXd basis_times(const MatrixXd& V, Index m, const MatrixXd& S) {
 // `relative_floor` times the largest column's before any projection) are dropped; `removed`
 // holds, per column, the M-norm² a caller's first projection took away (empty: none). MZ holds
 // M Z of the result.
-Projection orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m, MatrixXd& Z,
-                          MatrixXd& MZ, double relative_floor, MatrixXd& scratch, int passes = 2,
-                          const Eigen::RowVectorXd& removed = {}) {
+Projection detail::orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m,
+                                  MatrixXd& Z, MatrixXd& MZ, double relative_floor,
+                                  MatrixXd& scratch, int passes,
+                                  const Eigen::RowVectorXd& removed) {
   Projection p;
   p.C = MatrixXd::Zero(m, Z.cols());
   P.mass(Z, MZ);
@@ -168,9 +166,13 @@ Projection orthonormalise(const ShiftInvertPencil& P, const MatrixXd& V, Index m
     add_basis_times(Z, -1.0, V, m, e); // Z_in = V (C + e R) + Z' R
     p.C += e * p.R;
     p.R = svqb(P, Z, MZ, 0.0, scratch) * p.R;
+    ++p.rounds;
   }
   return p;
 }
+
+namespace {
+using detail::orthonormalise;
 
 // V.leftCols(k) ← V.leftCols(m) S (S is m × k, k ≤ m) in place, a slab of rows at a time, so
 // no second n × k matrix is needed.

@@ -84,4 +84,23 @@ struct BlockLanczosResult {
 /// Not converging within max_restarts is a result (status not_converging), not an exception.
 BlockLanczosResult block_lanczos(ShiftInvertPencil& pencil, const BlockLanczosOptions& options);
 
+namespace detail {
+/// Coefficients of an orthonormalisation: Z_in = V C + Z_out R (V the basis it was made
+/// orthogonal to); `rounds`: the re-check rounds it took after the passes (0 when the last
+/// pass removed little, "twice is enough").
+struct Projection {
+  Eigen::MatrixXd C; ///< m × q
+  Eigen::MatrixXd R; ///< kept × q
+  int rounds = 0;
+};
+/// The block Lanczos's orthonormalisation, exposed for its tests: makes Z M-orthonormal and
+/// M-orthogonal to the first m columns of the M-orthonormal V by `passes` passes of block
+/// classical Gram–Schmidt, then SVQB, then re-check rounds while the last pass removed more
+/// than half of a column (see block_lanczos.cpp). MZ holds M Z of the result.
+Projection orthonormalise(const ShiftInvertPencil& P, const Eigen::MatrixXd& V, Eigen::Index m,
+                          Eigen::MatrixXd& Z, Eigen::MatrixXd& MZ, double relative_floor,
+                          Eigen::MatrixXd& scratch, int passes = 2,
+                          const Eigen::RowVectorXd& removed = {});
+} // namespace detail
+
 } // namespace jointid::fem

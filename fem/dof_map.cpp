@@ -2,13 +2,36 @@
 
 #include "fem/elements.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace jointid::fem {
 
 namespace {
 constexpr int absent = -2, fixed = -1;
+
+// Node ids as sorted ranges, "1–7, 10, 12–15", at most `shown` ranges ("…, 120 nodes in all").
+std::string node_ranges(std::vector<int> ids) {
+  std::sort(ids.begin(), ids.end());
+  std::string out;
+  constexpr int shown = 6;
+  int ranges = 0;
+  for (std::size_t i = 0; i < ids.size();) {
+    std::size_t j = i;
+    while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1)
+      ++j;
+    if (ranges == shown) {
+      out += ", … (" + std::to_string(ids.size()) + " nodes in all)";
+      break;
+    }
+    out += (out.empty() ? "" : ", ") + std::to_string(ids[i]);
+    if (j > i) out += (j == i + 1 ? ", " : "–") + std::to_string(ids[j]);
+    ++ranges;
+    i = j + 1;
+  }
+  return out.empty() ? std::string("none") : out;
 }
+} // namespace
 
 DofMap::DofMap(const Model& model) {
   const std::size_t n = model.nodes.size();
@@ -83,6 +106,47 @@ int DofMap::equation(const NodeDof& nd) const {
                                          : " (no element or spring at the node uses it)"));
   if (e == fixed) throw std::invalid_argument("DOF " + to_string(nd) + " is fixed by a support");
   return e;
+}
+
+std::string DofMap::why_not_free(const NodeDof& nd) const {
+  const int i = index_of(nd.node);
+  // The DOFs node i has, with `which` (absent: every DOF it has; fixed: the free ones).
+  const auto dofs_of = [&](bool free_only) {
+    std::string list;
+    for (Dof d : all_dofs) {
+      const int e = eq_[i][static_cast<int>(d)];
+      if (e == absent || (free_only && e == fixed)) continue;
+      list += (list.empty() ? "" : ", ") + std::string(dof_name(d));
+    }
+    return list;
+  };
+  if (i < 0) {
+    if (!listed_)
+      return "the model has no node " + std::to_string(nd.node) +
+             " (its nodes: " + node_ranges(node_ids_) + ")";
+    std::string list;
+    for (std::size_t e = 0; e < by_equation_.size() && e < 8; ++e)
+      list += (list.empty() ? "" : ", ") + to_string(by_equation_[e]);
+    if (by_equation_.size() > 8)
+      list += ", … (" + std::to_string(by_equation_.size()) + " DOFs in all)";
+    return "the substructure has no DOF at node " + std::to_string(nd.node) +
+           " (it is known at its listed DOFs only: " + (list.empty() ? "none" : list) + ")";
+  }
+  const int e = eq_[i][static_cast<int>(nd.dof)];
+  if (e == absent) {
+    const std::string has = dofs_of(false);
+    return "node " + std::to_string(nd.node) + " has no DOF " + std::string(dof_name(nd.dof)) +
+           (listed_ ? " among the substructure's DOFs (" : " in the model (") +
+           (has.empty() ? "it has none" : "its DOFs: " + has) + ")";
+  }
+  if (e == fixed) {
+    const std::string free = dofs_of(true);
+    return "a support of the model holds " + to_string(nd) + " fixed (" +
+           (free.empty() ? "node " + std::to_string(nd.node) + " has no free DOF"
+                         : "the free DOFs of node " + std::to_string(nd.node) + ": " + free) +
+           ")";
+  }
+  return "";
 }
 
 std::array<int, 6> DofMap::node_equations(int node_id) const {

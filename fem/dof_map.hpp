@@ -6,6 +6,7 @@
 #include "fem/model.hpp"
 
 #include <array>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -27,6 +28,11 @@ public:
   /// Equation of a free DOF; throws std::invalid_argument saying whether the node does not
   /// exist, does not have that DOF, or has it fixed by a support.
   int equation(const NodeDof& nd) const;
+  /// Why `nd` is not a free DOF, saying what the model has instead ("" when it is free), for
+  /// messages that blame what refers to it (a record's channel, an option), not the model:
+  /// "the model has no node 99 (its nodes: 1–7)", "node 7 has no DOF uz in the model (its
+  /// DOFs: ux, uy, rz)", "a support of the model holds 1:uy fixed (node 1 has no free DOF)".
+  std::string why_not_free(const NodeDof& nd) const;
   const NodeDof& node_dof(int equation) const { return by_equation_.at(equation); }
   /// Node ids in model order, and every node's equation numbers (-1 where absent or fixed).
   const std::vector<int>& node_ids() const { return node_ids_; }

@@ -12,17 +12,26 @@
 namespace jointid::fem {
 
 /// Runs every job, on up to hardware_concurrency() threads, and returns their results in the
-/// order of the list. The first exception (in list order) is rethrown after all have finished.
+/// order of the list. Once a job has thrown, no further job is started (jobs start in list
+/// order, so none before it is left out); the first exception in list order is rethrown after
+/// the running ones have finished. An interrupt thrown from one job's progress callback so stops
+/// the whole map after the jobs in progress.
 template <class T> std::vector<T> parallel_map(const std::vector<std::function<T()>>& jobs) {
   std::vector<std::optional<T>> results(jobs.size());
   std::vector<std::exception_ptr> errors(jobs.size());
   std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
   auto worker = [&] {
-    for (std::size_t i = next++; i < jobs.size(); i = next++) {
+    // A job is taken only while none has failed, and a job taken is run: jobs before a failed
+    // one were taken before it, so they all run.
+    while (!failed) {
+      const std::size_t i = next++;
+      if (i >= jobs.size()) return;
       try {
         results[i].emplace(jobs[i]());
       } catch (...) {
         errors[i] = std::current_exception();
+        failed = true;
       }
     }
   };

@@ -1,6 +1,7 @@
 #include "frf/continuation.hpp"
 
 #include "frf/hb_equations.hpp"
+#include "joints/basis.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -482,6 +483,33 @@ ResponseCurves response_curves(const Substructure& sub, const std::vector<joints
   if (!synthesis.status().ok()) {
     out.status = synthesis.status();
     return out;
+  }
+  // An undamped mode where the harmonics reach (fundamental to harmonic K): only the joints can
+  // bound its resonance; without a dissipative joint term it is unbounded there, and the points
+  // near it are the arithmetic's limits (|X| of 1e14 m), not a response. Said, with the cure.
+  {
+    bool dissipates = false;
+    for (const auto& j : joints)
+      for (std::size_t t = 0; t < j.terms.size(); ++t)
+        if (joints::term_info(j.terms[t]).nature == joints::Nature::dissipative &&
+            j.values[t] != 0.0)
+          dissipates = true;
+    const double lo = std::min(start_hz, end_hz),
+                 hi = std::max(start_hz, end_hz) * std::max(1, o.hb.harmonics);
+    const Eigen::VectorXd& w = synthesis.natural_frequencies();
+    const Eigen::VectorXd& d = synthesis.modal_damping();
+    for (Eigen::Index r = 0; r < w.size(); ++r) {
+      const double f = w(r) / two_pi;
+      if (d(r) == 0.0 && f >= lo && f <= hi)
+        out.notes.push_back(
+            "mode " + std::to_string(r + 1) + " (" + hz(f) +
+            ") has no damping (modal damping 0) and lies where the harmonics reach (" + hz(lo) +
+            " to " + hz(hi) + "): " +
+            (dissipates ? "only the joints' damping bounds its resonance"
+                        : "no joint term dissipates either, so its resonance is unbounded and "
+                          "the points near it are the arithmetic's limits, not a response") +
+            "; give the model damping ([damping])");
+    }
   }
   for (std::size_t i = 0; i < amplitudes.size(); ++i) {
     std::function<void(double)> each;

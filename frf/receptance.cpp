@@ -250,6 +250,13 @@ CMatrix ModalSynthesis::receptances(std::span<const double> omegas, std::span<co
     for (int r = 0; r < m; ++r) {
       const double a = omega_(r) * omega_(r) - omega * omega, b = modal_damping_(r) * omega;
       const double d = a * a + b * b;
+      // A 0 Hz mode (rigid-body motion) has no static receptance: at 0 Hz (harmonic 0, the
+      // mean) its term is infinite. Named here, rather than let it turn every result into NaN.
+      if (!(d > 0.0) && omega == 0.0 && omega_(r) == 0.0)
+        throw std::invalid_argument(
+            "receptance: mode " + std::to_string(r + 1) +
+            " is at 0 Hz (a rigid-body motion), so the receptance at 0 Hz (harmonic 0, the "
+            "static mean) is infinite: support the substructure, or leave harmonic 0 out");
       modal(r, k) = d > 0.0 ? Complex(a / d, -b / d) : 1.0 / Complex(a, b);
     }
   }

@@ -2,6 +2,8 @@
 
 #include "fem/damping.hpp"
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -63,6 +65,32 @@ Substructure::Substructure(fem::Assembled system, fem::Damping damping) : dampin
       throw std::invalid_argument("M: diagonal entry " + std::to_string(i + 1) + " (" +
                                   fem::to_string(system.dofs.node_dof(i)) +
                                   ") is negative: " + number(system.M.coeff(i, i)));
+  // K positive definite: a substructure given by its matrices is held (no rigid-body motion,
+  // no mechanism) and has no negative stiffness; otherwise its first modes are at 0 Hz (or
+  // imaginary) and every receptance near them meaningless. The LDLᵀ factorisation (fill-reducing
+  // order) finds it: a pivot that is not above 1e-10 of its row's diagonal (rounding of a
+  // positive definite K leaves it far above that) is where it breaks down.
+  {
+    const Eigen::SimplicialLDLT<fem::SparseMatrix> ldlt(system.K);
+    const Eigen::VectorXd D = ldlt.vectorD();
+    const auto& to_original = ldlt.permutationPinv().indices();
+    for (Eigen::Index i = 0; i < D.size(); ++i) {
+      const int e = to_original(i);
+      const double diagonal = system.K.coeff(e, e);
+      if (D(i) > 1e-10 * std::abs(diagonal)) continue;
+      throw std::invalid_argument(
+          "K is not positive definite: its factorisation breaks down at " +
+          fem::to_string(system.dofs.node_dof(e)) + " (pivot " + number(D(i)) + ", diagonal " +
+          number(diagonal) + "): " +
+          (D(i) < -1e-10 * std::abs(diagonal)
+               ? "a negative stiffness"
+               : "a rigid-body motion or a mechanism (a 0 Hz mode)") +
+          " there; K and M must describe a supported structure (add its supports to K)");
+    }
+    if (ldlt.info() != Eigen::Success)
+      throw std::invalid_argument("K is not positive definite: its factorisation fails; K and M "
+                                  "must describe a supported structure (add its supports to K)");
+  }
   system_ = std::move(system);
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace jointid::identify {
@@ -19,13 +20,11 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
   if (responses.empty())
     throw std::invalid_argument(
         fmt::format("{}: no response channel (expected x@, v@ or a@NODE:DOF columns)", name));
-  for (const auto& c : measured.channels)
-    try {
-      sub.dofs().equation(c.at);
-    } catch (const std::invalid_argument& e) {
+  for (const auto& c : measured.channels) // the record's channel is at fault, not the model
+    if (const std::string why = sub.dofs().why_not_free(c.at); !why.empty())
       throw std::invalid_argument(
-          fmt::format("{}: channel {}: {} in the model", name, c.name(), e.what()));
-    }
+          fmt::format("{}: {} {}: {}", name,
+                      c.quantity == Quantity::force ? "force channel" : "channel", c.name(), why));
   const double fs = input.sample_rate_hz, nyquist = 0.5 * fs;
   const Eigen::Index n = measured.t.size();
   const double duration = static_cast<double>(n) / fs;
@@ -97,6 +96,11 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
   for (const Channel* c : responses) {
     const Channel* p = out.prediction.record.find(c->quantity, c->at);
     if (!p) throw std::logic_error("compare: a predicted channel is missing");
+    if (!(c->samples.tail(kept).cwiseAbs().maxCoeff() > 0.0))
+      throw std::invalid_argument(fmt::format(
+          "{}: channel {}: zero in every sample after the first {} s: nothing was measured there "
+          "to compare",
+          name, c->name(), static_cast<double>(first) / fs));
     Eigen::MatrixXd both(kept, 2);
     both << c->samples.tail(kept), p->samples.tail(kept);
     const WelchSpectra s = welch(both, fs, welch_options);
@@ -119,16 +123,42 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
     cc.predicted.resize(m);
     cc.difference_db.resize(m);
     const Eigen::VectorXd gm = s.psd(0), gp = s.psd(1);
-    const double floor = 1e-300;
+    // A line where either spectrum is below 1e-20 (-200 dB) of the larger peak of the two in
+    // the band holds the arithmetic's floor, not a measurement (a 24-bit converter spans 144 dB):
+    // its difference is no difference (NaN, written null) and is left out of the RMS and the
+    // maximum.
+    double peak = 0.0;
+    for (const Eigen::Index k : bins)
+      peak = std::max({peak, gm(k), gp(k)});
+    const double floor = 1e-20 * peak;
+    int at_floor = 0;
+    double sum = 0.0, largest = 0.0;
     for (Eigen::Index i = 0; i < m; ++i) {
       const Eigen::Index k = bins[static_cast<std::size_t>(i)];
       cc.frequency_hz(i) = s.frequency_hz(k);
       cc.measured(i) = gm(k);
       cc.predicted(i) = gp(k);
-      cc.difference_db(i) = 10.0 * std::log10(std::max(gp(k), floor) / std::max(gm(k), floor));
+      if (!(gm(k) > floor && gp(k) > floor)) {
+        cc.difference_db(i) = std::numeric_limits<double>::quiet_NaN();
+        ++at_floor;
+        continue;
+      }
+      cc.difference_db(i) = 10.0 * std::log10(gp(k) / gm(k));
+      sum += cc.difference_db(i) * cc.difference_db(i);
+      largest = std::max(largest, std::abs(cc.difference_db(i)));
     }
-    cc.rms_db = std::sqrt(cc.difference_db.squaredNorm() / static_cast<double>(m));
-    cc.max_db = cc.difference_db.cwiseAbs().maxCoeff();
+    if (at_floor == m)
+      throw std::invalid_argument(fmt::format(
+          "{}: channel {}: the {} spectrum is below -200 dB of the other's peak on every line "
+          "of the band {}:{} Hz: nothing to compare",
+          name, cc.channel, gm.maxCoeff() <= floor ? "measured" : "predicted", f0, f1));
+    cc.rms_db = std::sqrt(sum / static_cast<double>(m - at_floor));
+    cc.max_db = largest;
+    if (at_floor > 0)
+      out.notes.push_back(fmt::format(
+          "channel {}: {} of {} lines below -200 dB of the spectra's peak (the arithmetic's "
+          "floor) left out of the differences (null in difference_db)",
+          cc.channel, at_floor, m));
     out.channels.push_back(std::move(cc));
   }
   out.f0_hz = f0;

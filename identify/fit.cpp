@@ -49,12 +49,11 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   s.frequency_hz = m.frequency_hz;
   s.fundamental_only = m.fundamental_only;
   for (const auto& at : m.force_at) {
-    try {
-      s.force_equations.push_back(dofs.equation(at));
-    } catch (const std::invalid_argument& e) {
-      fail("force channel f@" + fem::to_string(at) + ": " + e.what() +
-           " (a force must act on a free DOF of the model)");
-    }
+    // The record's channel is at fault, not the model: say what the model has.
+    if (const std::string why = dofs.why_not_free(at); !why.empty())
+      fail("force channel f@" + fem::to_string(at) + ": " + why +
+           "; a force must act on a free DOF of the model");
+    s.force_equations.push_back(dofs.equation(at));
   }
   s.F = m.F;
 
@@ -538,6 +537,39 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
       throw std::invalid_argument("identify: term " + name_of(u) +
                                   " has no effect in these tests (its basis function is zero)");
 
+  // The terms that cannot be told apart, all of them: the near-null space of the column-scaled
+  // Q (right singular vectors whose singular value is below 1e-13 of the largest) holds the
+  // combinations that have no effect; a term takes part when its share of them (the norm of its
+  // row there) is at least a tenth of the largest share. An unrelated term's share is of the
+  // order of the rounding (1e-10 at most), a twin's 1/sqrt(2): the set does not depend on it.
+  auto inseparable_reason = [&](const Eigen::VectorXd& sv, const Eigen::MatrixXd& V,
+                                double condition) {
+    Eigen::Index null = 0;
+    while (null < nu && !(sv(nu - 1 - null) > 1e-13 * sv(0)))
+      ++null;
+    null = std::max<Eigen::Index>(null, 1);
+    const Eigen::VectorXd share = V.rightCols(null).rowwise().norm();
+    std::vector<std::string> names;
+    for (int u = 0; u < nu; ++u)
+      if (share(u) >= 0.1 * share.maxCoeff()) names.push_back(name_of(u));
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i)
+      list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+    if (names.size() < 2)
+      return fmt::format("the unknowns cannot be separated by these tests (condition number "
+                         "{:.3g}): term {} has almost no effect of its own: vary frequency and "
+                         "force level, or drop it",
+                         condition, list);
+    const std::string combinations =
+        null == 1 ? std::string("a combination of them has")
+                  : fmt::format("{} independent combinations of them have", null);
+    return fmt::format("the unknowns cannot be separated by these tests (condition number "
+                       "{:.3g}): terms {} act alike ({} no effect in these tests), so none of "
+                       "them can be told from the others: vary frequency and force level, or "
+                       "drop one of them",
+                       condition, list, combinations);
+  };
+
   // 2. Least squares of the column-scaled (and, with the noise, whitened) equations by SVD.
   struct Solution {
     Eigen::VectorXd b, scale, sv;
@@ -557,12 +589,7 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     sol.condition =
         sol.sv(nu - 1) > 0.0 ? sol.sv(0) / sol.sv(nu - 1) : std::numeric_limits<double>::infinity();
     if (!(sol.condition < 1e13)) {
-      Eigen::Index worst;
-      svd.matrixV().col(nu - 1).cwiseAbs().maxCoeff(&worst);
-      sol.inseparable = fmt::format(
-          "the unknowns cannot be separated by these tests (condition number {:.3g}); term {} is "
-          "a combination of the others: vary frequency and force level, or drop a term",
-          sol.condition, name_of(static_cast<int>(worst)));
+      sol.inseparable = inseparable_reason(sol.sv, sol.V, sol.condition);
       sol.b = Eigen::VectorXd::Constant(nu, nan);
       return sol;
     }
@@ -792,13 +819,11 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     warnings.insert(warnings.end(), m.warnings.begin(), m.warnings.end());
     // Response channels on DOFs the model does not have, or holds fixed, are not used: said.
     for (std::size_t r = 0; r < m.response_at.size(); ++r) {
-      const fem::DofMap::State state = dofs.state(m.response_at[r]);
-      if (state == fem::DofMap::State::free) continue;
-      warnings.push_back(
-          fmt::format("{}: channel {}@{}: {}; the channel is not used", m.source,
-                      quantity_letter(m.measured_as[r]), fem::to_string(m.response_at[r]),
-                      state == fem::DofMap::State::absent ? "the model has no such DOF"
-                                                          : "a support holds this DOF fixed"));
+      const std::string why = dofs.why_not_free(m.response_at[r]);
+      if (why.empty()) continue;
+      warnings.push_back(fmt::format("{}: channel {}@{}: {}; the channel is not used", m.source,
+                                     quantity_letter(m.measured_as[r]),
+                                     fem::to_string(m.response_at[r]), why));
     }
     tests.push_back(spectrum(m, dofs, joints, warnings));
     tables += m.fundamental_only ? 1 : 0;

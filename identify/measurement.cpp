@@ -109,7 +109,17 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
   m.source = r.source;
   m.harmonics = K;
   const auto forces = r.all(Quantity::force);
-  if (forces.empty()) fail("no force channel (expected a column such as f@7:uy)");
+  // Worded for every format a record is read from (CSV columns, UFF58 datasets).
+  const auto channel_list = [&] {
+    std::string names;
+    for (const auto& c : r.channels)
+      names += (names.empty() ? "" : ", ") + c.name();
+    return names.empty() ? std::string("none") : names;
+  };
+  if (forces.empty())
+    fail("no force channel among its channels (" + channel_list() +
+         "): a test needs its excitation force (a channel f@NODE:DOF) recorded with the "
+         "responses");
   // Response DOFs in order of first appearance, each with its best channel (x, then v, then a).
   std::vector<const Channel*> best;
   for (const auto& c : r.channels) {
@@ -125,7 +135,9 @@ Measurement measure_record(const Record& r, const MeasureOptions& o) {
     }
   }
   if (best.empty())
-    fail("no response channel (expected x, v or a columns such as x@7:uy next to the force)");
+    fail("no response channel among its channels (" + channel_list() +
+         "): a test needs a displacement, velocity or acceleration recorded with its force, "
+         "e.g. x@" + fem::to_string(forces.front()->at));
 
   // A force channel that is zero in every sample measured no force.
   std::vector<const Channel*> loaded;
@@ -321,6 +333,19 @@ Measurement measure_phasors(const Phasors& row, const MeasureOptions& o) {
   }
   if (forces.empty()) fail("no force channel (expected columns such as f@7:uy.re, f@7:uy.im)");
   if (responses.empty()) fail("no response channel (expected x, v or a columns)");
+  // A zero force phasor measured no force, as a record's force channel zero in every sample:
+  // one of several is said, every one is refused (the row would identify from nothing).
+  std::string zero_forces;
+  for (std::size_t i = 0; i < forces.size(); ++i)
+    if (forces[i] == Complex(0.0, 0.0)) {
+      const std::string name = "f@" + fem::to_string(m.force_at[i]);
+      m.warnings.push_back(row.source + ": channel " + name +
+                           ": zero (no force was measured there)");
+      if (zero_forces.empty()) zero_forces = name;
+    }
+  if (std::all_of(forces.begin(), forces.end(), [](Complex f) { return f == Complex(0.0, 0.0); }))
+    fail("every force channel is zero (" + zero_forces +
+         "): no force was measured; a sine test needs its force");
   const auto nf = static_cast<Eigen::Index>(forces.size()),
              nr = static_cast<Eigen::Index>(responses.size());
   m.F = Eigen::MatrixXcd::Zero(K + 1, nf);

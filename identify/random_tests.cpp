@@ -1,6 +1,7 @@
 #include "identify/random_tests.hpp"
 
 #include "identify/sine_tests.hpp"
+#include "identify/spectra.hpp"
 
 #include "fem/excitation.hpp"
 #include "fem/modal.hpp"
@@ -38,6 +39,17 @@ ForceInput force_input(const Record& record) {
     in.at.push_back(forces[j]->at);
     in.samples.col(static_cast<Eigen::Index>(j)) = forces[j]->samples;
   }
+  // A force zero in every sample drives nothing: the response would be zero, and a comparison
+  // with it a comparison with the arithmetic's floor.
+  if (in.samples.size() > 0 && in.samples.cwiseAbs().maxCoeff() == 0.0)
+    throw std::invalid_argument(fmt::format(
+        "{}: every force channel is zero in every sample ({}): no force to drive the model",
+        record.source, [&] {
+          std::string names;
+          for (const Channel* c : forces)
+            names += (names.empty() ? "" : ", ") + c->name();
+          return names;
+        }()));
   in.description = fmt::format(
       "force: the channels {} of {}",
       [&] {
@@ -49,6 +61,30 @@ ForceInput force_input(const Record& record) {
       record.source);
   return in;
 }
+
+namespace {
+// The frequency below which `fraction` of the force's power lies (all its channels, a Welch
+// spectrum of up to 4096-sample segments); 0 for fewer than 16 samples.
+double power_band_hz(const ForceInput& in, double fraction) {
+  const Eigen::Index n = in.samples.rows();
+  if (n < 16) return 0.0;
+  int segment = 16;
+  while (2 * segment <= std::min<Eigen::Index>(n, 4096))
+    segment *= 2;
+  const WelchSpectra s = welch(in.samples, in.sample_rate_hz, {segment, 0.5});
+  Eigen::VectorXd power = Eigen::VectorXd::Zero(s.frequency_hz.size());
+  for (Eigen::Index j = 0; j < in.samples.cols(); ++j)
+    power += s.psd(static_cast<int>(j));
+  const double total = power.sum();
+  if (!(total > 0.0)) return 0.0;
+  double sum = 0.0;
+  for (Eigen::Index k = 0; k < power.size(); ++k) {
+    sum += power(k);
+    if (sum >= fraction * total) return s.frequency_hz(k);
+  }
+  return s.frequency_hz(power.size() - 1);
+}
+} // namespace
 
 ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joints::Joint>& joints,
                            const ForceInput& in, const ForcedOptions& o) {
@@ -111,6 +147,9 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
                          dofs.num_equations(), o.substeps);
   } else {
     const double cutoff = o.modal_cutoff_hz > 0.0 ? o.modal_cutoff_hz : 0.5 * in.sample_rate_hz;
+    // The frequency below which 99 % of the force's power lies: a mode left out below it is
+    // driven at its resonance, which the static correction does not hold.
+    const double force_band = power_band_hz(in, 0.99);
     // Small models: every mode (dense); others: only the band below the cutoff (shift-invert
     // Lanczos on a sparse factorisation) — a dense eigensolution of 1000 equations alone takes
     // longer than the whole simulation.
@@ -121,7 +160,7 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
       mo.engine = fem::ModalEngine::dense;
     } else {
       mo.engine = fem::ModalEngine::sparse;
-      mo.max_frequency_hz = cutoff;
+      mo.max_frequency_hz = std::max(cutoff, force_band);
     }
     fem::Modes modes = fem::modal_analysis(system, mo);
     if (!modes.status.ok()) {
@@ -132,6 +171,17 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
     while (kept < modes.num_modes() && modes.frequency_hz(kept) < cutoff)
       ++kept;
     const bool all = kept == dofs.num_equations();
+    int below_band = 0;
+    for (int r = kept; r < modes.num_modes() && modes.frequency_hz(r) <= force_band; ++r)
+      ++below_band;
+    if (below_band > 0)
+      test.warnings.push_back(fmt::format(
+          "modal route: {} mode{} between the modal cutoff, {:.4g} Hz, and {:.4g} Hz (below which "
+          "99 % of the force's power lies) {} left out (the first at {:.4g} Hz): the force drives "
+          "{} near resonance, which the static correction does not hold, so the response can be "
+          "tens of per cent off; raise the modal cutoff above {:.4g} Hz (0: the Nyquist frequency)",
+          below_band, below_band > 1 ? "s" : "", cutoff, force_band, below_band > 1 ? "are" : "is",
+          modes.frequency_hz(kept), below_band > 1 ? "them" : "it", force_band));
     modes.omega.conservativeResize(kept);
     modes.phi.conservativeResize(Eigen::NoChange, kept);
     std::vector<int> loaded = history.equations;

@@ -204,11 +204,14 @@ void read_mesh(ModelReading& ctx, const Table& root) {
 
 void read_element_sets(ModelReading& ctx, const Table& root) {
   const auto list = tables(root, "element_sets");
-  std::vector<int> set_line(ctx.model().elements.size(),
-                            0); // line of the set covering each element
+  // The set covering each element (-1: none yet), and each set's line for messages (0 in a
+  // document built in memory, io/model_toml.hpp).
+  std::vector<int> set_of(ctx.model().elements.size(), -1);
+  std::vector<int> set_line;
   for (std::size_t i = 0; i < list.size(); ++i) {
     Table t(ctx.file, *list[i], fmt::format("[[element_sets]] #{}", i + 1),
             {"elements", "type", "material", "section", "up"});
+    set_line.push_back(t.line());
     const fem::ElementType type = parse_element_type(t);
     const int material = lookup(t, "material", ctx.material_index);
     const int section = lookup(t, "section", ctx.section_index);
@@ -248,15 +251,15 @@ void read_element_sets(ModelReading& ctx, const Table& root) {
       }
     }
     std::vector<int> twice;
-    std::set<int> other_lines;
+    std::set<int> other_sets;
     for (int id : members) {
       const int p = ctx.element_position.at(id);
-      if (set_line[p] != 0) {
+      if (set_of[p] >= 0) {
         twice.push_back(id);
-        other_lines.insert(set_line[p]);
+        other_sets.insert(set_of[p]);
         continue;
       }
-      set_line[p] = t.line();
+      set_of[p] = static_cast<int>(i);
       fem::Element& e = ctx.model().elements[p];
       e.type = type;
       e.material = material;
@@ -264,19 +267,23 @@ void read_element_sets(ModelReading& ctx, const Table& root) {
       e.up = up;
     }
     if (!twice.empty()) {
-      std::vector<std::string> lines;
-      for (int l : other_lines)
-        lines.push_back(std::to_string(l));
+      std::vector<std::string> lines, numbers;
+      for (int o : other_sets) {
+        lines.push_back(std::to_string(set_line[o]));
+        numbers.push_back(fmt::format("#{}", o + 1));
+      }
+      const bool by_line = set_line[*other_sets.begin()] > 0;
       t.fail_at(which, "key 'elements'",
-                fmt::format("element{} {} already in the element set at line {} (each element "
+                fmt::format("element{} {} already in the element set {} (each element "
                             "belongs to exactly one set)",
                             twice.size() > 1 ? "s" : "",
-                            id_list(twice) + (twice.size() > 1 ? " are" : " is"), joined(lines)));
+                            id_list(twice) + (twice.size() > 1 ? " are" : " is"),
+                            by_line ? "at line " + joined(lines) : joined(numbers)));
     }
   }
   std::vector<int> uncovered;
   for (std::size_t p = 0; p < ctx.model().elements.size(); ++p)
-    if (set_line[p] == 0) uncovered.push_back(ctx.model().elements[p].id);
+    if (set_of[p] < 0) uncovered.push_back(ctx.model().elements[p].id);
   if (!uncovered.empty())
     ctx.file.fail(ctx.elements_line,
                   fmt::format("[mesh]: element{} {}{} in no [[element_sets]] (each element belongs "

@@ -3,6 +3,7 @@
 #include "fem/dof_map.hpp"
 #include "io/files.hpp"
 #include "io/model_reader.hpp"
+#include "io/model_toml.hpp"
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -72,8 +73,12 @@ ModelFile read_model(const std::filesystem::path& path) {
     throw Error(fmt::format("{}:{}:{}: {}", path.string(), e.source().begin.line,
                             e.source().begin.column, e.description()));
   }
+  return read_model(root, path);
+}
+
+ModelFile read_model(const toml::table& document, const std::filesystem::path& path) {
   ModelReading reading(path);
-  ModelFile out = read_tables(reading, root);
+  ModelFile out = read_tables(reading, document);
   out.path = path;
   return out;
 }

@@ -10,7 +10,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <map>
+#include <optional>
+#include <utility>
 
 namespace jointid::io::detail {
 
@@ -159,6 +162,10 @@ ModelFile read_composite_file(ModelReading& ctx, const Table& root) {
   std::vector<fem::NodeDof> dofs;
   std::map<int, std::size_t> node_part;
   std::vector<int> part_lines;
+  // The dimension the parts must share, and where it comes from (list.size(): the whole's
+  // [model]); a planar whole admits only ux, uy and rz.
+  std::optional<std::pair<int, std::size_t>> dimension;
+  if (root.has("model")) dimension = std::pair{ctx.model().dimension, list.size()};
   for (std::size_t i = 0; i < list.size(); ++i) {
     Table t(ctx.file, *list[i], fmt::format("[[substructures]] entry {}", i + 1),
             {"file", "node_offset"});
@@ -170,9 +177,31 @@ ModelFile read_composite_file(ModelReading& ctx, const Table& root) {
         t.fail_at(*n, "key 'node_offset'", fmt::format("expected an integer >= 0, got {}", offset));
     }
     ModelFile part = read_model(path); // its errors name its own file and line
+    const std::string name = path.filename().string();
+    // Every part against the whole: a finite element part of another dimension than the
+    // whole's [model] (or than the other finite element parts), a DOF a planar whole lacks, a
+    // node id the offset would carry past the largest integer.
+    if (!part.model.nodes.empty()) {
+      if (!dimension) dimension = std::pair{part.model.dimension, i};
+      if (dimension->first != part.model.dimension)
+        t.fail_at(*t.get("file"), "key 'file'",
+                  fmt::format(
+                      "{} is a {} model (dimension = {}), but {} is {} (dimension = {}): "
+                      "the parts of a model share its dimension",
+                      name, part.model.dimension == 2 ? "planar" : "spatial", part.model.dimension,
+                      dimension->second == list.size()
+                          ? std::string("the whole ([model])")
+                          : fmt::format("substructure {} ({})", dimension->second + 1,
+                                        ctx.out.parts[dimension->second].path.filename().string()),
+                      dimension->first == 2 ? "planar" : "spatial", dimension->first));
+    }
     const fem::DofMap map = part.dof_map();
     for (int e = 0; e < map.num_equations(); ++e) {
       fem::NodeDof nd = map.node_dof(e);
+      if (nd.node > std::numeric_limits<int>::max() - offset)
+        t.fail_at(*t.get("file"), "key 'file'",
+                  fmt::format("node {} of {} + node_offset {} is above the largest node id ({})",
+                              nd.node, name, offset, std::numeric_limits<int>::max()));
       nd.node += offset;
       const auto [at, fresh] = node_part.emplace(nd.node, i);
       if (!fresh && at->second != i)
@@ -188,6 +217,23 @@ ModelFile read_composite_file(ModelReading& ctx, const Table& root) {
     ctx.out.parts.push_back(std::move(part));
     ctx.out.node_offsets.push_back(offset);
   }
+  // A planar whole (its [model], or its finite element parts) has only ux, uy and rz: a part's
+  // DOF beyond them (a [modal], [matrices] or [frf] part lists any) is refused.
+  if (dimension && dimension->first == 2)
+    for (const fem::NodeDof& nd : dofs)
+      if (nd.dof != fem::Dof::ux && nd.dof != fem::Dof::uy && nd.dof != fem::Dof::rz) {
+        const std::size_t p = node_part.at(nd.node);
+        ctx.file.fail(part_lines[p],
+                      fmt::format("[[substructures]] entry {}: {} has the DOF {} (node {} + "
+                                  "node_offset {}), but the model is planar (dimension = 2: {}), "
+                                  "which has only ux, uy and rz",
+                                  p + 1, ctx.out.parts[p].path.filename().string(),
+                                  fem::to_string(nd), nd.node - ctx.out.node_offsets[p],
+                                  ctx.out.node_offsets[p],
+                                  dimension->second == list.size()
+                                      ? std::string("its [model]")
+                                      : fmt::format("substructure {}", dimension->second + 1)));
+      }
   read_joints(ctx, root);
   check_joints(ctx, fem::DofMap::from_dofs(dofs));
   // The parts' own joints, their nodes moved by the offset; names stay unique.

@@ -286,8 +286,69 @@ void write_record(const std::filesystem::path& path, const identify::Record& rec
   write_file_atomically(path, record_csv(record, comments));
 }
 
+namespace {
+
+// The phase conventions a stepped-sine table may state (`# convention = ...`), each as the
+// map of its complex amplitude into jointid's x(t) = Re(X e^{iωt}).
+enum class PhaseConvention {
+  positive, ///< x(t) = Re(X e^{iωt}): jointid's (the default)
+  negative, ///< x(t) = Re(X e^{-iωt}): X is the complex conjugate of jointid's
+  sine      ///< x(t) = Im(X e^{iωt}) = |X| sin(ωt + arg X): jointid's is −i X
+};
+
+// A convention as written, without blanks, '*' or '·', in lower case, with ω or w, i or j,
+// e^{...}, e^(...) or exp(...), and an optional "x(t) =" before it.
+std::optional<PhaseConvention> parse_phase_convention(std::string_view text) {
+  std::string s;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const std::string_view rest = text.substr(i);
+    if (rest.starts_with("\xCF\x89")) { // ω
+      s += 'w';
+      ++i;
+    } else if (rest.starts_with("\xC2\xB7")) { // ·
+      ++i;
+    } else if (rest.starts_with("exp(")) {
+      s += "e^(";
+      i += 3;
+    } else if (text[i] == '{' || text[i] == '}') {
+      s += text[i] == '{' ? '(' : ')';
+    } else if (text[i] != ' ' && text[i] != '\t' && text[i] != '*') {
+      const char c = static_cast<char>(std::tolower(static_cast<unsigned char>(text[i])));
+      s += c == 'j' ? 'i' : c;
+    }
+  }
+  if (s.starts_with("x(t)=")) s.erase(0, 5);
+  if (s == "re(xe^(iwt))" || s == "re(xe^(+iwt))") return PhaseConvention::positive;
+  if (s == "re(xe^(-iwt))") return PhaseConvention::negative;
+  if (s == "im(xe^(iwt))" || s == "im(xe^(+iwt))") return PhaseConvention::sine;
+  return std::nullopt;
+}
+
+} // namespace
+
 SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
   const CsvText csv = scan(path, "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im");
+  // `# convention = x(t) = Re(X e^{iωt})` (the default), `Re(X e^{-iωt})` or `Im(X e^{iωt})`.
+  PhaseConvention convention = PhaseConvention::positive;
+  int convention_line = 0;
+  for (const Line& c : csv.comments) {
+    if (!c.text.starts_with("convention")) continue;
+    const std::string_view after = trim(c.text.substr(std::string_view("convention").size()));
+    if (after.empty() || after.front() != '=') continue; // some other comment
+    const std::string_view value_text = trim(after.substr(1));
+    const std::optional<PhaseConvention> read = parse_phase_convention(value_text);
+    if (!read)
+      csv.fail(c.number,
+               fmt::format("convention: expected x(t) = Re(X e^{{iωt}}) (jointid's, the "
+                           "default), x(t) = Re(X e^{{-iωt}}) or x(t) = Im(X e^{{iωt}}) (a sine "
+                           "reference), got \"{}\"",
+                           value_text));
+    if (convention_line > 0 && *read != convention)
+      csv.fail(c.number, fmt::format("convention given twice, differently (first at line {})",
+                                     convention_line));
+    convention = *read;
+    convention_line = c.number;
+  }
   const auto names = split_fields(csv.header.text);
   if (names.front() != "freq_hz")
     csv.fail(
@@ -342,10 +403,15 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
     table.lines.push_back(row.number);
   table.values.resize(static_cast<Eigen::Index>(n),
                       static_cast<Eigen::Index>(table.channels.size()));
+  // Into x(t) = Re(X e^{iωt}): exact (a sign change, or a swap of the parts).
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t c = 0; c < table.channels.size(); ++c)
-      table.values(static_cast<Eigen::Index>(i),
-                   static_cast<Eigen::Index>(c)) = {data[1 + 2 * c][i], data[2 + 2 * c][i]};
+    for (std::size_t c = 0; c < table.channels.size(); ++c) {
+      const double re = data[1 + 2 * c][i], im = data[2 + 2 * c][i];
+      table.values(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) =
+          convention == PhaseConvention::positive   ? std::complex<double>(re, im)
+          : convention == PhaseConvention::negative ? std::complex<double>(re, -im)
+                                                    : std::complex<double>(im, -re);
+    }
   return table;
 }
 

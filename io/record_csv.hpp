@@ -39,6 +39,11 @@ void write_record(const std::filesystem::path& path, const identify::Record& rec
 using SteppedSineTable = identify::SteppedSineTable;
 
 /// Reads a stepped-sine table; throws io::Error naming file, line and column as read_record.
+/// A comment `# convention = ...` states the table's phase convention: x(t) = Re(X e^{iωt})
+/// (jointid's, the default), x(t) = Re(X e^{-iωt}) (the values are conjugated as read) or
+/// x(t) = Im(X e^{iωt}) (a sine reference: the values are multiplied by −i as read); blanks, the
+/// case, "x(t) =", ω or w, i or j, e^{…} or exp(…) as one likes. Another convention, or two
+/// that differ, are refused naming the line.
 SteppedSineTable read_stepped_sine(const std::filesystem::path& path);
 
 /// The CSV text of a stepped-sine table: each comment as `# ...` lines, the header and one row

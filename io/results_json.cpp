@@ -1,8 +1,7 @@
 #include "io/results_json.hpp"
 
 #include "io/files.hpp"
-
-#include <nlohmann/json.hpp>
+#include "io/json_text.hpp"
 
 #include <cmath>
 
@@ -10,15 +9,9 @@ namespace jointid::io {
 
 namespace {
 
-using Json = nlohmann::ordered_json; // keeps the contract's key order
-
-Json number(double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
-
-std::string text(const Json& json) {
-  return json.dump(2) + "\n";
-}
+using json::Json;
+using json::number;
+using json::text;
 
 } // namespace
 

@@ -164,12 +164,17 @@ void write_uff58(const std::filesystem::path& path, const std::vector<Uff58Funct
                  bool binary = false);
 
 /// The time responses of a universal file as sine-test records. Every function must be a time
-/// response (type 1), real, evenly spaced, of at least 4 finite values; those with the same
-/// abscissa (minimum, increment, number of points, in seconds) form one identify::Record, in the
-/// order of their first function; Record::source is "<path>#<dataset>" with the position of
-/// that first function's dataset in the file (from 1, counting every dataset).
+/// response: function type 1, or 0 ("general or unknown", as many test systems write time
+/// data) whose abscissa is time (record 8 data type 17, or a units label of time: s, ms,
+/// "Time"); real, evenly spaced, of at least 4 finite values. Those with the same abscissa
+/// (minimum, increment, number of points, in seconds) form one identify::Record, in the order of
+/// their first function; Record::source is "<path>#<dataset>" with the position of that first
+/// function's dataset in the file (from 1, counting every dataset).
 ///  - Channel quantity from record 9's data type: 13 excitation force → f, 8 displacement → x,
-///    11 velocity → v, 12 acceleration → a; anything else is refused (0 unknown included).
+///    11 velocity → v, 12 acceleration → a; for 0 (unknown) and 1 (general), from the axis units
+///    label (uff_label_quantity: m/s², mm/s², g → a; m/s → v; m, mm → x; N, kN, lbf → f; at a
+///    rotation rad/s², rad/s, rad, N m). Other data types, or 0 and 1 without such a label, are
+///    refused.
 ///  - Channel DOF: node = the response node, DOF from the response direction (1..6 → ux uy uz
 ///    rx ry rz); a negative direction flips the sign of the samples. Reference node and
 ///    direction are not used.
@@ -185,10 +190,11 @@ void write_uff58(const std::filesystem::path& path, const std::vector<Uff58Funct
 ///    the quantity (translational motion 1 0 0, force 0 1 0, rotation 0 0 0, moment 1 1 0).
 ///  - `excitation_hz = <Hz>` in any ID line gives Record::excitation_hz (the functions of one
 ///    record must not disagree).
-/// Throws io::Error naming the file, the dataset and its line, the record and field: another
-/// function type ("only time responses are sine tests; FRFs are for the substructure, not read
-/// from UFF yet"), complex or uneven data, a scalar direction, a channel given twice in one
-/// record, no function at all.
+/// Throws io::Error naming the file, the dataset, its line and ID line 1, the record and field
+/// to fix, and what jointid can use instead: another function type (an FRF is for the model
+/// file's [frf] section or modal-fit; a spectrum has lost the time history), type 0 without a
+/// time abscissa, a quantity neither the data type nor the label tells, complex or uneven data,
+/// a scalar direction, a channel given twice in one record, no function at all.
 std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& functions,
                                             const std::filesystem::path& path);
 
@@ -200,7 +206,8 @@ std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& fu
 ///  - Record 9 (numerator): 8 displacement (receptance), 11 velocity (mobility: H = Y / iω),
 ///    12 acceleration (accelerance: H = A / (iω)² = −A / ω²; "g" in the label is 9.80665 m/s²);
 ///    record 10 (denominator): 13 excitation force, or 0 with no label (a force in the file's
-///    units). Units as for time responses: each axis' units label, else dataset 164, else SI.
+///    units); data types 0 and 1 with a units label take the quantity from it, as for time
+///    responses. Units as for time responses: each axis' units label, else dataset 164, else SI.
 ///  - Record 8: frequency (18, or 0/1 unspecified) in Hz; even or uneven spacing; complex single
 ///    or double values. A mobility or accelerance line at 0 Hz is dropped (it does not give the
 ///    receptance there).

@@ -20,10 +20,51 @@ using namespace detail;
 
 namespace {
 
-// The function's place, for messages: "a.uff: dataset 3 (line 14)".
+// The function's place: "a.uff: dataset 3 (line 14)" (an FRF's source).
 std::string where(const std::filesystem::path& path, const Uff58Function& f) {
   return f.dataset > 0 ? fmt::format("{}: dataset {} (line {})", path.string(), f.dataset, f.line)
                        : path.string();
+}
+
+// The function's place and its description, for messages that refuse it:
+// "a.uff: dataset 3 (line 14), ID line 1 "Accel 7+Y"".
+std::string culprit(const std::filesystem::path& path, const Uff58Function& f) {
+  const std::string_view id = trim(f.id_lines[0]);
+  if (id.empty() || id == "NONE" || id == "none") return where(path, f);
+  return fmt::format("{}, ID line 1 {}", where(path, f), shown(id));
+}
+
+// What a universal file's functions can be in jointid, for refusals: time responses are test
+// records, FRFs describe a substructure.
+constexpr std::string_view uses =
+    "jointid reads time responses (function type 1, or 0 with a time abscissa) as test records, "
+    "and frequency response functions (function type 4) in a model file's [frf] section or with "
+    "jointid modal-fit";
+
+// Why a function that is not a time response cannot be a test record (record 6 field 1).
+std::string not_a_time_response(const Uff58Function& f) {
+  const int type = f.function_type;
+  const std::string is = fmt::format("record 6 field 1 (function type) is {} ({})", type,
+                                     uff_function_type_name(type));
+  switch (type) {
+  case uff_function_type::frequency_response:
+  case 5: // transmissibility
+    return fmt::format("{}, not a test record: give FRFs to the model file's [frf] section "
+                       "(file = \"...\") or to jointid modal-fit; a test record is a time "
+                       "response (function type 1, or 0 with a time abscissa)",
+                       is);
+  case 2:  // auto spectrum
+  case 3:  // cross spectrum
+  case 9:  // power spectral density
+  case 10: // energy spectral density
+  case 12: // spectrum
+    return fmt::format("{}: a spectrum has lost the time history (an auto spectrum also the "
+                       "phase) that a test needs; export the time responses from the test system "
+                       "instead: {}",
+                       is, uses);
+  default:
+    return fmt::format("{}, which jointid does not use: {}", is, uses);
+  }
 }
 
 // The channel a time response holds, and the factor (sign included) that makes its values SI.
@@ -44,30 +85,63 @@ struct AxisScale {
   double factor = 1.0;
 };
 
+// The data types jointid reads, for messages.
+constexpr std::string_view quantities =
+    "13 (excitation force), 8 (displacement), 11 (velocity) or 12 (acceleration)";
+
+// `dof_field`: the record 6 field that gives the axis' DOF, as "record 6 field 7 (response
+// direction) is 2 (+Y)", for a units label of the other kind of DOF.
 template <class Error>
 AxisScale axis_scale(const Uff58Function& f, const Uff58Axis& o, int record, bool rotation,
-                     const Error& error) {
-  // The quantity from the specific data type.
-  const std::optional<UffAxisQuantity> q = uff_axis_quantity(o.data_type, rotation);
+                     const std::string& dof_field, const Error& error) {
+  // The quantity from the specific data type; for 0 (unknown) or 1 (general), as data
+  // acquisition systems write it, from the units label.
+  const char* axis = record == 9 ? "ordinate" : "denominator";
+  const bool unspecified =
+      o.data_type == uff_data_type::unknown || o.data_type == uff_data_type::general;
+  const bool labelled = !uff_no_units_label(o.units_label);
+  std::optional<UffAxisQuantity> q = uff_axis_quantity(o.data_type, rotation);
+  if (!q && unspecified && labelled) {
+    q = uff_label_quantity(o.units_label, rotation);
+    if (!q && uff_label_quantity(o.units_label, !rotation))
+      throw error(fmt::format("record {} field 6 (axis units label) '{}' is a unit of a {}, but "
+                              "{}, a {}",
+                              record, trim(o.units_label), rotation ? "translation" : "rotation",
+                              dof_field, rotation ? "rotation" : "translation"));
+    if (!q)
+      throw error(fmt::format(
+          "cannot tell the quantity: record {} field 1 ({} specific data type) is {} ({}) and "
+          "field 6 (axis units label) '{}' is not a unit jointid reads; set field 1 to {}, or "
+          "field 6 to a unit of one of them ({}; {}; {}; {})",
+          record, axis, o.data_type, uff_data_type_name(o.data_type), trim(o.units_label),
+          quantities, uff_unit_list(rotation ? UffUnitKind::moment : UffUnitKind::force),
+          uff_unit_list(rotation ? UffUnitKind::angle : UffUnitKind::length),
+          uff_unit_list(rotation ? UffUnitKind::angular_velocity : UffUnitKind::velocity),
+          uff_unit_list(rotation ? UffUnitKind::angular_acceleration : UffUnitKind::acceleration)));
+  }
+  if (!q && unspecified)
+    throw error(fmt::format("cannot tell the quantity: record {} field 1 ({} specific data type) "
+                            "is {} ({}) and field 6 (axis units label) gives no unit; set field 1 "
+                            "to {}, or field 6 to the unit (e.g. {})",
+                            record, axis, o.data_type, uff_data_type_name(o.data_type), quantities,
+                            rotation ? "N m, rad, rad/s, rad/s^2" : "N, m, m/s, m/s^2, g"));
   if (!q)
-    throw error(fmt::format("record {} field 1 ({} specific data type) is {} ({}): cannot tell the "
-                            "quantity; expected 13 (excitation force), 8 (displacement), 11 "
-                            "(velocity) or 12 (acceleration)",
-                            record, record == 9 ? "ordinate" : "denominator", o.data_type,
-                            uff_data_type_name(o.data_type)));
+    throw error(fmt::format("record {} field 1 ({} specific data type) is {} ({}): jointid reads "
+                            "{} (or 0 and 1 with a units label that names one of them)",
+                            record, axis, o.data_type, uff_data_type_name(o.data_type),
+                            quantities));
 
   // Unit exponents: not given (0 0 0), or those of the standard's Addendum A.
   const bool none = o.length_exponent == 0 && o.force_exponent == 0 && o.temperature_exponent == 0;
   const bool addendum = o.length_exponent == q->length_exponent &&
                         o.force_exponent == q->force_exponent && o.temperature_exponent == 0;
   if (!none && !addendum)
-    throw error(
-        fmt::format("record {} fields 2–4 (length, force, temperature units exponents) are {} {} "
-                    "{}, which do not fit {} at a {} DOF (expected {} {} 0 as in the standard's "
-                    "Addendum A, or 0 0 0)",
-                    record, o.length_exponent, o.force_exponent, o.temperature_exponent,
-                    uff_data_type_name(o.data_type), rotation ? "rotational" : "translational",
-                    q->length_exponent, q->force_exponent));
+    throw error(fmt::format(
+        "record {} fields 2–4 (length, force, temperature units exponents) are {} {} "
+        "{}, which do not fit {} at a {} DOF (expected {} {} 0 as in the standard's "
+        "Addendum A, or 0 0 0)",
+        record, o.length_exponent, o.force_exponent, o.temperature_exponent, uff_unit_noun(q->kind),
+        rotation ? "rotational" : "translational", q->length_exponent, q->force_exponent));
 
   // Scale to SI: the units label says the unit; without one, the unit system of dataset 164.
   AxisScale c{q->quantity, 1.0};
@@ -85,17 +159,30 @@ AxisScale axis_scale(const Uff58Function& f, const Uff58Axis& o, int record, boo
   return c;
 }
 
+// A time abscissa: data type 17 (time), or a units label of time (s, ms, "Time").
+bool time_abscissa(const Uff58Axis& a) {
+  return a.data_type == uff_data_type::time ||
+         (!uff_no_units_label(a.units_label) && uff_unit_to_si(UffUnitKind::time, a.units_label));
+}
+
 ChannelOf channel_of(const Uff58Function& f, const std::filesystem::path& path) {
-  const std::string at = where(path, f);
+  const std::string at = culprit(path, f);
   const auto error = [&](const std::string& what) {
     return Error(fmt::format("{}: {}", at, what));
   };
-  if (f.function_type != uff_function_type::time_response)
-    throw error(
-        fmt::format("record 6 field 1 (function type) is {} ({}): only time responses (1) are "
-                    "sine tests; measured FRFs (4) describe the substructure: give them in the "
-                    "model file's [frf] section",
-                    f.function_type, uff_function_type_name(f.function_type)));
+  // A time response: function type 1, or 0 (general or unknown, as test systems write time
+  // data) whose abscissa is time.
+  if (f.function_type == uff_function_type::general && !time_abscissa(f.abscissa))
+    throw error(fmt::format(
+        "record 6 field 1 (function type) is 0 (general or unknown) and record 8 (abscissa) does "
+        "not say time (field 1, specific data type, is {} ({}); field 6, axis units label, is "
+        "'{}'): for a time response set record 8 field 1 to 17 (time) or field 6 to s, or record "
+        "6 field 1 to 1 (time response); {}",
+        f.abscissa.data_type, uff_data_type_name(f.abscissa.data_type),
+        trim(f.abscissa.units_label), uses));
+  if (f.function_type != uff_function_type::time_response &&
+      f.function_type != uff_function_type::general)
+    throw error(not_a_time_response(f));
   if (f.is_complex())
     throw error(
         fmt::format("record 7 field 1 (ordinate data type) is {} ({}): a time response must be "
@@ -133,7 +220,10 @@ ChannelOf channel_of(const Uff58Function& f, const std::filesystem::path& path) 
           fem::all_dofs[static_cast<std::size_t>(std::abs(f.response_direction) - 1)]};
   const bool rotation = fem::is_rotation(c.at.dof);
 
-  const AxisScale scale = axis_scale(f, f.ordinate, 9, rotation, error);
+  const AxisScale scale = axis_scale(f, f.ordinate, 9, rotation,
+                                     fmt::format("record 6 field 7 (response direction) is {}",
+                                                 direction_text(f.response_direction)),
+                                     error);
   c.quantity = scale.quantity;
   c.factor = scale.factor;
   if (f.response_direction < 0) c.factor = -c.factor;
@@ -144,7 +234,7 @@ ChannelOf channel_of(const Uff58Function& f, const std::filesystem::path& path) 
       a.data_type != uff_data_type::general)
     throw error(
         fmt::format("record 8 field 1 (abscissa specific data type) is {} ({}): a time response's "
-                    "abscissa is time (17)",
+                    "abscissa is time (17, or 0 or 1 with the unit s)",
                     a.data_type, uff_data_type_name(a.data_type)));
   if (!uff_no_units_label(a.units_label)) {
     const std::optional<double> factor = uff_unit_to_si(UffUnitKind::time, a.units_label);
@@ -183,7 +273,8 @@ std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& fu
                                             const std::filesystem::path& path) {
   if (functions.empty())
     throw Error(fmt::format("{}: no dataset 58 (function at nodal DOF) in the file; expected the "
-                            "time responses of a sine test",
+                            "time responses of a test (function type 1, or 0 with a time "
+                            "abscissa)",
                             path.string()));
   struct Group {
     double t0, dt;
@@ -218,7 +309,7 @@ std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& fu
               "sample times are not finite, increasing and uniform in double precision (sample "
               "{} is at {} s); a time record starts near 0 with a step that is not lost against "
               "its start",
-              where(path, f), t0, dt, n, i + 1, t(i)));
+              culprit(path, f), t0, dt, n, i + 1, t(i)));
       }
       groups.push_back(std::move(g));
       group = groups.end() - 1;
@@ -229,7 +320,7 @@ std::vector<identify::SineTest> uff58_tests(const std::vector<Uff58Function>& fu
       if (!std::isfinite(channel.samples(i)))
         throw Error(fmt::format("{}: record 12 (data values) value {} is {}, which is {} in SI "
                                 "units (factor {}): not a finite number",
-                                where(path, f), i + 1, f.data(i), channel.samples(i), c.factor));
+                                culprit(path, f), i + 1, f.data(i), channel.samples(i), c.factor));
     for (std::size_t k = 0; k < group->record.channels.size(); ++k)
       if (group->record.channels[k].name() == channel.name()) {
         const Uff58Function& other = *group->members[k];
@@ -329,21 +420,28 @@ std::vector<Uff58Function> uff58_from_record(const identify::Record& record) {
 
 namespace {
 
-// One FRF (function type 4) as the receptance in SI; `at` names it in messages.
-frf::MeasuredFunction frf_of(const Uff58Function& f, const std::string& at) {
+// One FRF (function type 4) as the receptance in SI, its source `source`; `at` names it in
+// messages.
+frf::MeasuredFunction frf_of(const Uff58Function& f, const std::string& source,
+                             const std::string& at) {
   const auto error = [&](const std::string& what) {
     return Error(fmt::format("{}: {}", at, what));
   };
   if (f.function_type != uff_function_type::frequency_response)
-    throw error(fmt::format("record 6 field 1 (function type) is {} ({}): the substructure's "
-                            "FRFs are frequency response functions (4)",
-                            f.function_type, uff_function_type_name(f.function_type)));
+    throw error(fmt::format(
+        "record 6 field 1 (function type) is {} ({}): the substructure's FRFs are frequency "
+        "response functions (4){}",
+        f.function_type, uff_function_type_name(f.function_type),
+        f.function_type == uff_function_type::time_response ||
+                (f.function_type == uff_function_type::general && time_abscissa(f.abscissa))
+            ? "; a time response is a test record (give it to identify, discover or modal-fit)"
+            : ""));
   if (!f.is_complex())
     throw error(fmt::format("record 7 field 1 (ordinate data type) is {} ({}): an FRF must be "
                             "complex (5 or 6)",
                             f.ordinate_type, ordinate_type_text(f.ordinate_type)));
   frf::MeasuredFunction m;
-  m.source = at;
+  m.source = source;
   const auto dof_of = [&](int node, int direction, int field, const char* what) {
     if (node <= 0)
       throw error(fmt::format("record 6 field {} ({} node) is {}: expected a node id > 0", field,
@@ -357,22 +455,32 @@ frf::MeasuredFunction frf_of(const Uff58Function& f, const std::string& at) {
   m.response = dof_of(f.response_node, f.response_direction, 6, "response");
   m.drive = dof_of(f.reference_node, f.reference_direction, 9, "reference");
   // Numerator: displacement, velocity or acceleration; denominator: the force (or moment).
-  const AxisScale num = axis_scale(f, f.ordinate, 9, fem::is_rotation(m.response.dof), error);
+  const AxisScale num = axis_scale(f, f.ordinate, 9, fem::is_rotation(m.response.dof),
+                                   fmt::format("record 6 field 7 (response direction) is {}",
+                                               direction_text(f.response_direction)),
+                                   error);
   if (num.quantity == identify::Quantity::force)
-    throw error("record 9 field 1 (ordinate specific data type) is 13 (excitation force): an "
-                "FRF's numerator is the response (8 displacement, 11 velocity, 12 "
-                "acceleration)");
+    throw error(fmt::format("record 9 (ordinate) is a force (field 1, specific data type, {} ({}); "
+                            "field 6, axis units label, '{}'): an FRF's numerator is the "
+                            "response (8 displacement, 11 velocity, 12 acceleration)",
+                            f.ordinate.data_type, uff_data_type_name(f.ordinate.data_type),
+                            trim(f.ordinate.units_label)));
   AxisScale den;
   if (f.denominator.data_type == uff_data_type::unknown &&
       uff_no_units_label(f.denominator.units_label))
     den.factor = f.units ? uff164_to_si(*f.units, fem::is_rotation(m.drive.dof) ? 1 : 0, 1)
                          : 1.0; // not given: a force in the file's units
   else
-    den = axis_scale(f, f.denominator, 10, fem::is_rotation(m.drive.dof), error);
+    den = axis_scale(f, f.denominator, 10, fem::is_rotation(m.drive.dof),
+                     fmt::format("record 6 field 10 (reference direction) is {}",
+                                 direction_text(f.reference_direction)),
+                     error);
   if (den.quantity != identify::Quantity::force)
-    throw error(fmt::format("record 10 field 1 (denominator specific data type) is {} ({}): an "
+    throw error(fmt::format("record 10 (ordinate denominator) is a response, not a force (field "
+                            "1, specific data type, {} ({}); field 6, axis units label, '{}'): an "
                             "FRF is per excitation force (13)",
-                            f.denominator.data_type, uff_data_type_name(f.denominator.data_type)));
+                            f.denominator.data_type, uff_data_type_name(f.denominator.data_type),
+                            trim(f.denominator.units_label)));
   double sign = num.factor / den.factor;
   if ((f.response_direction < 0) != (f.reference_direction < 0)) sign = -sign;
   // Abscissa: frequency in Hz.
@@ -429,7 +537,7 @@ std::vector<frf::MeasuredFunction> uff58_frfs(const std::vector<Uff58Function>& 
   std::vector<frf::MeasuredFunction> out;
   for (const Uff58Function& f : functions) {
     const std::string at = where(path, f);
-    frf::MeasuredFunction m = frf_of(f, at);
+    frf::MeasuredFunction m = frf_of(f, at, culprit(path, f));
     for (const frf::MeasuredFunction& other : out)
       if (other.response == m.response && other.drive == m.drive)
         throw Error(fmt::format("{}: the FRF {}/{} (response/reference) is already in {}", at,

@@ -152,6 +152,27 @@ std::optional<UffAxisQuantity> uff_axis_quantity(int data_type, bool rotation) {
   }
 }
 
+std::optional<UffAxisQuantity> uff_label_quantity(std::string_view label, bool rotation) {
+  struct KindType {
+    UffUnitKind kind;
+    int data_type;
+  };
+  static constexpr KindType translational[] = {
+      {UffUnitKind::length, uff_data_type::displacement},
+      {UffUnitKind::velocity, uff_data_type::velocity},
+      {UffUnitKind::acceleration, uff_data_type::acceleration},
+      {UffUnitKind::force, uff_data_type::excitation_force}};
+  static constexpr KindType rotational[] = {
+      {UffUnitKind::angle, uff_data_type::displacement},
+      {UffUnitKind::angular_velocity, uff_data_type::velocity},
+      {UffUnitKind::angular_acceleration, uff_data_type::acceleration},
+      {UffUnitKind::moment, uff_data_type::excitation_force}};
+  for (const KindType& k :
+       rotation ? std::span<const KindType>(rotational) : std::span<const KindType>(translational))
+    if (uff_unit_to_si(k.kind, label)) return uff_axis_quantity(k.data_type, rotation);
+  return std::nullopt;
+}
+
 double uff164_to_si(const UffUnits& units, int length_exponent, int force_exponent) {
   return 1.0 / (std::pow(units.length, length_exponent) * std::pow(units.force, force_exponent));
 }

@@ -74,6 +74,14 @@ struct UffAxisQuantity {
 /// nullopt.
 std::optional<UffAxisQuantity> uff_axis_quantity(int data_type, bool rotation);
 
+/// The quantity an axis units label names, for an axis whose specific data type does not say it
+/// (0 unknown, 1 general, as many data acquisition systems write): a length → displacement, a
+/// velocity, an acceleration (g and G included), a force → excitation force; at a rotational DOF
+/// a rotation, an angular velocity, an angular acceleration, a moment. The exponents are those
+/// of the quantity's data type (uff_axis_quantity). nullopt when the label is none of these
+/// units (time and frequency labels included).
+std::optional<UffAxisQuantity> uff_label_quantity(std::string_view label, bool rotation);
+
 /// Dataset 164: the factor to SI of a value in the file's unit system with these exponents,
 /// 1 / (length^length_exponent · force^force_exponent) (UffUnits: a value in the file's units
 /// divided by the factor is SI).

@@ -1,6 +1,6 @@
 #include "report/discovery_json.hpp"
 
-#include <nlohmann/json.hpp>
+#include "io/json_text.hpp"
 
 #include <cmath>
 
@@ -8,15 +8,9 @@ namespace jointid::report {
 
 namespace {
 
-using Json = nlohmann::ordered_json; // keeps the contract's key order
-
-Json number(double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
-
-std::string text(const Json& json) {
-  return json.dump(2) + "\n";
-}
+using io::json::Json;
+using io::json::number;
+using io::json::text;
 
 Json candidate_json(const discover::Candidate& c) {
   Json j;

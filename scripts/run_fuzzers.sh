@@ -14,7 +14,8 @@ seconds=${1:-600}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(fuzz_model_file fuzz_gmsh fuzz_record_csv fuzz_uff58 fuzz_matrix_market fuzz_frf_csv)
+  targets=(fuzz_model_file fuzz_gmsh fuzz_record_csv fuzz_uff58 fuzz_matrix_market fuzz_frf_csv
+    fuzz_tests)
 fi
 command -v clang++ >/dev/null || { echo "clang++ not found (Debian: apt-get install clang)" >&2; exit 1; }
 

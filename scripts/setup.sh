@@ -7,6 +7,9 @@ packages=(build-essential cmake pkg-config libeigen3-dev libspectra-dev libsuite
   # Python 3 (standard library only): the documentation's figures and their checks
   # (scripts/update_docs.py, tests/docs).
   python3
+  # The Python module jointid (python/, docs/python.md): pybind11 for the interpreter of
+  # python3-dev, numpy, pytest for its tests, matplotlib for the examples' figures.
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
   # FFTW (pkg-config fftw3): random excitation signals and Welch spectra (fem/fft.hpp).
   libfftw3-dev
   # OpenBLAS takes over libblas.so.3 (Debian's alternatives) from the reference BLAS, which

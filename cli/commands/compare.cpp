@@ -90,6 +90,8 @@ void Compare::run() {
         }
       });
   require(result.status);
+  for (const auto& w : result.prediction.warnings)
+    warn(w);
 
   // 4. Write.
   make_output_dir(output_dir_);

@@ -322,6 +322,11 @@ void Simulate::run_signal() {
   // 3. The model and the simulation.
   const Model model(model_, engine());
   if (!from_record) input.at = {model.dof("--force", force_)};
+  for (const auto& at : input.at) // a record's force channel is its fault, not the model's
+    if (const std::string why = model.sub.dofs().why_not_free(at); from_record && !why.empty())
+      throw io::Error(fmt::format("{}: force channel f@{}: {}; a force must act on a free DOF of "
+                                  "the model ({})",
+                                  force_from_.string(), fem::to_string(at), why, model.name()));
   for (const auto& text : outputs_)
     options.extra_outputs.push_back(model.dof("--outputs", text));
   io::check_not_an_input(output_dir_ / name);

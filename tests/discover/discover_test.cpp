@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -250,6 +251,32 @@ TEST(Discover, ThroughMeasuredFrfsAsThroughTheModel) {
                            "harmonic 6 (twice the 3 compared, to estimate their own error) of "
                            "the highest test frequency, 5 Hz: 30 Hz. Measure to that, or compare "
                            "fewer harmonics");
+  }
+}
+
+// The checkpoint (Options::checkpoint) is called as the run goes, and an exception thrown from
+// it — on whichever thread the candidates run — stops the run and leaves discover() (the Python
+// module's Ctrl-C, python/src/common.hpp).
+TEST(Discover, AnExceptionFromTheCheckpointStopsTheRun) {
+  Data d;
+  d.truth = {joint("tip", 7, {Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})};
+  d.frequencies = {2.5, 3.5, 4.5};
+  d.levels = {20.0, 80.0};
+  const std::vector<identify::Measurement> tests = measure(d);
+  struct Stop {};
+  for (const int stop_at : {1, 40}) {
+    std::atomic<int> calls{0};
+    discover::Options o;
+    o.terms = {Term::k3, Term::c2};
+    o.substructure_damping = false;
+    o.curve_points = 0;
+    o.checkpoint = [&calls, stop_at] {
+      if (++calls >= stop_at) throw Stop{};
+    };
+    EXPECT_THROW(discover::discover(frf::Substructure(d.model), {linear_start("tip", 7)}, tests, o),
+                 Stop)
+        << "stop at call " << stop_at;
+    EXPECT_GE(calls.load(), stop_at);
   }
 }
 

@@ -86,6 +86,19 @@ TEST(Problem, RefusesWhatCannotBeCompared) {
                 .find("measured to harmonic 1, but 4 are "
                       "compared"),
             std::string::npos);
+  // A force or response channel the substructure lacks is the test's fault: named with its
+  // channel and what the substructure has (its [modal] DOFs here).
+  auto foreign = tests;
+  foreign[0].force_at[0] = {99, fem::Dof::uy};
+  EXPECT_EQ(refused(foreign, {m.joint(0.0, 0.0)}, o),
+            tests[0].source + ": force channel f@99:uy: the substructure has no DOF at node 99 (it "
+                              "is known at its listed DOFs only: 7:uy)");
+  foreign = tests;
+  foreign[0].response_at.push_back({7, fem::Dof::rz});
+  foreign[0].measured_as.push_back(identify::Quantity::displacement);
+  EXPECT_EQ(refused(foreign, {m.joint(0.0, 0.0)}, o),
+            tests[0].source + ": channel x@7:rz: node 7 has no DOF rz among the substructure's "
+                              "DOFs (its DOFs: uy)");
   auto silent = tests;
   silent[0].X.setZero();
   EXPECT_EQ(refused(silent, {m.joint(0.0, 0.0)}, o), "discover: every response is zero");

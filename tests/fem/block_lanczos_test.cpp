@@ -323,3 +323,37 @@ TEST(BlockLanczos, BadOptionsThrow) {
   EXPECT_THROW(block_lanczos(op, with([](BlockLanczosOptions& o) { o.max_dimension = 3; })),
                std::invalid_argument);
 }
+
+// The orthonormalisation on a block that nearly lies in span(V) (issue 31): Z = V C + δ W with
+// δ = 1e-9, so one pass of Gram–Schmidt leaves cosines with V of about ε / δ ≈ 1e-7, far above
+// rounding. Two passes bring them to rounding ("twice is enough") without a re-check round; one
+// pass (the Lanczos step's, after its own projection) needs the re-check rounds. Either way
+// the result is M-orthonormal, M-orthogonal to V to rounding, and Z_in = V C + Z_out R.
+// Removing the second pass makes the first case take a round; removing the rounds leaves the
+// second case's cosines at ~1e-7.
+TEST(BlockLanczos, OrthogonalisationPassesAndRechecksOnANearlyDependentBlock) {
+  std::mt19937 rng(5);
+  const int n = 120, m = 16, q = 4;
+  const MatrixXd A = random_matrix(n, n, rng);
+  const MatrixXd M = A * A.transpose() / n + MatrixXd::Identity(n, n);
+  DensePencil P(M, M, 0.0);
+  // V: M-orthonormal (Cholesky of its Gram matrix).
+  MatrixXd V = random_matrix(n, m, rng);
+  const MatrixXd G = V.transpose() * M * V;
+  V = V * Eigen::LLT<MatrixXd>(G).matrixU().solve(MatrixXd::Identity(m, m));
+  const MatrixXd Zin = V * random_matrix(m, q, rng) + 1e-9 * random_matrix(n, q, rng);
+  for (const int passes : {2, 1}) {
+    MatrixXd Z = Zin, MZ, scratch;
+    const jointid::fem::detail::Projection p =
+        jointid::fem::detail::orthonormalise(P, V, m, Z, MZ, 0.0, scratch, passes);
+    ASSERT_EQ(Z.cols(), q) << passes;
+    EXPECT_EQ(p.rounds == 0, passes == 2) << passes << " passes, " << p.rounds << " rounds";
+    const double eps = std::numeric_limits<double>::epsilon();
+    EXPECT_LT((Z.transpose() * M * Z - MatrixXd::Identity(q, q)).cwiseAbs().maxCoeff(), 100 * eps)
+        << passes;
+    EXPECT_LT((V.transpose() * M * Z).cwiseAbs().maxCoeff(), 100 * eps) << passes;
+    EXPECT_LT((V * p.C + Z * p.R - Zin).cwiseAbs().maxCoeff(),
+              100 * eps * Zin.cwiseAbs().maxCoeff())
+        << passes;
+  }
+}

@@ -102,6 +102,39 @@ TEST(DofMap, AbsentOrFixedDofThrowsNamingNodeAndDof) {
   EXPECT_EQ(dofs.state({99, Dof::uy}), State::absent);
 }
 
+TEST(DofMap, WhyNotFreeSaysWhatTheModelHas) {
+  // A planar cantilever of beam elements: nodes 1–3, each with uy and rz; node 1 clamped.
+  const fem::DofMap dofs(test::cantilever(2));
+  EXPECT_EQ(dofs.why_not_free({2, Dof::uy}), "");
+  EXPECT_EQ(dofs.why_not_free({99, Dof::uy}), "the model has no node 99 (its nodes: 1–3)");
+  EXPECT_EQ(dofs.why_not_free({2, Dof::ux}),
+            "node 2 has no DOF ux in the model (its DOFs: uy, rz)");
+  EXPECT_EQ(dofs.why_not_free({1, Dof::uy}),
+            "a support of the model holds 1:uy fixed (node 1 has no free DOF)");
+  fem::Model pinned = test::cantilever(2);
+  pinned.supports[0].fixed = {Dof::uy};
+  EXPECT_EQ(fem::DofMap(pinned).why_not_free({1, Dof::uy}),
+            "a support of the model holds 1:uy fixed (the free DOFs of node 1: rz)");
+  // Node ids as sorted ranges, a pair as two ids, at most six ranges.
+  fem::Model scattered = test::uniform_beam(9); // nodes 1–10
+  for (int id : {22, 12, 20, 21, 14})
+    scattered.nodes.push_back({id, Eigen::Vector3d(id, 1.0, 0.0)});
+  EXPECT_EQ(fem::DofMap(scattered).why_not_free({11, Dof::uy}),
+            "the model has no node 11 (its nodes: 1–10, 12, 14, 20–22)");
+  for (int id : {30, 31, 40, 50, 60})
+    scattered.nodes.push_back({id, Eigen::Vector3d(id, 1.0, 0.0)});
+  EXPECT_EQ(fem::DofMap(scattered).why_not_free({11, Dof::uy}),
+            "the model has no node 11 (its nodes: 1–10, 12, 14, 20–22, 30, 31, 40, … (20 nodes "
+            "in all))");
+  // A substructure known at a few DOFs only.
+  const fem::DofMap listed = fem::DofMap::from_dofs({{4, Dof::uy}, {7, Dof::uy}});
+  EXPECT_EQ(listed.why_not_free({5, Dof::uy}),
+            "the substructure has no DOF at node 5 (it is known at its listed DOFs only: 4:uy, "
+            "7:uy)");
+  EXPECT_EQ(listed.why_not_free({4, Dof::rz}),
+            "node 4 has no DOF rz among the substructure's DOFs (its DOFs: uy)");
+}
+
 TEST(DofMap, SpringsAddTheirDofs) {
   // A grounded spring on ux of a beam node gives that node an ux DOF; a spring between two
   // nodes gives both the DOF.

@@ -1,6 +1,8 @@
 // Response curves by continuation: against fixed-frequency harmonic balance, the exact linear
 // FRF, time integration from rest, and the Floquet multipliers of the bare structure.
 #include "frf/continuation.hpp"
+#include "frf/modal_model.hpp"
+#include "frf/substructure.hpp"
 
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
@@ -14,6 +16,7 @@
 #include <cstdio>
 #include <numbers>
 #include <sstream>
+#include <string>
 #include <vector>
 
 using namespace jointid;
@@ -328,4 +331,42 @@ TEST(Continuation, AModalAnalysisThatFailsIsTheCurvesStatus) {
   EXPECT_EQ(curves.status.code, fem::Status::Code::numerical_issue);
   EXPECT_EQ(curves.status.reason, "the modal analysis failed: " + test::failing_modes_reason);
   EXPECT_TRUE(curves.curves.empty());
+}
+
+// An undamped mode where the harmonics reach (issue 31): the curves' notes name it and the
+// missing damping, and whether a joint's damping can bound its resonance; a damped one is not
+// mentioned. One mode at 10 Hz; band 4–4.5 Hz with 3 harmonics: they reach 4–13.5 Hz, and no
+// harmonic lands on 10 Hz (the points stay finite).
+TEST(Continuation, AnUndampedModeInReachIsNamedWithTheMissingDamping) {
+  frf::ModalModel m;
+  m.dofs = {{7, Dof::uy}};
+  m.frequencies_hz = Eigen::VectorXd::Constant(1, 10.0);
+  m.damping = Eigen::VectorXd::Zero(1);
+  m.shapes = Eigen::MatrixXd::Constant(1, 1, 1.0);
+  frf::ContinuationOptions o;
+  o.hb.harmonics = 3;
+  auto notes = [&](const frf::ModalModel& model, const joints::Joint& j) {
+    const frf::ResponseCurves c =
+        frf::response_curves(frf::Substructure(model), {j}, {7, Dof::uy}, {0.1}, 4.0, 4.5, o);
+    EXPECT_TRUE(c.status.ok()) << c.status.reason;
+    std::string all;
+    for (const auto& n : c.notes)
+      all += n + "\n";
+    return all;
+  };
+  const std::string undamped = notes(m, make("tip", 7, {Term::k3}, {1e6}));
+  EXPECT_NE(undamped.find("mode 1 (10 Hz) has no damping (modal damping 0) and lies where the "
+                          "harmonics reach (4 Hz to 13.5 Hz): no joint term dissipates either, so "
+                          "its resonance is unbounded and the points near it are the arithmetic's "
+                          "limits, not a response; give the model damping ([damping])"),
+            std::string::npos)
+      << undamped;
+  const std::string joint_damped = notes(m, make("tip", 7, {Term::k3, Term::c}, {1e6, 2.0}));
+  EXPECT_NE(joint_damped.find("mode 1 (10 Hz) has no damping (modal damping 0) and lies where the "
+                              "harmonics reach (4 Hz to 13.5 Hz): only the joints' damping bounds "
+                              "its resonance"),
+            std::string::npos)
+      << joint_damped;
+  m.damping(0) = 0.01;
+  EXPECT_EQ(notes(m, make("tip", 7, {Term::k3}, {1e6})).find("no damping"), std::string::npos);
 }

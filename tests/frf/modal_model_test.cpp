@@ -1,10 +1,13 @@
 // A substructure given by its modes: what ModalModel::validate accepts and refuses.
 #include "frf/modal_model.hpp"
+#include "frf/receptance.hpp"
 
 #include <gtest/gtest.h>
 
+#include <complex>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -85,4 +88,29 @@ TEST(ModalModel, EachProblemIsNamed) {
         << "expected '" << c.expected << "' in: '" << message << "'";
     EXPECT_EQ(message.rfind("modal model: ", 0), 0u) << message;
   }
+}
+
+// A 0 Hz mode (issue 31): its receptance at 0 Hz (harmonic 0) is infinite, and that is named,
+// not left to surface as a term "without effect"; at any other frequency it is the mass line
+// −φ_iφ_j / ω² of a rigid-body motion, plus the flexible mode's term.
+TEST(ModalModel, AZeroHertzModeIsNamedAtZeroHertzAndAMassLineElsewhere) {
+  frf::ModalModel m = valid();
+  m.frequencies_hz(0) = 0.0;
+  m.residual_flexibility.resize(0, 0);
+  const frf::ModalSynthesis H(m, {0, 1, 2});
+  const std::vector<int> at{1};
+  try {
+    H.receptance(0.0, at, at);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "receptance: mode 1 is at 0 Hz (a rigid-body motion), so the receptance at 0 Hz "
+              "(harmonic 0, the static mean) is infinite: support the substructure, or leave "
+              "harmonic 0 out");
+  }
+  const double w = 2.0 * std::numbers::pi * 5.0, w2 = 2.0 * std::numbers::pi * 212.0;
+  const std::complex<double> flexible =
+      0.88 * 0.88 / std::complex<double>(w2 * w2 - w * w, 2.0 * 0.002 * w2 * w);
+  const std::complex<double> expected = -0.40 * -0.40 / (-w * w) + flexible;
+  EXPECT_LE(std::abs(H.receptance(w, at, at)(0, 0) - expected), 1e-14 * std::abs(expected));
 }

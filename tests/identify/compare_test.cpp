@@ -10,6 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+#include <string>
 #include <utility>
 
 using namespace jointid;
@@ -156,4 +159,57 @@ TEST(Compare, APredictionThatFailsIsTheComparisonsStatus) {
   EXPECT_EQ(c.status.reason,
             "rig.csv: time simulation: the modal analysis failed: " + test::failing_modes_reason);
   EXPECT_TRUE(c.channels.empty());
+}
+
+// Degenerate records (issue 31): a force zero in every sample, a response channel zero in every
+// sample or constant, are refused naming the record and channel; lines where a spectrum is at
+// the arithmetic's floor are no differences (never thousands of dB).
+TEST(Compare, DegenerateRecordsAndTheFloorAreNamedNotCompared) {
+  const Record r = measured(4800.0, TransientRoute::modal);
+  auto error = [&](const Record& rec) {
+    try {
+      compare_spectra(cantilever(), {joint(4800.0)}, rec, band_2_40());
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  Record zero_force = r;
+  zero_force.channels[0].samples.setZero();
+  EXPECT_EQ(error(zero_force), "measured.csv: every force channel is zero in every sample "
+                               "(f@7:uy): no force to drive the model");
+  Record dead = r;
+  dead.channels[1].samples.setZero();
+  EXPECT_EQ(error(dead), "measured.csv: channel x@7:uy: zero in every sample after the first 4 s: "
+                         "nothing was measured there to compare");
+  // A constant (a sensor's offset alone): its mean removed, nothing is left on any line.
+  Record offset = r;
+  offset.channels[1].samples.setConstant(1e-3);
+  EXPECT_NE(error(offset).find("measured.csv: channel x@7:uy: the measured spectrum is below "
+                               "-200 dB of the other's peak on every line of the band 2:40 Hz"),
+            std::string::npos)
+      << error(offset);
+  // A sine on a line of the spectra (10 Hz, 0.25 Hz apart, the periodic Hann window): in exact
+  // arithmetic it has power on that line and its two neighbours only; the other 150 lines hold
+  // rounding (1e-32 of the peak), left out, not reported as differences of ~3000 dB.
+  Record sine = r;
+  const Eigen::VectorXd& x = r.channels[1].samples;
+  const double amplitude = std::sqrt(2.0) * x.norm() / std::sqrt(static_cast<double>(x.size()));
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    sine.channels[1].samples(i) = amplitude * std::sin(2.0 * std::numbers::pi * 10.0 * i / 256.0);
+  const Comparison c = compare_spectra(cantilever(), {joint(4800.0)}, sine, band_2_40());
+  const ChannelComparison& ch = c.channels.at(0);
+  int finite = 0;
+  for (Eigen::Index i = 0; i < ch.difference_db.size(); ++i)
+    if (std::isfinite(ch.difference_db(i))) {
+      ++finite;
+      EXPECT_NEAR(ch.frequency_hz(i), 10.0, 0.25 + 1e-9);
+    }
+  EXPECT_EQ(finite, 3);
+  EXPECT_TRUE(std::isfinite(ch.max_db));
+  EXPECT_LT(ch.max_db, 100.0); // a sine against a random response: tens of dB, not thousands
+  bool noted = false;
+  for (const auto& n : c.notes)
+    noted = noted || n.find("channel x@7:uy: 150 of 153 lines below -200 dB") != std::string::npos;
+  EXPECT_TRUE(noted);
 }

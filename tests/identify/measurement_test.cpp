@@ -367,11 +367,15 @@ TEST(Measure, ErrorsNameTheSource) {
   no_force.channels.erase(no_force.channels.begin());
   std::string e = error_of(no_force);
   EXPECT_NE(e.find("synthetic.csv"), std::string::npos) << e;
-  EXPECT_NE(e.find("no force channel"), std::string::npos) << e;
+  // Worded for every format a record comes from (no CSV "column" in a UFF58 record's message).
+  EXPECT_NE(e.find("no force channel among its channels (x@7:uy)"), std::string::npos) << e;
+  EXPECT_EQ(e.find("column"), std::string::npos) << e;
 
   e = error_of(make_record(256, 2, {}));
   EXPECT_NE(e.find("synthetic.csv"), std::string::npos) << e;
-  EXPECT_NE(e.find("no response channel"), std::string::npos) << e;
+  EXPECT_NE(e.find("no response channel among its channels (f@7:uy)"), std::string::npos) << e;
+  EXPECT_NE(e.find("e.g. x@7:uy"), std::string::npos) << e;
+  EXPECT_EQ(e.find("column"), std::string::npos) << e;
 
   // 16 samples a period: Nyquist at 8 f; harmonic 9 lies above it.
   e = error_of(make_record(16, 4, {Quantity::displacement}), {.harmonics = 9});
@@ -394,6 +398,23 @@ TEST(Measure, ErrorsNameTheSource) {
   e = error_of(row);
   EXPECT_NE(e.find("table.csv:9"), std::string::npos) << e;
   EXPECT_NE(e.find("no response channel"), std::string::npos) << e;
+}
+
+// A stepped-sine row with zero force measured no force, as a record whose force channel is zero
+// in every sample: every force zero is refused naming the row and channel; one of two is said.
+TEST(Measure, ZeroForceInASteppedSineRowIsRefusedLikeARecords) {
+  Phasors row;
+  row.source = "table.csv:4";
+  row.frequency_hz = 3.0;
+  row.channels = {{Quantity::force, tip, cd(0.0, 0.0)}, {Quantity::displacement, tip, cd(1e-3)}};
+  const std::string e = error_of(row);
+  EXPECT_EQ(e, "table.csv:4: every force channel is zero (f@7:uy): no force was measured; a sine "
+               "test needs its force");
+  row.channels.push_back({Quantity::force, mid, cd(0.0, -10.0)});
+  const Measurement m = measure(row, {});
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_EQ(m.warnings[0], "table.csv:4: channel f@7:uy: zero (no force was measured there)");
+  EXPECT_DOUBLE_EQ(force_level(m), 10.0);
 }
 
 TEST(Measure, RecordsTooShortForThePeriodOrTheHarmonicsAreNamed) {

@@ -309,3 +309,53 @@ TEST(MatrixMarket, NonFiniteSumsAndNegativeMassesAreNamed) {
             std::string::npos)
       << e;
 }
+
+// A K that is not positive definite (issue 31): a 0 Hz first mode or an imaginary one, refused
+// naming the DOF where its factorisation breaks down, rather than analysed.
+TEST(MatrixMarket, AStiffnessThatIsNotPositiveDefiniteIsRefused) {
+  const Exported x;
+  const int n = fem::assemble(x.fe.model).dofs.num_equations();
+  auto diagonal = [n](const std::string& first) {
+    std::string s =
+        fmt::format("%%MatrixMarket matrix coordinate real general\n{} {} {}\n{}", n, n, n, first);
+    for (int i = 2; i <= n; ++i)
+      s += fmt::format("{} {} 1\n", i, i);
+    return s;
+  };
+  auto error_with = [&](const std::string& k_text) {
+    test::write_text(x.dir / "k_bad.mtx", k_text);
+    test::write_text(x.model, test::replaced(Exported::text(), "k.mtx", "k_bad.mtx"));
+    return error_of([&] { io::read_model(x.model); });
+  };
+  // The first row of the table is 2:uy: stiffness 0 there (free to move: a 0 Hz mode), then -1.
+  std::string e = error_with(diagonal("1 1 0\n"));
+  EXPECT_NE(e.find(fmt::format("matrices.toml:4: [matrices] (k_bad.mtx, m.mtx, {} DOFs): K is not "
+                               "positive definite: its factorisation breaks down at 2:uy (pivot 0, "
+                               "diagonal 0): a rigid-body motion or a mechanism (a 0 Hz mode) "
+                               "there",
+                               n)),
+            std::string::npos)
+      << e;
+  e = error_with(diagonal("1 1 -1\n"));
+  EXPECT_NE(e.find("K is not positive definite: its factorisation breaks down at 2:uy (pivot -1, "
+                   "diagonal -1): a negative stiffness there"),
+            std::string::npos)
+      << e;
+  // Singular without a zero on the diagonal: two DOFs tied by a spring alone (rows 1 and 2 of
+  // [[1, -1], [-1, 1]]): a rigid-body motion of the pair, found whichever row it reaches last.
+  e = error_with(
+      fmt::format("%%MatrixMarket matrix coordinate real symmetric\n{} {} {}\n1 1 1\n2 1 "
+                  "-1\n2 2 1\n",
+                  n, n, n + 1) +
+      [&] {
+        std::string s;
+        for (int i = 3; i <= n; ++i)
+          s += fmt::format("{} {} 1\n", i, i);
+        return s;
+      }());
+  EXPECT_NE(e.find("K is not positive definite: its factorisation breaks down at "),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("a rigid-body motion or a mechanism (a 0 Hz mode) there"), std::string::npos)
+      << e;
+}

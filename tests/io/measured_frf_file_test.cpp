@@ -176,7 +176,8 @@ TEST(MeasuredFrfFile, MalformedFilesNameTheFileLineAndWhatWasExpected) {
             p + ":2: column 2 ('0:uy.re'): node id 0: expected > 0 (0 means ground)");
   EXPECT_EQ(csv("# drive = 7:uy\n# kind = accelerance\nfreq_hz,7:uy.re,7:uy.im\n1e-300,1,0\n"),
             p + ":4: columns 2 and 3: 1 0 at 1e-300 Hz is not a finite receptance (H = A / −ω²)");
-  // A universal file's time response is a sine test, not an FRF.
+  // A universal file's time response is a test record, not an FRF: the message says so, naming
+  // the dataset by its position, line and ID line 1 (the channel, as jointid writes it).
   const Cantilever c;
   identify::Record r;
   r.t = Eigen::VectorXd::LinSpaced(8, 0.0, 0.7);
@@ -184,8 +185,9 @@ TEST(MeasuredFrfFile, MalformedFilesNameTheFileLineAndWhatWasExpected) {
   io::write_uff58(dir / "t.uff", io::uff58_from_record(r));
   EXPECT_EQ(error_of([&] { (void)io::read_measured_frf({dir / "t.uff"}); }),
             (dir / "t.uff").string() +
-                ": dataset 1 (line 1): record 6 field 1 (function type) is 1 (time response): the "
-                "substructure's FRFs are frequency response functions (4)");
+                ": dataset 1 (line 1), ID line 1 \"f@7:uy\": record 6 field 1 (function type) is 1 "
+                "(time response): the substructure's FRFs are frequency response functions (4); a "
+                "time response is a test record (give it to identify, discover or modal-fit)");
   // The same FRF in two files.
   const frf::FrfSweep s = c.sweep(frf::FrfKind::receptance, 0.5, 5.0);
   io::write_file_atomically(dir / "a.csv", io::frf_csv(s, c.sub.dofs()));

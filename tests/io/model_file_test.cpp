@@ -2,6 +2,7 @@
 
 #include "io/cantilever_toml.hpp"
 #include "io/files.hpp"
+#include "io/model_toml.hpp"
 #include "io/test_files.hpp"
 
 #include <gtest/gtest.h>
@@ -93,6 +94,63 @@ TEST_F(ModelFileTest, ReadsTheCantilever) {
             (std::vector<joints::Term>{joints::Term::k, joints::Term::c, joints::Term::k3}));
   EXPECT_EQ(j.values, (std::vector<double>{4800.0, 20.0, 1.6e8}));
   EXPECT_EQ(j.fixed, (std::vector<bool>{false, false, false}));
+}
+
+// The cantilever of cantilever_toml() built in memory, as Python's dicts give it (python/): no
+// source positions anywhere.
+toml::table built_cantilever(const std::string& joint_dof = "uy") {
+  toml::array nodes, elements;
+  for (int i = 0; i < 7; ++i)
+    nodes.push_back(toml::array{i + 1, length * i / 6.0, 0.0});
+  for (int e = 1; e <= 6; ++e)
+    elements.push_back(toml::array{e, e, e + 1});
+  return toml::table{
+      {"model", toml::table{{"dimension", 2}}},
+      {"materials",
+       toml::array{toml::table{{"name", "steel"}, {"E", 210e9}, {"rho", 7850.0}, {"nu", 0.3}}}},
+      {"sections", toml::array{toml::table{{"name", "bar"}, {"A", test::area}, {"Iz", test::Iz}}}},
+      {"mesh", toml::table{{"nodes", nodes}, {"elements", elements}}},
+      {"element_sets",
+       toml::array{toml::table{
+           {"elements", "all"}, {"type", "beam"}, {"material", "steel"}, {"section", "bar"}}}},
+      {"supports", toml::array{toml::table{{"node", 1}, {"fix", toml::array{"ux", "uy", "rz"}}}}},
+      {"damping", toml::table{{"modal", 0.01}}},
+      {"joints", toml::array{toml::table{
+                     {"name", "tip"},
+                     {"node", 7},
+                     {"dof", joint_dof},
+                     {"terms", toml::array{"k", "c", "k3"}},
+                     {"values", toml::table{{"k", 4800.0}, {"c", 20.0}, {"k3", 1.6e8}}}}}}};
+}
+
+TEST_F(ModelFileTest, ReadsADocumentBuiltInMemoryAsTheFile) {
+  const ModelFile file = read_model(write(cantilever_toml()));
+  const ModelFile built = read_model(built_cantilever(), dir / "<dict>");
+  EXPECT_EQ(built.path, dir / "<dict>");
+  ASSERT_EQ(built.model.nodes.size(), file.model.nodes.size());
+  for (std::size_t i = 0; i < file.model.nodes.size(); ++i) {
+    EXPECT_EQ(built.model.nodes[i].id, file.model.nodes[i].id);
+    EXPECT_EQ(built.model.nodes[i].x, file.model.nodes[i].x);
+  }
+  EXPECT_EQ(built.model.elements.size(), 6u);
+  EXPECT_EQ(built.model.damping.modal_ratio, 0.01);
+  EXPECT_EQ(built.dof_map().num_equations(), file.dof_map().num_equations());
+  ASSERT_EQ(built.joints.size(), 1u);
+  EXPECT_EQ(built.joints[0].values, file.joints[0].values);
+  EXPECT_EQ(built.joints[0].dof, Dof::uy);
+}
+
+TEST_F(ModelFileTest, ADocumentBuiltInMemoryIsCheckedWithoutLines) {
+  try {
+    read_model(built_cantilever("uw"), "<dict>");
+    FAIL() << "expected io::Error";
+  } catch (const Error& e) {
+    // Named as given, no line (there is none); the key and what was expected as for a file.
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("<dict>: [[joints]] 'tip': ", 0), 0u) << message;
+    EXPECT_NE(message.find("'dof'"), std::string::npos) << message;
+    EXPECT_NE(message.find("\"uw\""), std::string::npos) << message;
+  }
 }
 
 TEST_F(ModelFileTest, ReadsOptionalItemsAndExtensions) {

@@ -9,11 +9,14 @@
 
 #include <bit>
 #include <cmath>
+#include <complex>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <tuple>
 
 namespace jointid::io {
 namespace {
@@ -316,6 +319,31 @@ TEST_F(RecordCsvTest, ForceChannelMustActOnAFreeDof) {
   }
 }
 
+// A force channel on a node the model lacks is the record's fault: the message starts with the
+// record (file, or file and line for a table's test) and its channel, and says what the model
+// has (issue 31). The UFF58 case is in uff58_test.cpp.
+TEST_F(RecordCsvTest, ForceChannelOnANodeTheModelLacksIsTheRecordsFault) {
+  const fem::DofMap dofs = cantilever_dofs();
+  const auto expect_blamed = [&](const identify::SineTest& test, const std::string& source) {
+    std::vector<std::string> warnings;
+    try {
+      identify::spectrum(identify::measure(test, {.harmonics = 1}), dofs, {tip_joint()}, warnings);
+      FAIL() << "expected std::invalid_argument";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()),
+                source + ": force channel f@99:uy: the model has no node 99 (its nodes: 1–7); a "
+                         "force must act on a free DOF of the model");
+    }
+  };
+  const auto record = write(test::replaced(good_csv, "f@7:uy", "f@99:uy"));
+  expect_blamed(read_record(record), record.string());
+  const auto table = write("# stepped sine\n"
+                           "freq_hz,f@99:uy.re,f@99:uy.im,x@7:uy.re,x@7:uy.im\n"
+                           "3.0,0.0,-10.0,1e-3,-2e-3\n",
+                           "table.csv");
+  expect_blamed(stepped_sine_tests(read_stepped_sine(table), table).at(0), table.string() + ":3");
+}
+
 const std::string table_csv = "# stepped sine, 2 tests\n"
                               "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im\n"
                               "3.0,0.0,-10.0,1e-3,-2e-3\n"
@@ -405,6 +433,93 @@ TEST_F(RecordCsvTest, SteppedSineTableRoundTripIsBitExact) {
     EXPECT_EQ(row.channels[2].at, (fem::NodeDof{3, fem::Dof::rz}));
     EXPECT_EQ(row.channels[1].value, t.values(static_cast<Eigen::Index>(i), 1));
   }
+}
+
+// A table may state its phase convention: `# convention = x(t) = Re(X e^{iωt})` (jointid's, the
+// default), `Re(X e^{-iωt})` or `Im(X e^{iωt})` (a sine reference). Read in jointid's: the
+// signal each row's value describes in its own convention, sampled over a period, is the signal
+// of the value read in jointid's; and a table written in another convention reads back exactly.
+TEST_F(RecordCsvTest, SteppedSineTableMayStateItsPhaseConvention) {
+  SteppedSineTable t;
+  t.freq_hz = {3.0, 4.5};
+  t.channels = {"f@7:uy", "x@7:uy"};
+  t.values.resize(2, 2);
+  t.values << std::complex<double>(0.0, -10.0), std::complex<double>(1e-3, -2e-3),
+      std::complex<double>(7.0, 2.5), std::complex<double>(-4e-3, 5e-4);
+  struct Convention {
+    std::string comment;                                    // as a file states it
+    std::function<double(std::complex<double>, double)> of; // x(t) from X and ωt, by hand
+    std::function<std::complex<double>(std::complex<double>)> written; // X in that convention
+  };
+  const auto re_plus = [](std::complex<double> X, double wt) {
+    return X.real() * std::cos(wt) - X.imag() * std::sin(wt);
+  };
+  const auto re_minus = [](std::complex<double> X, double wt) {
+    return X.real() * std::cos(wt) + X.imag() * std::sin(wt);
+  };
+  const auto im_plus = [](std::complex<double> X, double wt) {
+    return X.real() * std::sin(wt) + X.imag() * std::cos(wt);
+  };
+  const auto same = [](std::complex<double> X) { return X; };
+  const auto conjugate = [](std::complex<double> X) { return std::conj(X); };
+  const auto times_i = [](std::complex<double> X) { return std::complex(-X.imag(), X.real()); };
+  const std::vector<Convention> conventions = {
+      {"", re_plus, same},
+      {"convention = x(t) = Re(X e^{i\u03c9t})", re_plus, same},
+      {"convention = Re(X exp(+iwt))", re_plus, same},
+      {"convention = x(t) = Re(X e^{-i\u03c9t})", re_minus, conjugate},
+      {"convention=re(X\u00b7e^(-j\u03c9t))", re_minus, conjugate},
+      {"convention = x(t) = Im(X e^{i\u03c9t})", im_plus, times_i},
+      {"convention = Im(X*exp(j w t))", im_plus, times_i}};
+  for (const Convention& c : conventions) {
+    SCOPED_TRACE(c.comment);
+    SteppedSineTable in_file = t;
+    in_file.values = t.values.unaryExpr(c.written);
+    std::vector<std::string> comments{"a table"};
+    if (!c.comment.empty()) comments.push_back(c.comment);
+    const SteppedSineTable back =
+        read_stepped_sine(write(stepped_sine_csv(in_file, comments), "table.csv"));
+    ASSERT_EQ(back.values.rows(), 2);
+    ASSERT_EQ(back.values.cols(), 2);
+    for (Eigen::Index i = 0; i < 2; ++i)
+      for (Eigen::Index k = 0; k < 2; ++k) {
+        EXPECT_EQ(back.values(i, k), t.values(i, k)) << i << "," << k; // exactly
+        // The same signal: x(t) of the file's value in its convention, and of the value read.
+        for (int step = 0; step < 8; ++step) {
+          const double wt = 2.0 * std::numbers::pi * step / 8.0;
+          const double scale = std::abs(t.values(i, k));
+          EXPECT_NEAR(c.of(in_file.values(i, k), wt), re_plus(back.values(i, k), wt), 1e-15 * scale)
+              << i << "," << k << " at ωt = " << wt;
+        }
+      }
+  }
+  // An unknown convention, or two that differ, are refused naming the line.
+  const std::string header = "freq_hz,f@7:uy.re,f@7:uy.im,x@7:uy.re,x@7:uy.im\n3.0,0,-10,1,2\n";
+  for (const auto& [text, line, part] : std::vector<std::tuple<std::string, int, std::string>>{
+           {"# one\n# convention = Re(X e^{i\u03c9t + \u03c6})\n" + header, 2,
+            "convention: expected x(t) = Re(X e^{i\u03c9t}) (jointid's, the default), x(t) = "
+            "Re(X e^{-i\u03c9t}) or x(t) = Im(X e^{i\u03c9t}) (a sine reference), got "
+            "\"Re(X e^{i\u03c9t + \u03c6})\""},
+           {"# convention = cosine\n" + header, 1, "got \"cosine\""},
+           {"# convention = Re(X e^{i\u03c9t})\n# convention = Re(X e^{-i\u03c9t})\n" + header, 2,
+            "convention given twice, differently (first at line 1)"}}) {
+    try {
+      read_stepped_sine(write(text, "table.csv"));
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("table.csv:" + std::to_string(line) + ": convention"),
+                std::string::npos)
+          << message;
+      EXPECT_NE(message.find(part), std::string::npos) << message;
+    }
+  }
+  // The same convention twice, and a comment that only starts with the word, are fine.
+  EXPECT_NO_THROW(read_stepped_sine(
+      write("# convention = Re(X e^{iwt})\n# convention = x(t) = Re(X exp(i w t))\n"
+            "# conventions differ between labs\n" +
+                header,
+            "table.csv")));
 }
 
 TEST_F(RecordCsvTest, SteppedSineWriterRefusesWhatTheReaderWouldRefuse) {

@@ -206,3 +206,45 @@ TEST(Substructures, ErrorsNameTheFileAndTheParts) {
   EXPECT_EQ(model(twice), m + ":4: [[substructures]] entry 1: joint 'tip' of a.toml has the name "
                               "of another joint; rename one of them");
 }
+
+// Every part checked against the whole (issue 31): its dimension, its DOFs, its node ids.
+TEST(Substructures, EveryPartIsCheckedAgainstTheWhole) {
+  const TwoBeams x;
+  const auto model = [&](const std::string& text) {
+    test::write_text(x.dir / "m.toml", text);
+    return error_of([&] { (void)io::read_model(x.dir / "m.toml"); });
+  };
+  const std::string m = (x.dir / "m.toml").string();
+  // A spatial whole of planar parts.
+  std::string spatial = TwoBeams::composite("b.toml");
+  spatial.replace(spatial.find("dimension = 2"), 13, "dimension = 3");
+  EXPECT_EQ(model(spatial), m + ":5: [[substructures]] entry 1: key 'file': a.toml is a planar "
+                                "model (dimension = 2), but the whole ([model]) is spatial "
+                                "(dimension = 3): the parts of a model share its dimension");
+  // A [modal] part with a DOF the planar whole lacks (listed after the finite element parts,
+  // and without [model] of its own, where any of the six DOFs may be listed).
+  test::write_text(x.dir / "c.toml", "[modal]\ndofs = [\"1:uz\"]\nfrequencies_hz = [10.0]\n"
+                                     "damping = [0.01]\nshapes = [[1.0]]\n");
+  const std::string with_c =
+      TwoBeams::composite("b.toml") + "\n[[substructures]]\nfile = \"c.toml\"\nnode_offset = 200\n";
+  EXPECT_EQ(model(with_c),
+            m + ":19: [[substructures]] entry 3: c.toml has the DOF 201:uz (node 1 + "
+                "node_offset 200), but the model is planar (dimension = 2: its "
+                "[model]), which has only ux, uy and rz");
+  // Without the whole's [model], the planar finite element parts set the dimension.
+  std::string no_model = with_c;
+  no_model.erase(0, no_model.find("[[substructures]]"));
+  EXPECT_NE(model(no_model).find("c.toml has the DOF 201:uz (node 1 + node_offset 200), but the "
+                                 "model is planar (dimension = 2: substructure 1)"),
+            std::string::npos)
+      << model(no_model);
+  // A node offset that carries a node id past the largest integer.
+  std::string far = TwoBeams::composite("b.toml");
+  far.replace(far.find("node_offset = 100"), 17, "node_offset = 2147483647");
+  EXPECT_NE(model(far).find("[[substructures]] entry 2: key 'file': node "), std::string::npos)
+      << model(far);
+  EXPECT_NE(model(far).find("of b.toml + node_offset 2147483647 is above the largest node id "
+                            "(2147483647)"),
+            std::string::npos)
+      << model(far);
+}

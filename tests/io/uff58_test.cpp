@@ -443,9 +443,10 @@ TEST_F(Uff58Test, SampleTimesAndSiValuesMustStayFiniteAndUniform) {
   text = test::replaced(text, "  2.50000E+00 -3.25000E+00", "  2.50000E+10 -3.25000E+00");
   const auto path = write(tiny_metre + text, "tiny.uff");
   const std::string e = error_of([&] { uff58_tests(read_uff58(path), path); });
-  EXPECT_NE(e.find("tiny.uff: dataset 2 (line 7): record 12 (data values) value 2 is 24999999488, "
-                   "which is inf in SI units"),
-            std::string::npos)
+  EXPECT_NE(
+      e.find("tiny.uff: dataset 2 (line 7), ID line 1 \"Tip displacement, sine test at 3 "
+             "Hz\": record 12 (data values) value 2 is 24999999488, which is inf in SI units"),
+      std::string::npos)
       << e;
 }
 
@@ -589,6 +590,39 @@ TEST_F(Uff58Test, SineTestsIdentifyAsFromCsv) {
   EXPECT_NE(twice.find("given twice"), std::string::npos) << twice;
 }
 
+// A force channel on a node the model lacks is the record's fault: the message starts with the
+// universal file's record and the channel, and says what the model has (issue 31; the CSV
+// record and the stepped-sine table are in record_csv_test.cpp).
+TEST_F(Uff58Test, ForceChannelOnANodeTheModelLacksIsTheRecordsFault) {
+  identify::Record r;
+  r.excitation_hz = 3.0;
+  const int n = 64; // two periods of 32 samples
+  r.t.resize(n);
+  Eigen::VectorXd force(n), x(n);
+  for (int i = 0; i < n; ++i) {
+    r.t(i) = i / (32.0 * 3.0);
+    force(i) = 10.0 * std::sin(2.0 * std::numbers::pi * 3.0 * r.t(i));
+    x(i) = 1e-3 * std::cos(2.0 * std::numbers::pi * 3.0 * r.t(i));
+  }
+  r.channels.push_back({Quantity::force, {99, fem::Dof::uy}, force});
+  r.channels.push_back({Quantity::displacement, {7, fem::Dof::uy}, x});
+  const auto path = dir / "foreign_force.uff";
+  write_uff58(path, uff58_from_record(r));
+  const auto tests = read_tests({path});
+  ASSERT_EQ(tests.size(), 1u);
+  joints::Joint tip{"tip", 7, 0, fem::Dof::uy, {joints::Term::k}, {4800.0}, {false}, {}};
+  const fem::DofMap dofs(test::paper_cantilever());
+  std::vector<std::string> warnings;
+  try {
+    identify::spectrum(identify::measure(tests[0], {.harmonics = 1}), dofs, {tip}, warnings);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path.string() + "#1: force channel f@99:uy: the model has no node 99 (its nodes: "
+                              "1–7); a force must act on a free DOF of the model");
+  }
+}
+
 TEST_F(Uff58Test, MalformedFilesNameFileLineRecordAndField) {
   const std::string& g = hand_written;
   expect_error("junk\n" + g, "bad.uff:1:", {"expected '    -1'"});
@@ -656,10 +690,12 @@ TEST_F(Uff58Test, MalformedFilesNameFileLineRecordAndField) {
 
   // What read_uff58 accepts but is not a sine test.
   expect_test_error(test::replaced(g, "    1         2    3", "    4         2    3"),
-                    {"function type) is 4 (frequency response function)",
-                     "only time responses (1) are sine tests", "FRFs", "substructure"});
-  expect_test_error(test::replaced(g, "         8    1    0", "         0    1    0"),
-                    {"record 9 field 1", "0 (unknown)", "13 (excitation force)"});
+                    {"function type) is 4 (frequency response function), not a test record",
+                     "[frf] section", "jointid modal-fit", "function type 1, or 0 with a time"});
+  expect_test_error(
+      test::replaced(test::replaced(g, "         8    1    0", "         0    1    0"),
+                     "Displacement         mm ", "Displacement         NONE"),
+      {"cannot tell the quantity", "record 9 field 1", "0 (unknown)", "13 (excitation force)"});
   expect_test_error(test::replaced(g, "Displacement         mm ", "Displacement         V  "),
                     {"record 9 field 6 (axis units label) 'V'", "displacement", "mm"});
   expect_test_error(test::replaced(g, "         8    1    0", "         8    2    0"),
@@ -683,7 +719,10 @@ TEST_F(Uff58Test, MalformedFilesNameFileLineRecordAndField) {
     uneven.dataset = 4;
     uneven.line = 30;
     const std::string e = error_of([&] { uff58_tests({uneven}, "x.uff"); });
-    EXPECT_NE(e.find("x.uff: dataset 4 (line 30): record 7 field 3"), std::string::npos) << e;
+    EXPECT_NE(e.find("x.uff: dataset 4 (line 30), ID line 1 \"Tip displacement, sine test at 3 "
+                     "Hz\": record 7 field 3"),
+              std::string::npos)
+        << e;
     EXPECT_NE(e.find("uneven"), std::string::npos) << e;
     Uff58Function complex = read_uff58(write(g))[0];
     complex.ordinate_type = 6;
@@ -697,6 +736,140 @@ TEST_F(Uff58Test, MalformedFilesNameFileLineRecordAndField) {
   // read_tests: a universal file without datasets 58.
   const auto empty = write(header_151, "header.uff");
   EXPECT_NE(error_of([&] { read_tests({empty}); }).find("no dataset 58"), std::string::npos);
+}
+
+// Function type 0 ("general or unknown") and data types 0 and 1 ("unknown", "general"), as data
+// acquisition systems write time data: a time abscissa makes a time response, the units label
+// names the quantity. Four channels of one record, 4 samples at 5 ms, read as the command line
+// reads them; the SI values by hand.
+TEST_F(Uff58Test, TypeZeroAndGeneralDataReadTheirQuantityFromTheUnitsLabel) {
+  const auto function = [](const std::string& id, int type, const std::string& dof,
+                           const std::string& abscissa, const std::string& ordinate,
+                           const std::string& values) {
+    return "    -1\n    58\n" + id + "\nNONE\nNONE\nNONE\nNONE\n" + fmt::format("{:5}", type) +
+           "         1    0         0 NONE      " + dof + " NONE               0   0\n" +
+           "         4         4         1  0.00000E+00  5.00000E-03  0.00000E+00\n" + abscissa +
+           "\n" + ordinate + "\n" + "         0    0    0    0 NONE                 NONE\n" +
+           "         0    0    0    0 NONE                 NONE\n" + values + "\n    -1\n";
+  };
+  const std::string text =
+      // Type 0, abscissa time (17), ordinate unknown (0) in m/s² at node 4, +Z.
+      function("Tip acceleration", 0, "         4   3",
+               "        17    0    0    0 Time                 s",
+               "         0    0    0    0 Response             m/s\xC2\xB2",
+               "  2.500000000000E+00 -1.000000000000E+00  5.000000000000E-01  "
+               "0.000000000000E+00") +
+      // Type 1, ordinate general (1) in mm/s^2 at node 6, +Y.
+      function("Mid acceleration", 1, "         6   2",
+               "        17    0    0    0 Time                 s",
+               "         1    0    0    0 Response             mm/s^2",
+               "  1.250000000000E+03 -2.500000000000E+02  4.000000000000E+00  "
+               "0.000000000000E+00") +
+      // Type 0, abscissa general (1) in s, ordinate general in kN at node 4, +Z: the force.
+      function("Drive force", 0, "         4   3",
+               "         1    0    0    0 Abscissa             s",
+               "         1    0    0    0 Force                kN",
+               "  1.000000000000E-02 -2.000000000000E-02  0.000000000000E+00  "
+               "5.000000000000E-03") +
+      // Type 0, abscissa unknown (0) in ms, ordinate acceleration (12) in g at node 8, -Y.
+      function("Root acceleration", 0, "         8  -2",
+               "         0    0    0    0 NONE                 ms",
+               "        12    1    0    0 Acceleration         g",
+               "  1.000000000000E+00 -5.000000000000E-01  0.000000000000E+00  "
+               "2.000000000000E+00");
+  const auto path = write(text, "daq.uff");
+  const auto tests = read_tests({path});
+  // The fourth's abscissa is 5 ms in ms: 0.005 ms steps, another record.
+  ASSERT_EQ(tests.size(), 2u);
+  const auto& r = std::get<identify::Record>(tests[0]);
+  ASSERT_EQ(r.channels.size(), 3u);
+  EXPECT_EQ(r.channels[0].name(), "a@4:uz");
+  EXPECT_EQ(r.channels[1].name(), "a@6:uy");
+  EXPECT_EQ(r.channels[2].name(), "f@4:uz");
+  const double a4[] = {2.5, -1.0, 0.5, 0.0};     // m/s²
+  const double a6[] = {1.25, -0.25, 0.004, 0.0}; // m/s², from mm/s²
+  const double f4[] = {10.0, -20.0, 0.0, 5.0};   // N, from kN
+  for (Eigen::Index i = 0; i < 4; ++i) {
+    EXPECT_NEAR(r.channels[0].samples(i), a4[i], 1e-15) << i;
+    EXPECT_NEAR(r.channels[1].samples(i), a6[i], 1e-15) << i;
+    EXPECT_NEAR(r.channels[2].samples(i), f4[i], 1e-14) << i;
+  }
+  EXPECT_DOUBLE_EQ(r.t(3), 0.015);
+  const auto& root = std::get<identify::Record>(tests[1]);
+  ASSERT_EQ(root.channels.size(), 1u);
+  EXPECT_EQ(root.channels[0].name(), "a@8:uy");
+  const double a8[] = {-9.80665, 4.903325, 0.0, -19.6133}; // m/s², from g along -Y
+  for (Eigen::Index i = 0; i < 4; ++i)
+    EXPECT_NEAR(root.channels[0].samples(i), a8[i], 1e-14) << i;
+  EXPECT_DOUBLE_EQ(root.t(3), 15e-6); // 3 × 0.005 ms
+}
+
+// What is not a time response, or does not say its quantity, is refused naming the dataset, its
+// line and ID line 1, the record and field to fix, and what jointid can use instead.
+TEST_F(Uff58Test, FunctionsThatAreNotTimeResponsesSayWhatTheyAreAndWhatToFix) {
+  const std::string& g = hand_written;
+  const std::string id = "ID line 1 \"Tip displacement, sine test at 3 Hz\"";
+  const std::string type0 = test::replaced(g, "    1         2    3", "    0         2    3");
+  // Type 0 with a time abscissa (data type 17, or a unit of time) is read; the same without a
+  // time abscissa is refused.
+  EXPECT_NO_THROW(uff58_tests(read_uff58(write(type0)), "t.uff"));
+  EXPECT_NO_THROW(uff58_tests(read_uff58(write(test::replaced(type0, "Time                 s  ",
+                                                              "Time                 NONE"))),
+                              "t.uff"));
+  EXPECT_NO_THROW(uff58_tests(
+      read_uff58(write(test::replaced(type0, "        17    0    0    0 Time                 s  ",
+                                      "         1    0    0    0 Time                 ms "))),
+      "t.uff"));
+  expect_test_error(test::replaced(type0, "        17    0    0    0 Time                 s  ",
+                                   "         0    0    0    0 NONE                 NONE"),
+                    {id, "record 6 field 1 (function type) is 0 (general or unknown)",
+                     "record 8 (abscissa) does not say time",
+                     "set record 8 field 1 to 17 (time) or field 6 to s"});
+  expect_test_error(test::replaced(type0, "        17    0    0    0 Time                 s  ",
+                                   "        18    0    0    0 Frequency            Hz "),
+                    {id, "is 18 (frequency)", "frequency response functions (function type 4)"});
+  // The quantity: neither the data type nor the units label says it.
+  const std::string unknown = test::replaced(type0, "         8    1    0", "         0    0    0");
+  expect_test_error(
+      test::replaced(unknown, "Displacement         mm ", "Displacement         NONE"),
+      {id, "cannot tell the quantity",
+       "record 9 field 1 (ordinate specific data "
+       "type) is 0 (unknown)",
+       "field 6 (axis units label) gives no unit",
+       "set field 1 to 13 (excitation force), 8 (displacement)", "m/s^2"});
+  expect_test_error(
+      test::replaced(unknown, "Displacement         mm ", "Displacement         V  "),
+      {id, "cannot tell the quantity", "'V' is not a unit jointid reads", "m/s2, mm/s2"});
+  expect_test_error(test::replaced(unknown, "Displacement         mm ", "Displacement         rad"),
+                    {id, "record 9 field 6 (axis units label) 'rad' is a unit of a rotation",
+                     "record 6 field 7 (response direction) is 2 (+Y), a translation"});
+  // Unit exponents are checked against the quantity the label names.
+  expect_test_error(test::replaced(unknown, "         0    0    0    0 Displacement",
+                                   "         0    0    1    0 Displacement"),
+                    {"record 9 fields 2–4", "0 1 0", "expected 1 0 0"});
+  // Other function types: spectra, FRFs, the rest.
+  expect_test_error(test::replaced(g, "    1         2    3", "    9         2    3"),
+                    {id, "is 9 (power spectral density): a spectrum has lost the time history",
+                     "export the time responses", "jointid reads time responses"});
+  expect_test_error(test::replaced(g, "    1         2    3", "    6         2    3"),
+                    {"is 6 (coherence), which jointid does not use", "jointid reads time"});
+  expect_test_error(test::replaced(g, "    1         2    3", "    4         2    3"),
+                    {"not a test record", "[frf] section", "jointid modal-fit"});
+  // No refusal of a time record says "[frf]" as if it were an FRF, nor speaks of CSV columns.
+  for (const std::string& text :
+       {test::replaced(unknown, "Displacement         mm ", "Displacement         NONE"),
+        test::replaced(type0, "excitation_hz = 3", "excitation_hz = -3")}) {
+    const auto path = write(text, "bad.uff");
+    std::string message;
+    try {
+      uff58_tests(read_uff58(path), path);
+    } catch (const Error& e) {
+      message = e.what();
+    }
+    ASSERT_FALSE(message.empty());
+    EXPECT_EQ(message.find("[frf]"), std::string::npos) << message;
+    EXPECT_EQ(message.find("column"), std::string::npos) << message;
+  }
 }
 
 TEST_F(Uff58Test, TimeRecordsMustBeFiniteAndHoldFourSamples) {

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -213,16 +214,56 @@ Uff58Function frf_function(const Uff58Axis& numerator, bool response_rotation,
   return f;
 }
 
+// The quantity a label names (for data types 0 and 1), by hand.
+identify::Quantity quantity_of(Kind kind) {
+  switch (kind) {
+  case Kind::length:
+  case Kind::angle:
+    return identify::Quantity::displacement;
+  case Kind::velocity:
+  case Kind::angular_velocity:
+    return identify::Quantity::velocity;
+  case Kind::acceleration:
+  case Kind::angular_acceleration:
+    return identify::Quantity::acceleration;
+  default:
+    return identify::Quantity::force;
+  }
+}
+
+TEST(UffUnits, EveryLabelNamesItsQuantityWhereTheDataTypeDoesNot) {
+  for (const Label& l : labels) {
+    SCOPED_TRACE(trace(l));
+    const std::optional<UffAxisQuantity> q = uff_label_quantity(l.written, at_rotation(l.kind));
+    if (l.kind == Kind::time || l.kind == Kind::frequency) {
+      EXPECT_FALSE(q);
+      continue;
+    }
+    ASSERT_TRUE(q);
+    EXPECT_EQ(q->quantity, quantity_of(l.kind));
+    EXPECT_EQ(q->kind, l.kind);
+    // At the other kind of DOF (a translation's unit at a rotation, and back) it names nothing.
+    EXPECT_FALSE(uff_label_quantity(l.written, !at_rotation(l.kind)));
+  }
+  EXPECT_FALSE(uff_label_quantity("V", false));
+  EXPECT_FALSE(uff_label_quantity("NONE", false));
+}
+
 TEST(UffUnits, EveryLabelScalesTheTimeResponseItLabels) {
+  // The quantity from the data type, or from the label where the data type is 0 (unknown) or 1
+  // (general), as data acquisition systems write it.
   for (const Label& l : labels) {
     if (l.kind == Kind::time || l.kind == Kind::frequency) continue;
-    SCOPED_TRACE(trace(l));
-    const Uff58Function f = time_response(data_type_of(l.kind), at_rotation(l.kind), l.written);
-    const auto tests = uff58_tests({f}, "labels.uff");
-    const auto& r = std::get<identify::Record>(tests.at(0));
-    ASSERT_EQ(r.channels.size(), 1u);
-    for (Eigen::Index i = 0; i < 4; ++i)
-      expect_relative(r.channels[0].samples(i), l.si * f.data(i), 1e-15, std::to_string(i));
+    for (const int data_type : {data_type_of(l.kind), 0, 1}) {
+      SCOPED_TRACE(trace(l) + ", data type " + std::to_string(data_type));
+      const Uff58Function f = time_response(data_type, at_rotation(l.kind), l.written);
+      const auto tests = uff58_tests({f}, "labels.uff");
+      const auto& r = std::get<identify::Record>(tests.at(0));
+      ASSERT_EQ(r.channels.size(), 1u);
+      EXPECT_EQ(r.channels[0].quantity, quantity_of(l.kind));
+      for (Eigen::Index i = 0; i < 4; ++i)
+        expect_relative(r.channels[0].samples(i), l.si * f.data(i), 1e-15, std::to_string(i));
+    }
   }
   for (const Label& l : labels) {
     if (l.kind != Kind::time) continue;
@@ -240,34 +281,37 @@ TEST(UffUnits, EveryLabelScalesTheFrfItLabels) {
   // or rotation (so that no 1/(iω) enters), the denominator a force or moment.
   const Uff58Axis metre{uff_data_type::displacement, 0, 0, 0, "Displacement", "m"};
   const Uff58Axis newton{uff_data_type::excitation_force, 0, 0, 0, "Force", "N"};
-  for (const Label& l : labels) {
-    if (l.kind == Kind::time) continue;
-    SCOPED_TRACE(trace(l));
-    const bool rotation = at_rotation(l.kind);
-    const Uff58Axis axis{data_type_of(l.kind), 0, 0, 0, "Axis", l.written};
-    double num = 1.0, den = 1.0;
-    Uff58Function f;
-    if (l.kind == Kind::length || l.kind == Kind::angle) {
-      f = frf_function(axis, rotation, newton, false);
-      num = l.si;
-    } else if (l.kind == Kind::force || l.kind == Kind::moment) {
-      f = frf_function(metre, false, axis, rotation);
-      den = l.si;
-    } else if (l.kind == Kind::frequency) {
-      f = frf_function(metre, false, newton, false);
-      f.abscissa.units_label = l.written;
-    } else {
-      continue; // velocities and accelerations: their factors are checked with time responses
+  // Data types 0 (unknown) and 1 (general) take their quantity from the label.
+  for (const Label& l : labels)
+    for (const int data_type : {data_type_of(l.kind), 0, 1}) {
+      if (l.kind == Kind::time) continue;
+      SCOPED_TRACE(trace(l) + ", data type " + std::to_string(data_type));
+      const bool rotation = at_rotation(l.kind);
+      const Uff58Axis axis{data_type, 0, 0, 0, "Axis", l.written};
+      double num = 1.0, den = 1.0;
+      Uff58Function f;
+      if (l.kind == Kind::length || l.kind == Kind::angle) {
+        f = frf_function(axis, rotation, newton, false);
+        num = l.si;
+      } else if (l.kind == Kind::force || l.kind == Kind::moment) {
+        f = frf_function(metre, false, axis, rotation);
+        den = l.si;
+      } else if (l.kind == Kind::frequency) {
+        f = frf_function(metre, false, newton, false);
+        f.abscissa.units_label = l.written;
+      } else {
+        continue; // velocities and accelerations: their factors are checked with time responses
+      }
+      const auto frfs = uff58_frfs({f}, "labels.uff");
+      ASSERT_EQ(frfs.size(), 1u);
+      EXPECT_EQ(frfs[0].frequencies_hz, (std::vector<double>{10.0, 11.0}));
+      for (std::size_t i = 0; i < 2; ++i) {
+        const std::complex<double> expected =
+            f.complex_data(static_cast<Eigen::Index>(i)) * num / den;
+        EXPECT_NEAR(std::abs(frfs[0].receptance[i] - expected), 0.0, 1e-15 * std::abs(expected))
+            << i;
+      }
     }
-    const auto frfs = uff58_frfs({f}, "labels.uff");
-    ASSERT_EQ(frfs.size(), 1u);
-    EXPECT_EQ(frfs[0].frequencies_hz, (std::vector<double>{10.0, 11.0}));
-    for (std::size_t i = 0; i < 2; ++i) {
-      const std::complex<double> expected =
-          f.complex_data(static_cast<Eigen::Index>(i)) * num / den;
-      EXPECT_NEAR(std::abs(frfs[0].receptance[i] - expected), 0.0, 1e-15 * std::abs(expected)) << i;
-    }
-  }
 }
 
 // Dataset 164 unit systems: inch–pound-force, and millimetre–millinewton (I-DEAS "MM").
