@@ -21,7 +21,11 @@ constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 Outcome refused(Candidate c, const State& state, const std::string& why) {
   c.rejected = why;
   c.gap = c.criterion = inf;
-  return {std::move(c), state};
+  State none; // no model: nothing simulated
+  none.joints = state.joints;
+  none.damping_scale = state.damping_scale;
+  none.gap = none.criterion = inf;
+  return {std::move(c), std::move(none)};
 }
 
 Outcome consider_refit(const Problem& problem, const State& state, const Simulator& sim) {
@@ -127,7 +131,13 @@ Outcome consider_damping(const Problem& problem, const State& state) {
       const identify::FitResult fit = problem.identify(state.joints, *sim, problem.all_tests());
       State st = problem.evaluate(fit.identified(state.joints), *sim);
       st.fit = fit;
-      if (!st.converged || !physical_problem(st.joints).empty()) return inf;
+      // The trials are compared with each other: each must re-simulate every test the model
+      // now does.
+      if (!std::isfinite(st.criterion) ||
+          !std::includes(state.failed.begin(), state.failed.end(), st.failed.begin(),
+                         st.failed.end()) ||
+          !physical_problem(st.joints).empty())
+        return inf;
       const double f = st.criterion;
       tried.emplace(u, std::move(st));
       return f;
@@ -176,17 +186,19 @@ std::vector<std::function<Outcome()>> candidate_jobs(const Problem& problem, con
   const Problem* p = &problem;
   const State* s = &state;
   const Simulator* sim = &current;
+  const Preconditions& can = problem.preconditions();
   std::vector<std::function<Outcome()>> jobs;
   if (!values_fitted) jobs.push_back([=] { return consider_refit(*p, *s, *sim); });
   for (const auto& j : state.joints)
     for (joints::Term t : problem.options().terms)
-      if (j.term_index(t) < 0)
+      // An even force has no fundamental for a sinusoidal deformation: from the fundamentals
+      // alone (tables) it cannot be identified (Preconditions::harmonics).
+      if (j.term_index(t) < 0 && (can.harmonics || !joints::term_info(t).even))
         jobs.push_back([=, name = j.name] { return consider_term(*p, *s, *sim, name, t); });
-  if (problem.options().substructure_damping && problem.synthesis().num_modes() > 0)
-    jobs.push_back([=] { return consider_damping(*p, *s); });
+  if (can.damping_scale) jobs.push_back([=] { return consider_damping(*p, *s); });
   // What the library cannot add: a term of the model whose coefficient changes between tests
   // (with four tests or more: fewer leave too little to tell a trend from a fit).
-  if (problem.tests().size() >= 4)
+  if (can.per_test_values)
     for (const auto& j : state.joints)
       for (std::size_t t = 0; t < j.terms.size(); ++t)
         if (!j.fixed[t])

@@ -15,7 +15,8 @@ namespace jointid::discover::detail {
 /// A candidate and the state it gives.
 using Outcome = std::pair<Candidate, State>;
 
-/// A candidate that gives no model: rejected with `why`, its gap and criterion infinite.
+/// A candidate that gives no model: rejected with `why`, its gap and criterion infinite, its
+/// state nothing simulated (the joints of `state`).
 Outcome refused(Candidate candidate, const State& state, const std::string& why);
 
 /// The starting values identified again (when none was identified at the start).
@@ -34,9 +35,10 @@ Outcome consider_variation(const Problem& problem, const State& state, const Sim
 Outcome consider_damping(const Problem& problem, const State& state);
 
 /// Every candidate of a step from `state` (simulated with `current`), as jobs to run in
-/// parallel: a refit unless `values_fitted`, the library's terms at every joint, the damping
-/// scale (if asked and the substructure has modes), and, with four tests or more, a value per
-/// test of every non-fixed term. The jobs refer to the arguments, which must outlive them.
+/// parallel: a refit unless `values_fitted`, the library's terms at every joint (even ones only
+/// where some test has harmonics beyond the fundamental), the damping scale (if asked and the
+/// substructure has modes), and, with four tests or more, a value per test of every non-fixed
+/// term (Problem::preconditions). The jobs refer to the arguments, which must outlive them.
 std::vector<std::function<Outcome()>> candidate_jobs(const Problem& problem, const State& state,
                                                      const Simulator& current, bool values_fitted);
 

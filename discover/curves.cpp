@@ -31,17 +31,21 @@ ResponseCurve sweep(const Problem& problem, const State& state,
                     const frf::ModalSynthesis& synthesis, const Sweeps& s, std::size_t g,
                     bool down) {
   const auto& tests = problem.tests();
-  const int points = problem.options().curve_points;
   const bool over_frequency = s.over_frequency;
   // The group's tests: their span, and the first one's force DOF and outputs.
   double lo = inf, hi = -inf;
-  int first = -1;
+  int first = -1, count = 0;
   for (std::size_t i = 0; i < tests.size(); ++i)
     if (s.group[i] == static_cast<int>(g)) {
       const double x = over_frequency ? s.frequency[i] : s.level[i];
       lo = std::min(lo, x), hi = std::max(hi, x);
       if (first < 0) first = static_cast<int>(i);
+      ++count;
     }
+  // At least a point between every two tests (a stepped sweep's resonance peak is as narrow as
+  // its steps), up to four times the points asked.
+  const int asked = problem.options().curve_points;
+  const int points = std::clamp(2 * count - 1, asked, 4 * asked);
   const auto& m = tests[first];
   ResponseCurve c;
   c.over_frequency = over_frequency;
@@ -118,7 +122,10 @@ std::vector<ResponseCurve> curves(const Problem& problem, const State& state) {
   Sweeps s;
   for (const auto& m : problem.tests())
     s.frequency.push_back(m.frequency_hz), s.level.push_back(identify::force_level(m));
-  auto [fg, fmeans] = cluster(s.frequency, 0.01);
+  // Frequencies apart by 0.01 % are other frequencies: a stepped sine's steps near a resonance
+  // are fine (0.25 Hz at 75 Hz is 0.33 %), and grouped by a coarser tolerance, step after step,
+  // its whole sweep would be one "frequency". Force levels within 3 % are one level.
+  auto [fg, fmeans] = cluster(s.frequency, 1e-4);
   auto [lg, lmeans] = cluster(s.level, 0.03);
   s.over_frequency = fmeans.size() >= lmeans.size();
   s.group = s.over_frequency ? lg : fg;

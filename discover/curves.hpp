@@ -12,10 +12,12 @@ namespace jointid::discover::detail {
 std::pair<std::vector<int>, std::vector<double>> cluster(const std::vector<double>& values,
                                                          double tolerance);
 
-/// The model's response curves through the tests: per force level over frequency (or per
-/// frequency over level, whichever the tests vary more), at the force DOF of the group's first
-/// test, by continuation from point to point; swept up, and down where that differs by more
-/// than 1 % (another branch). None when Options::curve_points < 2.
+/// The model's response curves through the tests: per force level (within 3 %) over frequency,
+/// or per frequency (within 0.01 %) over level, whichever the tests have more of, at the force
+/// DOF of the group's first test, by continuation from point to point; swept up, and down where
+/// that differs by more than 1 % (another branch). Options::curve_points each, or a point
+/// between every two tests of the group where it has more (at most four times as many). None
+/// when Options::curve_points < 2.
 std::vector<ResponseCurve> curves(const Problem& problem, const State& state);
 
 } // namespace jointid::discover::detail

@@ -1,5 +1,6 @@
 #include "discover/diagnosis.hpp"
 
+#include "discover/selection.hpp"
 #include "discover/text.hpp"
 
 #include <fmt/format.h>
@@ -63,9 +64,7 @@ struct Best {
 template <class Keep> Best best_of(const std::vector<Candidate>& ranking, Keep&& keep) {
   const Candidate* who = nullptr;
   for (const auto& c : ranking)
-    if (c.converged && std::isfinite(c.criterion) && keep(c) &&
-        (!who || c.criterion < who->criterion))
-      who = &c;
+    if (std::isfinite(c.criterion) && keep(c) && (!who || c.criterion < who->criterion)) who = &c;
   return {who ? std::max(who->explained, 0.0) : 0.0, who};
 }
 
@@ -89,11 +88,33 @@ Families families(const std::vector<Candidate>& ranking) {
           })};
 }
 
-// Linear or not: can a linear correction do as well as a non-linear term?
-void level_finding(Diagnosis& d, const Families& f, int values) {
+// Linear or not: can a linear correction do as well as a non-linear term? Returns whether a
+// non-linear term does better. From tests at one force level that is not a change with the
+// level, which they cannot show: it is said so, and level_dependent stays empty.
+bool level_finding(Diagnosis& d, const Families& f, int values, bool several_levels) {
   const Best &lin = f.linear, &non = f.nonlinear;
-  d.level_dependent = changes_with_level(lin.who ? lin.who->criterion : inf,
-                                         non.who ? non.who->criterion : inf, values);
+  const bool nonlinear = changes_with_level(lin.who ? lin.who->criterion : inf,
+                                            non.who ? non.who->criterion : inf, values);
+  if (!several_levels) {
+    d.findings.push_back(fmt::format(
+        "The tests are all at one force level: they cannot tell whether the disagreement "
+        "changes with the level. {}",
+        nonlinear
+            ? fmt::format("A non-linear term ({}) explains {} of it, the best linear correction{} "
+                          "{}.",
+                          non.who->name(), pct(non.share),
+                          lin.who ? " (" + lin.who->name() + ")" : std::string(),
+                          pct(std::max(lin.share, 0.0)))
+            : fmt::format("The best linear correction ({}) explains {} of it{}; no non-linear "
+                          "term does better.",
+                          lin.who ? lin.who->name() : std::string("none"),
+                          pct(std::max(lin.share, 0.0)),
+                          non.who ? fmt::format(", the best non-linear term ({}) {}",
+                                                non.who->name(), pct(non.share))
+                                  : std::string())));
+    return nonlinear;
+  }
+  d.level_dependent = nonlinear;
   if (*d.level_dependent) {
     d.findings.push_back(fmt::format(
         "The disagreement changes with force level (non-linear): the best linear correction{} "
@@ -108,15 +129,17 @@ void level_finding(Diagnosis& d, const Families& f, int values) {
         non.who ? fmt::format(", the best non-linear term ({}) {}", non.who->name(), pct(non.share))
                 : std::string()));
   }
+  return nonlinear;
 }
 
 // Where: the joint of the best candidate of the family that explains it, against the others.
-void where_finding(Diagnosis& d, const std::vector<Candidate>& ranking, const Families& f) {
+void where_finding(Diagnosis& d, const std::vector<Candidate>& ranking, const Families& f,
+                   bool nonlinear) {
   std::map<std::string, double> by_joint;
   for (const auto& c : ranking)
-    if (c.converged && std::isfinite(c.gap) && (!c.refit))
+    if (std::isfinite(c.gap) && (!c.refit))
       by_joint[c.joint] = std::max(by_joint[c.joint], c.explained);
-  const Candidate* where = *d.level_dependent ? f.nonlinear.who : f.linear.who;
+  const Candidate* where = nonlinear ? f.nonlinear.who : f.linear.who;
   if (!where) return;
   d.joint = where->joint;
   std::string others;
@@ -139,23 +162,26 @@ std::string named_share(const Best& b) {
   return b.who ? fmt::format("({}) {}", b.who->name(), pct(b.share)) : std::string("none");
 }
 
-// Conservative or dissipative: which non-linear family explains more.
-void nature_finding(Diagnosis& d, const Families& f) {
+// Conservative or dissipative: which non-linear family explains more. What it does with the
+// level only where the tests have several levels.
+void nature_finding(Diagnosis& d, const Families& f, bool several_levels) {
   const Best &cons = f.conservative, &diss = f.dissipative;
   d.nature = cons.share > diss.share ? "conservative" : "dissipative";
   if (d.nature == "conservative") {
     std::string how;
     if (cons.who && cons.who->term == joints::Term::k3)
-      how = cons.who->value > 0.0 ? " (hardening: the resonance rises with level)"
-                                  : " (softening: the resonance falls with level)";
+      how = cons.who->value > 0.0
+                ? several_levels ? " (hardening: the resonance rises with level)" : " (hardening)"
+            : several_levels ? " (softening: the resonance falls with level)"
+                             : " (softening)";
     d.findings.push_back(
         fmt::format("Conservative: a stiffness term ({}) explains {}, the best damping term {}{}.",
                     cons.who->name(), pct(cons.share), named_share(diss), how));
   } else {
     d.findings.push_back(
-        fmt::format("Dissipative: a damping term ({}) explains {}, the best stiffness term {}; the "
-                    "damping changes with level.",
-                    diss.who->name(), pct(diss.share), named_share(cons)));
+        fmt::format("Dissipative: a damping term ({}) explains {}, the best stiffness term {}{}.",
+                    diss.who->name(), pct(diss.share), named_share(cons),
+                    several_levels ? "; the damping changes with level" : ""));
   }
 }
 
@@ -188,14 +214,29 @@ void even_finding(Diagnosis& d, const EvenHarmonics& even, const std::vector<Can
 
 } // namespace
 
+std::string unjudged(const std::vector<Candidate>& ranking, const State& s,
+                     const std::vector<identify::Measurement>& tests) {
+  std::vector<std::string> names;
+  for (const auto& c : ranking)
+    if (!c.converged && !c.varies) names.push_back(c.name());
+  std::string why;
+  if (!names.empty())
+    why = fmt::format("the re-simulations of {} did not converge for every test", join(names));
+  if (!s.failed.empty())
+    why += fmt::format("{}the model's did not converge for {} test{} (e.g. {})",
+                       why.empty() ? "" : ", and ", s.failed.size(),
+                       s.failed.size() == 1 ? "" : "s", tests[s.failed.front()].source);
+  return why;
+}
+
 bool changes_with_level(double linear_criterion, double nonlinear_criterion, int values) {
   const double N = values;
   return nonlinear_criterion + std::log(N) < linear_criterion;
 }
 
 Diagnosis diagnose(const Compared& compared, const std::vector<identify::Measurement>& tests,
-                   const State& s, const std::vector<Candidate>& ranking,
-                   const Candidate* outside) {
+                   const State& s, const std::vector<Candidate>& ranking, const Candidate* outside,
+                   const Preconditions& preconditions) {
   Diagnosis d;
   const EvenHarmonics even = disagreement(d, compared, tests, s);
   d.even_content = even.content;
@@ -208,8 +249,10 @@ Diagnosis diagnose(const Compared& compared, const std::vector<identify::Measure
   d.nonlinear_explains = f.nonlinear.share;
   d.conservative_explains = f.conservative.share;
   d.dissipative_explains = f.dissipative.share;
-  const bool significant = std::any_of(ranking.begin(), ranking.end(),
-                                       [](const Candidate& c) { return c.rejected.empty(); });
+  // Admissible, or failing only the rule that could not be applied (held-out tests).
+  const bool significant = std::any_of(ranking.begin(), ranking.end(), [](const Candidate& c) {
+    return c.rejected.empty() || only_unchecked(c);
+  });
 
   if (compared.noise_known)
     d.findings.push_back(fmt::format(
@@ -241,14 +284,21 @@ Diagnosis diagnose(const Compared& compared, const std::vector<identify::Measure
     return d;
   }
   if (!significant) {
-    d.findings.push_back(
-        "No candidate explains a significant share of the disagreement: nothing is missing "
-        "that these tests can reveal.");
+    const std::string why = unjudged(ranking, s, tests);
+    if (why.empty())
+      d.findings.push_back(
+          "No candidate explains a significant share of the disagreement: nothing is missing "
+          "that these tests can reveal.");
+    else
+      d.findings.push_back(fmt::format(
+          "No candidate that could be judged explains a significant share of the disagreement; "
+          "but the conclusion is limited: {}, so what those would explain there is unknown.",
+          why));
     return d;
   }
-  level_finding(d, f, compared.values);
-  where_finding(d, ranking, f);
-  if (*d.level_dependent) nature_finding(d, f);
+  const bool nonlinear = level_finding(d, f, compared.values, preconditions.several_levels);
+  where_finding(d, ranking, f, nonlinear);
+  if (nonlinear) nature_finding(d, f, preconditions.several_levels);
   if (d.even_harmonics)
     even_finding(d, even, ranking, tests.size(), compared.noise_known);
   else if (any_harmonics)

@@ -4,6 +4,7 @@
 /// or not (a linear model error), at which joint, conservative or dissipative, and whether even
 /// harmonics point to an asymmetric joint force; in sentences.
 #include "discover/gap.hpp"
+#include "discover/preconditions.hpp"
 
 #include <string>
 #include <vector>
@@ -12,10 +13,20 @@ namespace jointid::discover::detail {
 
 /// From the starting state, its compared values and tests, and the first step's additions
 /// (each with its criterion and its share of the squared gap explained). `outside`: the best
-/// explanation, when it is a coefficient that changes between tests.
+/// explanation, when it is a coefficient that changes between tests. What the tests cannot
+/// tell (`preconditions`) is not said: from tests at one force level, nothing about a change
+/// with the level; when a candidate's re-simulations or the model's did not converge for every
+/// test, never that nothing is missing.
 Diagnosis diagnose(const Compared& compared, const std::vector<identify::Measurement>& tests,
                    const State& state, const std::vector<Candidate>& additions,
-                   const Candidate* outside);
+                   const Candidate* outside, const Preconditions& preconditions);
+
+/// What the rules could not judge: the additions whose re-simulations did not converge for
+/// every test (left out or rejected), and the tests the state could not re-simulate — "the
+/// re-simulations of k3 at 'tip' did not converge for every test, and the model's did not
+/// converge for 2 tests (e.g. t.csv:12)". Empty when everything was judged.
+std::string unjudged(const std::vector<Candidate>& additions, const State& state,
+                     const std::vector<identify::Measurement>& tests);
 
 /// The disagreement changes with the force level when the best non-linear addition's criterion
 /// is below the best linear one's by more than ln N (N real values compared): a non-linear term

@@ -21,6 +21,7 @@
 
 #include <cmath>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -64,7 +65,31 @@ private:
     out.warnings = problem_.notes();
     for (const auto& m : problem_.tests())
       out.warnings.insert(out.warnings.end(), m.warnings.begin(), m.warnings.end());
+    out.limits = problem_.preconditions().limits;
+    out.warnings.insert(out.warnings.end(), out.limits.begin(), out.limits.end());
     return out;
+  }
+
+  // "a.csv:3, a.csv:7 and 2 more".
+  std::string named(const std::vector<int>& tests) const {
+    std::vector<std::string> names = problem_.sources(tests);
+    if (names.size() > 4) {
+      const std::size_t more = names.size() - 3;
+      names.resize(3);
+      names.push_back(fmt::format("{} more", more));
+    }
+    return join(names);
+  }
+
+  // A state's tests whose re-simulation did not converge, in a warning.
+  void warn_left_out(Result& out, const State& state, const std::string& model) const {
+    if (state.failed.empty()) return;
+    out.warnings.push_back(fmt::format(
+        "the re-simulation of {} test{} with {} did not converge, even from the measured "
+        "response and from the nearest tests: {}; left out of its gap{}",
+        state.failed.size(), state.failed.size() == 1 ? "" : "s", model, named(state.failed),
+        comparable(problem_.compared(), state) ? std::string()
+                                               : " (too many: the model could not be compared)"));
   }
 
   // 1. The starting model: values not given are identified from all tests.
@@ -103,9 +128,7 @@ private:
       out.start_notes.push_back("Every starting term has a value in the model file; those values "
                                 "are the starting model.");
     }
-    if (!state.converged)
-      out.warnings.push_back("the harmonic balance did not converge for every test with the "
-                             "starting model");
+    warn_left_out(out, state, "the starting model");
     out.states.push_back(state);
     return state;
   }
@@ -119,7 +142,7 @@ private:
     if (!(compared.noise_known && simulation_gap > 0.3 * compared.noise_gap && values_fitted_))
       return;
     State again = refine(problem_, state, problem_.simulator(state.damping_scale));
-    if (!again.converged) return;
+    if (!std::isfinite(again.criterion) || again.failed.size() > state.failed.size()) return;
     state = std::move(again);
     simulation_gap = problem_.estimate_simulation_error(state);
     out.states.back() = state;
@@ -135,9 +158,12 @@ private:
   // — the best few by the criterion, simulated and converged — identified again by output
   // error, and judged again (the equation-error estimate screens; noise in the measured
   // deformation biases it, e.g. a stiff joint's damping).
-  void try_candidates(const std::vector<std::function<Outcome()>>& jobs, const Simulator& current,
-                      std::vector<Candidate>& ranking, std::vector<State>& states) const {
+  void try_candidates(const std::vector<std::function<Outcome()>>& jobs, const State& now,
+                      const Simulator& current, std::vector<Candidate>& ranking,
+                      std::vector<State>& states) const {
+    const std::vector<std::string> sources = problem_.sources(problem_.all_tests());
     for (auto& [c, s] : fem::parallel_map(jobs)) {
+      compare_on_common_tests(c, s, now, problem_.compared(), sources);
       ranking.push_back(std::move(c));
       states.push_back(std::move(s));
     }
@@ -154,7 +180,18 @@ private:
       const std::size_t i = best[f];
       states[i] = std::move(refined[f]);
       judge(ranking[i], states[i]);
+      compare_on_common_tests(ranking[i], states[i], now, problem_.compared(), sources);
     }
+  }
+
+  // The cross-validated gap of a state on the tests that it and the model now re-simulated,
+  // kept per set of tests left out for the model now (computed once per step for most).
+  CrossValidation cross_validated_now(const State& now, const State& candidate,
+                                      std::map<std::vector<int>, CrossValidation>& kept) {
+    const std::vector<int> out = united(now.failed, candidate.failed);
+    const auto it = kept.find(out);
+    if (it != kept.end()) return it->second;
+    return kept[out] = cross_validated(problem_, now.joints, now.damping_scale, out);
   }
 
   // 2. One step: the admissible candidate with the lowest criterion is added. False when the
@@ -169,20 +206,23 @@ private:
     }
     std::vector<Candidate> ranking;
     std::vector<State> states;
-    try_candidates(jobs, current, ranking, states);
+    try_candidates(jobs, state, current, ranking, states);
     const std::vector<std::size_t> order = screen(ranking, state, o_.min_explained);
+    std::map<std::vector<int>, CrossValidation> cv_now;
     const Choice choice = choose(
         ranking, order,
-        [&] { return cross_validated(problem_, state.joints, state.damping_scale); },
+        [&](std::size_t i) { return cross_validated_now(state, states[i], cv_now); },
         [&](std::size_t i) {
-          return cross_validated(problem_, states[i].joints, states[i].damping_scale);
+          return cross_validated(problem_, states[i].joints, states[i].damping_scale,
+                                 united(state.failed, states[i].failed));
         });
     if (step == 0) {
       std::vector<Candidate> additions;
       for (const auto& c : ranking)
         if (!c.varies) additions.push_back(c);
-      out.diagnosis = diagnose(problem_.compared(), problem_.tests(), state, additions,
-                               choice.outside ? &ranking[*choice.outside] : nullptr);
+      out.diagnosis =
+          diagnose(problem_.compared(), problem_.tests(), state, additions,
+                   choice.outside ? &ranking[*choice.outside] : nullptr, problem_.preconditions());
     }
     Step s;
     for (std::size_t i : order)
@@ -192,25 +232,60 @@ private:
         out.stop_reason = outside_the_library(ranking, order, *choice.outside, state.gap);
         out.diagnosis.findings.push_back(ranking[*choice.outside].varies->description);
       } else {
-        const Candidate& best = ranking[order.front()];
-        out.stop_reason = fmt::format(
-            "no addition is significant (the best, {}, was rejected: {}); the gap stays at {}",
-            best.name(), best.rejected, number(state.gap));
+        out.stop_reason = nothing_added(ranking, order, state);
       }
       out.last_ranking = std::move(s.ranking);
       return false;
     }
     s.added = ranking[*choice.chosen];
-    s.gap_before = state.gap;
+    // On the tests both models re-simulated, when either left some out.
+    s.gap_before = s.added.gap_now >= 0.0 ? s.added.gap_now : state.gap;
     s.cv_before = choice.cv_now.value_or(-1.0);
     s.cv_after = s.added.cv_gap;
     state = std::move(states[*choice.chosen]);
-    s.gap_after = state.gap;
+    s.gap_after = s.added.gap_now >= 0.0 ? s.added.gap : state.gap;
     s.finding = finding(s);
     values_fitted_ = true;
+    warn_left_out(out, state,
+                  "the model after step " + std::to_string(out.steps.size() + 1) + " (+ " +
+                      s.added.name() + ")");
+    if (!s.added.determined())
+      out.warnings.push_back(fmt::format("the 95 % interval of {} added in step {} could not be "
+                                         "determined: its value is not a result",
+                                         s.added.name(), out.steps.size() + 1));
     out.steps.push_back(std::move(s));
     out.states.push_back(state);
     return true;
+  }
+
+  // Why nothing is added: the best addition cannot be checked against held-out tests, or none
+  // is significant; and what the rules could not judge.
+  std::string nothing_added(const std::vector<Candidate>& ranking,
+                            const std::vector<std::size_t>& order, const State& now) const {
+    std::string reason;
+    for (std::size_t i : order)
+      if (only_unchecked(ranking[i])) {
+        const Candidate& c = ranking[i];
+        reason = fmt::format("nothing is added: the best addition, {} (it explains {} of the "
+                             "squared gap), {}; more tests would decide",
+                             c.name(), pct(c.explained), c.rejected);
+        break;
+      } else if (ranking[i].rejected.empty()) {
+        break;
+      }
+    if (reason.empty()) {
+      const Candidate& best = ranking[order.front()];
+      reason = fmt::format(
+          "no addition is significant (the best, {}, was rejected: {}); the gap stays at {}",
+          best.name(), best.rejected, number(now.gap));
+    }
+    std::vector<Candidate> additions;
+    for (const auto& c : ranking)
+      if (!c.varies) additions.push_back(c);
+    if (const std::string why = unjudged(additions, now, problem_.tests()); !why.empty())
+      reason += "; but the conclusion is limited: " + why +
+                ", so what they would explain there is unknown";
+    return reason;
   }
 
   static std::string outside_the_library(const std::vector<Candidate>& ranking,
@@ -245,7 +320,7 @@ private:
       out.curves.push_back(curves(problem_, s));
     }
     out.at_noise_level = at_noise_level(compared, out.states.back());
-    out.chi2_per_value = out.states.back().chi2 / compared.values;
+    out.chi2_per_value = out.states.back().chi2 / misfit(compared, state.X, state.failed).values;
     if (compared.noise_known) out.chi2_by_harmonic = chi2_by_harmonic(compared, state.X);
     if (out.steps.empty() && out.at_noise_level && out.diagnosis.findings.empty())
       out.diagnosis.findings.push_back(fmt::format(

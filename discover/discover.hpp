@@ -117,12 +117,20 @@ struct Candidate {
   double value = 0.0;         ///< identified coefficient (SI), or the damping scale
   double std = 0.0;
   double ci_low = 0.0, ci_high = 0.0;
+  /// The 95 % interval is a result: finite, of non-zero width (false: "undetermined", never a
+  /// number ± 0).
+  bool determined() const;
   double gap = 0.0;       ///< after adding it
   double criterion = 0.0; ///< information criterion after adding it
   double explained = 0.0; ///< share of the squared gap it removes (negative: worse)
   bool converged = true;  ///< every re-simulation converged
-  double cv_gap = -1.0;   ///< cross-validated gap (< 0: not computed)
-  std::string rejected;   ///< why it may not be added; empty: admissible
+  /// Tests whose re-simulation with it did not converge, even from the measured response:
+  /// left out of its comparison with the model before it, which is compared on the same tests
+  /// (`gap` and `gap_now` are over those; its criterion is the model's plus the difference).
+  std::vector<std::string> left_out;
+  double gap_now = -1.0; ///< the model before it on the tests it is compared on (< 0: all)
+  double cv_gap = -1.0;  ///< cross-validated gap (< 0: not computed)
+  std::string rejected;  ///< why it may not be added; empty: admissible
 };
 
 /// A model and how well it reproduces the measurement.
@@ -133,7 +141,11 @@ struct State {
   double gap = 0.0;
   double chi2 = 0.0; ///< Σ |e|² / (E|δX|²/2) when the noise is known, else NaN
   double criterion = 0.0;
-  bool converged = true;
+  bool converged = true; ///< every test's re-simulation converged
+  /// Tests whose re-simulation did not converge (from the measured response, the nearest
+  /// re-simulated test and the linear response), ascending: left out of the gap, χ² and
+  /// criterion. More than a tenth of the tests: not compared at all (criterion +∞).
+  std::vector<int> failed;
   std::vector<Eigen::MatrixXcd> X; ///< per test: simulated harmonics 0 … K at its responses
   std::vector<Eigen::MatrixXcd> Y; ///< per test: the joints' deformation harmonics (all solved)
   identify::FitResult fit;         ///< the identification that gave the values (if any)
@@ -151,11 +163,13 @@ struct Step {
 struct Comparison {
   std::string test, channel;
   double frequency_hz = 0.0, force = 0.0;
+  std::complex<double> force_phasor;        ///< F_1 of its (first) force channel, N or N·m
   std::complex<double> measured, simulated; ///< X_1, m or rad
   double amplitude_error = 0.0;             ///< |X_sim| / |X_meas| − 1
   double phase_error_deg = 0.0;             ///< arg(X_sim / X_meas)
   double harmonics_measured = 0.0;          ///< sqrt(Σ_{k≥2} |X_k|²) / |X_1|, measured
   double harmonics_simulated = 0.0;
+  bool converged = true; ///< false: its re-simulation did not converge (left out)
 };
 
 /// A model's response along a sweep through the tests: over frequency at one force level, or over
@@ -174,7 +188,8 @@ struct ResponseCurve {
 };
 
 struct Diagnosis {
-  /// Does the disagreement change with force level? Empty when nothing significant is found.
+  /// Does the disagreement change with force level? Empty when nothing significant is found,
+  /// or when the tests are all at one force level (they cannot tell).
   std::optional<bool> level_dependent;
   double linear_explains = 0.0;    ///< best linear candidate's share of the squared gap
   double nonlinear_explains = 0.0; ///< best non-linear candidate's share
@@ -214,6 +229,12 @@ struct Result {
   Diagnosis diagnosis;
   std::string stop_reason;
   std::vector<std::string> warnings;
+  /// The rules these tests do not allow to be applied, and what that means for the result (also
+  /// among the warnings): cross-validation and a value per test need four tests or more; the
+  /// level dependence, tests at more than one force level; the noise level, records; even
+  /// terms and harmonics, more than the fundamental; the damping scale, a substructure with
+  /// modes.
+  std::vector<std::string> limits;
   /// Per state: the fundamental at every test and channel.
   std::vector<std::vector<Comparison>> comparisons;
   /// Per state: the model's response curves through the tests (Options::curve_points > 0).

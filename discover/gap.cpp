@@ -1,6 +1,8 @@
 #include "discover/gap.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 
 namespace jointid::discover::detail {
@@ -11,6 +13,7 @@ constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 Compared compared_values(const std::vector<identify::Measurement>& tests, int harmonics) {
   Compared c;
+  c.tests = static_cast<int>(tests.size());
   c.harmonics = harmonics;
   for (std::size_t i = 0; i < tests.size(); ++i) {
     const auto& m = tests[i];
@@ -30,12 +33,16 @@ Compared compared_values(const std::vector<identify::Measurement>& tests, int ha
   return c;
 }
 
-Misfit misfit(const Compared& compared, const std::vector<Eigen::MatrixXcd>& X) {
+Misfit misfit(const Compared& compared, const std::vector<Eigen::MatrixXcd>& X,
+              const std::vector<int>& left_out) {
   Misfit m;
   for (const auto& e : compared.entries) {
+    if (std::binary_search(left_out.begin(), left_out.end(), e.test)) continue;
     const double d = std::norm(e.measured - X[e.test](e.harmonic, e.response));
     m.squared += d;
     m.chi2 += compared.noise_known ? e.dof() * d / e.total() : 0.0;
+    m.values += e.dof();
+    m.measured2 += std::norm(e.measured);
   }
   if (!compared.noise_known) m.chi2 = nan;
   return m;
@@ -43,6 +50,25 @@ Misfit misfit(const Compared& compared, const std::vector<Eigen::MatrixXcd>& X) 
 
 double gap(const Compared& compared, double squared) {
   return std::sqrt(squared / compared.measured2);
+}
+
+double gap(const Compared& compared, const Misfit& misfit) {
+  return std::sqrt(misfit.squared /
+                   (misfit.measured2 > 0.0 ? misfit.measured2 : compared.measured2));
+}
+
+int max_left_out(int tests) {
+  return tests / 10;
+}
+
+bool comparable(const Compared& compared, const State& state) {
+  return static_cast<int>(state.failed.size()) <= max_left_out(compared.tests);
+}
+
+std::vector<int> united(const std::vector<int>& a, const std::vector<int>& b) {
+  std::vector<int> out;
+  std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  return out;
 }
 
 double noise_level(const Compared& compared) {

@@ -27,6 +27,7 @@ struct Entry {
 /// Every value compared, and what they add up to.
 struct Compared {
   std::vector<Entry> entries;
+  int tests = 0;           ///< the tests the entries come from
   int harmonics = 1;       ///< K: harmonics 0 … K are compared
   int values = 0;          ///< N: real values (harmonic 0 counts one, the others two)
   double measured2 = 0.0;  ///< Σ |X_meas|²
@@ -41,15 +42,31 @@ struct Compared {
 Compared compared_values(const std::vector<identify::Measurement>& tests, int harmonics);
 
 /// Σ |X_meas − X_sim|² over the compared values, and χ² = Σ dof · |X_meas − X_sim|² / total
-/// (NaN when the noise is unknown). X: per test, (K+1) × responses.
+/// (NaN when the noise is unknown), with the real values N and Σ |X_meas|² they cover.
 struct Misfit {
   double squared = 0.0;
   double chi2 = 0.0;
+  int values = 0;         ///< N of the values summed; 0: all of the Compared's
+  double measured2 = 0.0; ///< their Σ |X_meas|²; 0: all of the Compared's
 };
-Misfit misfit(const Compared& compared, const std::vector<Eigen::MatrixXcd>& X);
+/// X: per test, (K+1) × responses. The tests `left_out` (ascending; their re-simulation did not
+/// converge) are not summed.
+Misfit misfit(const Compared& compared, const std::vector<Eigen::MatrixXcd>& X,
+              const std::vector<int>& left_out = {});
 
 /// The gap of a squared misfit: sqrt(S / Σ |X_meas|²).
 double gap(const Compared& compared, double squared);
+/// The gap of a misfit, over the values it covers.
+double gap(const Compared& compared, const Misfit& misfit);
+
+/// The most tests a state may leave out of its comparison because their re-simulation did not
+/// converge (even from the measured response): a tenth of them, rounded down. A model that
+/// cannot re-simulate more is not compared at all: what it leaves out could be what decides.
+int max_left_out(int tests);
+/// The state can be compared: no more tests left out than max_left_out.
+bool comparable(const Compared& compared, const State& state);
+/// a ∪ b of two ascending lists of tests.
+std::vector<int> united(const std::vector<int>& a, const std::vector<int>& b);
 
 /// The noise level: the gap a perfect model would leave, from the responses' noise and the
 /// measured force's, propagated (Entry::variance and Entry::force).
@@ -59,7 +76,7 @@ double noise_level(const Compared& compared);
 std::vector<double> chi2_by_harmonic(const Compared& compared,
                                      const std::vector<Eigen::MatrixXcd>& X);
 
-/// At the noise level: the noise known, the state converged, and its χ² per value within 3
+/// At the noise level: the noise known, every test re-simulated, and its χ² per value within 3
 /// standard deviations (√(2/N)) of 1, overall and for every compared harmonic on its own (so
 /// that a misfit of the few large fundamentals is not averaged away by many small harmonics).
 bool at_noise_level(const Compared& compared, const State& state);

@@ -43,6 +43,11 @@ Problem::Problem(const frf::Substructure& sub, const std::vector<joints::Joint>&
   if (!base_->status().ok())
     throw std::runtime_error("discover: the substructure: " + base_->status().reason);
   compared_ = compared_values(tests, K_);
+  preconditions_ = detail::preconditions(tests, compared_, o_, base_->num_modes() > 0);
+  for (const auto& m : tests) {
+    log_frequency_.push_back(std::log(m.frequency_hz));
+    log_level_.push_back(std::log(std::max(identify::force_level(m), 1e-300)));
+  }
 }
 
 int Problem::equation(const identify::Measurement& m, const std::string& what,
@@ -144,6 +149,28 @@ std::vector<int> Problem::all_tests() const {
   return all;
 }
 
+std::vector<std::string> Problem::sources(const std::vector<int>& tests) const {
+  std::vector<std::string> out;
+  for (int i : tests)
+    out.push_back(tests_[static_cast<std::size_t>(i)].source);
+  return out;
+}
+
+std::vector<int> Problem::nearest(int i, const std::vector<int>& candidates,
+                                  std::size_t count) const {
+  auto distance = [&](int j) {
+    return std::abs(log_frequency_[j] - log_frequency_[i]) +
+           std::abs(log_level_[j] - log_level_[i]);
+  };
+  std::vector<int> out = candidates;
+  out.erase(std::remove(out.begin(), out.end(), i), out.end());
+  const std::size_t n = std::min(count, out.size());
+  std::partial_sort(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n), out.end(),
+                    [&](int a, int b) { return distance(a) < distance(b); });
+  out.resize(n);
+  return out;
+}
+
 std::unique_ptr<Simulator> Problem::make_simulator(double scale, bool refined) const {
   const int harmonics = o_.balance.harmonics * (refined ? 2 : 1);
   auto s = std::make_unique<Simulator>(
@@ -164,12 +191,39 @@ const Simulator& Problem::simulator(double scale, bool refined) {
   return *simulators_.back();
 }
 
+const Problem::Spectra& Problem::spectra(const std::vector<joints::Joint>& joints) const {
+  std::string key;
+  for (const auto& j : joints) {
+    key += j.name + ':';
+    for (const joints::Term t : j.terms)
+      key += std::string(joints::term_name(t)) + ',';
+    key += ';';
+  }
+  const std::lock_guard<std::mutex> lock(spectra_mutex_);
+  auto& kept = spectra_[key];
+  if (!kept) {
+    auto made = std::make_unique<Spectra>();
+    for (const auto& m : tests_) {
+      made->warnings.emplace_back();
+      made->tests.push_back(identify::spectrum(m, dofs_, joints, made->warnings.back()));
+    }
+    kept = std::move(made);
+  }
+  return *kept;
+}
+
 identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
                                       const Simulator& sim, const std::vector<int>& use) const {
+  const Spectra& all = spectra(joints);
   std::vector<std::string> warnings;
-  std::vector<identify::TestSpectrum> spectra;
   for (int i : use)
-    spectra.push_back(identify::spectrum(tests_[i], dofs_, joints, warnings));
+    warnings.insert(warnings.end(), all.warnings[i].begin(), all.warnings[i].end());
+  std::vector<identify::TestSpectrum> subset;
+  const bool every = use == all_tests();
+  if (!every)
+    for (int i : use)
+      subset.push_back(all.tests[i]);
+  const std::vector<identify::TestSpectrum>& spectra = every ? all.tests : subset;
   const identify::ReceptanceFn H = [&sim](double w, std::span<const int> rows,
                                           std::span<const int> cols) {
     return sim.synthesis.receptance(w, rows, cols);
@@ -203,16 +257,39 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
   s.damping_scale = sim.scale;
   s.parameters = parameters(joints, sim.scale) +
                  (per_test.empty() ? 0 : static_cast<int>(per_test.size()) - 1);
-  s.X.assign(tests_.size(), Eigen::MatrixXcd());
+  s.X.resize(tests_.size()); // NaN where not tried
+  for (std::size_t i = 0; i < tests_.size(); ++i)
+    s.X[i] =
+        Eigen::MatrixXcd::Constant(K_ + 1, static_cast<Eigen::Index>(response_eq_[i].size()), nan);
   s.Y.assign(tests_.size(), Eigen::MatrixXcd());
+  const int limit = max_left_out(static_cast<int>(tests_.size()));
+  std::vector<int> solved;
   for (std::size_t i = 0; i < tests_.size(); ++i) {
+    const int t = static_cast<int>(i);
+    const std::vector<joints::Joint>& these = per_test.empty() ? joints : per_test[i];
     const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
-    const frf::HarmonicBalanceResult r =
-        solve(sim, static_cast<int>(i), per_test.empty() ? joints : per_test[i], start);
-    s.converged = s.converged && r.status.ok() && r.X.allFinite();
+    frf::HarmonicBalanceResult r = solve(sim, t, these, start);
+    // Where the model's steady state is far from the measured one (a fold the model has and
+    // the structure had not), the nearest tests re-simulated — the neighbours of a stepped
+    // sweep — are the start a sweep would have had.
+    if (!(r.status.ok() && r.X.allFinite()))
+      for (int j : nearest(t, solved, 2)) {
+        frf::HarmonicBalanceResult again = sim.balance[i].solve(these, drive_[i], &s.Y[j]);
+        if (again.status.ok() && again.X.allFinite()) {
+          r = std::move(again);
+          break;
+        }
+      }
     s.X[i] = r.X.topRows(K_ + 1);
     s.Y[i] = r.Y;
+    if (r.status.ok() && r.X.allFinite()) {
+      solved.push_back(t);
+    } else {
+      s.failed.push_back(t);
+      if (static_cast<int>(s.failed.size()) > limit) break; // not compared: the rest not tried
+    }
   }
+  s.converged = s.failed.empty();
   score(s);
   return s;
 }

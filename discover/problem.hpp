@@ -6,8 +6,11 @@
 /// measured force's noise).
 #include "discover/discover.hpp"
 #include "discover/gap.hpp"
+#include "discover/preconditions.hpp"
 
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -46,7 +49,11 @@ public:
   const Eigen::MatrixXcd& measured_deformation(std::size_t i) const { return measured_start_[i]; }
   /// What the set-up had to say (e.g. fewer harmonics in the band of measured FRFs).
   const std::vector<std::string>& notes() const { return notes_; }
+  /// The rules these tests allow, and those they do not (said in sentences).
+  const Preconditions& preconditions() const { return preconditions_; }
   std::vector<int> all_tests() const;
+  /// The sources of these tests ("table.csv:12"), for messages.
+  std::vector<std::string> sources(const std::vector<int>& tests) const;
 
   /// The harmonic-balance problems of every test with the damping scaled, at the options'
   /// harmonics or (`refined`) twice as many, to estimate the truncation error.
@@ -60,9 +67,21 @@ public:
   /// std::invalid_argument when the tests cannot separate the terms.
   identify::FitResult identify(const std::vector<joints::Joint>& joints, const Simulator& sim,
                                const std::vector<int>& use) const;
+  /// Every test's spectrum for these joints' terms (their basis functions on the measured
+  /// deformation, which do not depend on the values), and its warnings: computed once per set
+  /// of terms and kept (identify() needs them for every candidate, trial and fold). Safe to call
+  /// from several threads.
+  struct Spectra {
+    std::vector<identify::TestSpectrum> tests;
+    std::vector<std::vector<std::string>> warnings; ///< per test
+  };
+  const Spectra& spectra(const std::vector<joints::Joint>& joints) const;
   /// Identified coefficients: the non-fixed terms, and the damping scale if not 1.
   int parameters(const std::vector<joints::Joint>& joints, double scale) const;
-  /// Simulates every test with these joints, and scores the state.
+  /// Simulates every test with these joints, and scores the state. A test whose re-simulation
+  /// does not converge (solve(), then from the nearest tests already re-simulated: a stepped
+  /// sweep's neighbours) is left out (State::failed); past max_left_out the rest are not
+  /// tried (the state is not compared: its criterion is +∞).
   State evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim,
                  const State* warm = nullptr) const;
   /// The same with test i's joints `per_test[i]` where given (the state holds `joints` and
@@ -75,6 +94,9 @@ public:
   frf::HarmonicBalanceResult solve(const Simulator& sim, int i,
                                    const std::vector<joints::Joint>& joints,
                                    const Eigen::MatrixXcd* warm = nullptr) const;
+  /// The tests nearest to test i in frequency and force level (|ln f/fᵢ| + |ln F/Fᵢ|), nearest
+  /// first, among `candidates`.
+  std::vector<int> nearest(int i, const std::vector<int>& candidates, std::size_t count) const;
   /// The gap, χ² and criterion of a simulated state.
   void score(State& state) const;
 
@@ -108,8 +130,12 @@ private:
   std::unique_ptr<frf::ModalSynthesis> base_;
   std::vector<std::unique_ptr<Simulator>> simulators_;
   Compared compared_;
-  std::vector<Eigen::MatrixXcd> measured_start_; // per test: (K_hb+1) × joints
-  std::vector<Eigen::MatrixXcd> drive_;          // per test: the force harmonics that drive it
+  std::vector<Eigen::MatrixXcd> measured_start_;  // per test: (K_hb+1) × joints
+  std::vector<Eigen::MatrixXcd> drive_;           // per test: the force harmonics that drive it
+  std::vector<double> log_frequency_, log_level_; // per test, for nearest()
+  Preconditions preconditions_;
+  mutable std::mutex spectra_mutex_;
+  mutable std::map<std::string, std::unique_ptr<const Spectra>> spectra_; // by the joints' terms
 };
 
 } // namespace jointid::discover::detail

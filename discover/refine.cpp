@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace jointid::discover::detail {
 
@@ -30,6 +31,15 @@ public:
   }
 
   Eigen::Index size() const { return static_cast<Eigen::Index>(params_.size()); }
+
+  // The tests the search compares: those the start re-simulated (a trial must re-simulate every
+  // one of them too).
+  void compare_on(const State& begin) {
+    left_out_ = begin.failed;
+    values_ = 0;
+    for (const auto& e : compared_.entries)
+      if (!std::binary_search(left_out_.begin(), left_out_.end(), e.test)) values_ += e.dof();
+  }
 
   // Steps stay among physical models (no negative damping or friction); a start outside them
   // (an equation-error estimate biased by noise) is first brought back to zero damping there.
@@ -83,7 +93,7 @@ public:
         const std::vector<joints::Joint> nj = joints_with(nb);
         if (!nb.allFinite() || !physical_problem(nj).empty()) continue;
         State sn = problem_.evaluate(nj, sim_, &current_);
-        if (!sn.converged) continue;
+        if (!covers(sn)) continue;
         const Eigen::VectorXd rn = residual(sn);
         if (rn.squaredNorm() < cost_) {
           gain = (cost_ - rn.squaredNorm()) / cost_;
@@ -98,21 +108,17 @@ public:
   }
 
   // The fit of the values reached: intervals from the Jacobian there, or NaN (undetermined)
-  // when it cannot be formed or there is no redundancy.
+  // when it cannot be formed, there is no redundancy, or the tests do not constrain them.
   identify::FitResult fit(const identify::FitResult& begin_fit) {
     const Eigen::Index p = size();
-    const int values = compared_.values;
+    const int values = values_;
     J_.setConstant(nan);
     const int dof = values - static_cast<int>(p);
-    const bool determined = jacobian() && dof > 0;
-    Eigen::MatrixXd C = Eigen::MatrixXd::Constant(p, p, nan);
-    double tq = nan;
-    if (determined) {
-      double s2 = cost_ / dof;
-      if (compared_.noise_known) s2 = std::max(s2, 1.0);
-      C = s2 * (J_.transpose() * J_).completeOrthogonalDecomposition().pseudoInverse();
-      tq = identify::student_t_quantile(0.975, dof);
-    }
+    const bool formed = jacobian() && dof > 0;
+    double s2 = formed ? cost_ / dof : nan;
+    if (compared_.noise_known) s2 = std::max(s2, 1.0);
+    const Eigen::MatrixXd C = formed ? covariance(J_, s2) : Eigen::MatrixXd::Constant(p, p, nan);
+    const double tq = formed ? identify::student_t_quantile(0.975, dof) : nan;
     identify::FitResult fit = begin_fit;
     std::size_t q = 0;
     fit.joints.clear();
@@ -140,16 +146,24 @@ public:
     return fit;
   }
 
+  // Every test the search compares was re-simulated by `trial`.
+  bool covers(const State& trial) const {
+    return std::isfinite(trial.criterion) &&
+           std::includes(left_out_.begin(), left_out_.end(), trial.failed.begin(),
+                         trial.failed.end());
+  }
+
 private:
   struct Param {
     std::size_t joint, term;
   };
 
   Eigen::VectorXd residual(const State& st) const {
-    Eigen::VectorXd r(compared_.values);
+    Eigen::VectorXd r(values_);
     Eigen::Index n = 0;
     for (std::size_t i = 0; i < compared_.entries.size(); ++i) {
       const auto& e = compared_.entries[i];
+      if (std::binary_search(left_out_.begin(), left_out_.end(), e.test)) continue;
       const Complex err = e.measured - st.X[e.test](e.harmonic, e.response);
       r(n++) = weight_[i] * err.real();
       if (e.harmonic != 0) r(n++) = weight_[i] * err.imag();
@@ -174,7 +188,7 @@ private:
         const std::vector<joints::Joint> jq = joints_with(bq);
         if (!physical_problem(jq).empty()) continue;
         const State sq = problem_.evaluate(jq, sim_, &current_);
-        if (!sq.converged) continue;
+        if (!covers(sq)) continue;
         J_.col(q) = (residual(sq) - r_) / h;
         break;
       }
@@ -188,6 +202,8 @@ private:
   const Simulator& sim_;
   std::vector<Param> params_;
   std::vector<double> weight_;
+  std::vector<int> left_out_;         // tests the start could not re-simulate, ascending
+  int values_ = 0;                    // real values compared (of the other tests)
   std::vector<joints::Joint> joints_; // the layout and fixed values the parameters go into
   Eigen::VectorXd b_, step_, r_;
   Eigen::MatrixXd J_;
@@ -197,11 +213,36 @@ private:
 
 } // namespace
 
+Eigen::MatrixXd covariance(const Eigen::MatrixXd& J, double s2) {
+  const Eigen::Index p = J.cols();
+  Eigen::MatrixXd C = Eigen::MatrixXd::Constant(p, p, nan);
+  if (!J.allFinite() || !std::isfinite(s2)) return C;
+  // Columns scaled to unit norm: the parameters' units differ by many orders of magnitude (a
+  // cubic stiffness of 1e9 N/m³ beside a damping of 1 N s/m), and unscaled, JᵀJ's small
+  // singular values fall below the solver's rounding threshold and their variance comes out 0.
+  Eigen::VectorXd scale(p);
+  for (Eigen::Index q = 0; q < p; ++q) {
+    const double norm = J.col(q).norm();
+    if (!(norm > 0.0)) return C; // a parameter the tests do not see: undetermined
+    scale(q) = 1.0 / norm;
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J * scale.asDiagonal(), Eigen::ComputeThinV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  // Parameters that act alike beyond what the Jacobian resolves: undetermined. Its columns are
+  // forward differences of re-simulations solved to 1e-12 over a step of 1e-5 of the value,
+  // good to about 1e-7 of their norm, which moves a singular value by as much (Weyl): below
+  // 1e-6 of the largest, a singular value — and the variance it gives — is that error.
+  if (!(sv(p - 1) > 1e-6 * sv(0))) return C;
+  const Eigen::MatrixXd W = svd.matrixV() * sv.cwiseInverse().asDiagonal();
+  return s2 * scale.asDiagonal() * (W * W.transpose()) * scale.asDiagonal();
+}
+
 State refine(const Problem& problem, const State& start, const Simulator& sim) {
   OutputError search(problem, sim, start);
   if (search.size() == 0) return start;
   const State begin = search.begin(start);
-  if (!begin.converged || !physical_problem(begin.joints).empty()) return start;
+  if (!std::isfinite(begin.criterion) || !physical_problem(begin.joints).empty()) return start;
+  search.compare_on(begin);
   State refined = search.search(start, begin);
   refined.fit = search.fit(begin.fit);
   return refined;

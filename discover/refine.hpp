@@ -11,7 +11,15 @@
 namespace jointid::discover::detail {
 
 /// The state refined from `start` (its fit replaced by the output-error one); `start` itself
-/// when nothing is identified, or its values are not physical and cannot be brought back.
+/// when nothing is identified, or its values are not physical and cannot be brought back. The
+/// tests the start could not re-simulate stay out of the search, and every trial must
+/// re-simulate all the others.
 State refine(const Problem& problem, const State& start, const Simulator& sim);
+
+/// The parameters' covariance s² (JᵀJ)⁻¹ from the Jacobian J of the residual (columns scaled to
+/// unit norm first: their units differ by orders of magnitude). NaN throughout — undetermined,
+/// never 0 — when J is not finite, a column is zero, or its singular values are more than 1e6
+/// apart (the parameters act alike beyond what a Jacobian by finite differences resolves).
+Eigen::MatrixXd covariance(const Eigen::MatrixXd& J, double s2);
 
 } // namespace jointid::discover::detail

@@ -26,6 +26,11 @@ std::string Candidate::effect() const {
   return std::string(joints::term_effect(*term));
 }
 
+bool Candidate::determined() const {
+  return std::isfinite(ci_low) && std::isfinite(ci_high) && ci_high > ci_low &&
+         std::isfinite(std) && std > 0.0;
+}
+
 bool Candidate::linear() const {
   return !varies && (refit || !term || joints::is_linear(*term));
 }
@@ -44,6 +49,7 @@ std::vector<Comparison> comparisons(const std::vector<identify::Measurement>& te
       c.channel = channel_name(m, j);
       c.frequency_hz = m.frequency_hz;
       c.force = identify::force_level(m);
+      c.force_phasor = m.F.cols() > 0 ? m.F(1, 0) : std::complex<double>();
       c.measured = m.X(1, jj);
       c.simulated = s.X[i](1, jj);
       c.amplitude_error = std::abs(c.simulated) / std::max(std::abs(c.measured), 1e-300) - 1.0;
@@ -54,6 +60,7 @@ std::vector<Comparison> comparisons(const std::vector<identify::Measurement>& te
           hm += std::norm(m.X(k, jj)), hs += std::norm(s.X[i](k, jj));
       c.harmonics_measured = std::sqrt(hm) / std::max(std::abs(c.measured), 1e-300);
       c.harmonics_simulated = std::sqrt(hs) / std::max(std::abs(c.measured), 1e-300);
+      c.converged = !std::binary_search(s.failed.begin(), s.failed.end(), static_cast<int>(i));
       out.push_back(c);
     }
   }
@@ -61,10 +68,18 @@ std::vector<Comparison> comparisons(const std::vector<identify::Measurement>& te
 }
 
 std::string finding(const Step& s) {
-  return fmt::format(
-      "Added {} ({}) = {} [{}, {}]: the gap fell from {} to {} ({} of it explained).",
-      s.added.name(), s.added.effect(), number(s.added.value), number(s.added.ci_low),
-      number(s.added.ci_high), number(s.gap_before), number(s.gap_after), pct(s.added.explained));
+  const std::string interval =
+      s.added.determined()
+          ? fmt::format("[{}, {}]", number(s.added.ci_low), number(s.added.ci_high))
+          : std::string("(its interval undetermined: the value is not a result)");
+  const std::string left_out =
+      s.added.left_out.empty()
+          ? std::string()
+          : fmt::format("; {} test{} it could not re-simulate left out", s.added.left_out.size(),
+                        s.added.left_out.size() == 1 ? "" : "s");
+  return fmt::format("Added {} ({}) = {} {}: the gap fell from {} to {} ({} of it explained{}).",
+                     s.added.name(), s.added.effect(), number(s.added.value), interval,
+                     number(s.gap_before), number(s.gap_after), pct(s.added.explained), left_out);
 }
 
 std::string summary(const Result& r, const Compared& compared) {

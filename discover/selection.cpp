@@ -1,5 +1,6 @@
 #include "discover/selection.hpp"
 
+#include "discover/preconditions.hpp"
 #include "discover/problem.hpp"
 #include "discover/text.hpp"
 #include "fem/parallel.hpp"
@@ -22,18 +23,54 @@ constexpr double inf = std::numeric_limits<double>::infinity();
 
 double information_criterion(const Compared& compared, const Misfit& misfit, int parameters,
                              bool converged) {
-  const double N = compared.values, penalty = parameters * std::log(N);
+  const double N = misfit.values > 0 ? misfit.values : compared.values;
+  const double measured2 = misfit.measured2 > 0.0 ? misfit.measured2 : compared.measured2;
+  const double penalty = parameters * std::log(N);
   return !converged ? inf
          : compared.noise_known
              ? misfit.chi2 + penalty
-             : N * std::log(std::max(misfit.squared, 1e-300 * compared.measured2) / N) + penalty;
+             : N * std::log(std::max(misfit.squared, 1e-300 * measured2) / N) + penalty;
 }
 
 void score(State& state, const Compared& compared) {
-  const Misfit m = misfit(compared, state.X);
-  state.gap = gap(compared, m.squared);
+  if (!comparable(compared, state)) { // too many tests left out: not compared at all
+    state.gap = state.criterion = inf;
+    state.chi2 = std::numeric_limits<double>::quiet_NaN();
+    return;
+  }
+  const Misfit m = misfit(compared, state.X, state.failed);
+  state.gap = gap(compared, m);
   state.chi2 = m.chi2;
-  state.criterion = information_criterion(compared, m, state.parameters, state.converged);
+  state.criterion = information_criterion(compared, m, state.parameters, true);
+}
+
+void compare_on_common_tests(Candidate& candidate, const State& state, const State& now,
+                             const Compared& compared, const std::vector<std::string>& sources) {
+  if (state.X.empty()) return; // refused: no model to compare
+  candidate.left_out.clear();
+  for (int i : state.failed)
+    candidate.left_out.push_back(sources[static_cast<std::size_t>(i)]);
+  candidate.gap_now = -1.0;
+  if (!comparable(compared, state)) {
+    const std::vector<std::string> first(
+        candidate.left_out.begin(),
+        candidate.left_out.begin() +
+            std::min<std::ptrdiff_t>(3, static_cast<std::ptrdiff_t>(candidate.left_out.size())));
+    candidate.rejected = fmt::format(
+        "a re-simulation did not converge (for {} tests, e.g. {}; at most {} of the {} may be "
+        "left out)",
+        state.failed.size(), join(first), max_left_out(compared.tests), compared.tests);
+    return;
+  }
+  if ((state.failed.empty() && now.failed.empty()) || !std::isfinite(candidate.criterion)) return;
+  // Both on the tests both re-simulated.
+  const std::vector<int> out = united(state.failed, now.failed);
+  const Misfit mc = misfit(compared, state.X, out), mn = misfit(compared, now.X, out);
+  candidate.gap = gap(compared, mc);
+  candidate.gap_now = gap(compared, mn);
+  candidate.criterion = now.criterion +
+                        information_criterion(compared, mc, state.parameters, true) -
+                        information_criterion(compared, mn, now.parameters, true);
 }
 
 std::string physical_problem(const std::vector<joints::Joint>& joints) {
@@ -66,7 +103,7 @@ void fill(Candidate& candidate, const State& state) {
   candidate.gap = state.gap;
   candidate.criterion = state.criterion;
   candidate.converged = state.converged;
-  if (!state.converged) candidate.rejected = "a re-simulation did not converge";
+  if (!std::isfinite(state.criterion)) candidate.rejected = "a re-simulation did not converge";
 }
 
 void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::string& joint,
@@ -95,6 +132,9 @@ std::string interval_problem(const Candidate& candidate) {
   const double none = candidate.term ? 0.0 : 1.0;
   if (!std::isfinite(candidate.ci_low) || !std::isfinite(candidate.ci_high))
     return "not determined: its 95 % interval could not be estimated";
+  if (!(candidate.ci_high > candidate.ci_low))
+    return "not determined: its 95 % interval has zero width (the tests do not constrain it, "
+           "or it sits at a bound)";
   if (candidate.ci_low > none || candidate.ci_high < none) return {};
   return fmt::format("not significant: its 95 % interval [{}, {}] holds {}",
                      number(candidate.ci_low), number(candidate.ci_high), none);
@@ -116,10 +156,20 @@ std::string explained_problem(const Candidate& candidate, double min_explained) 
                      pct(candidate.explained), pct(min_explained));
 }
 
-std::string cross_validation_problem(double cv_gap, double cv_now) {
-  if (!(cv_now >= 0.0 && cv_gap >= 0.0 && !(cv_gap < cv_now))) return {};
+std::string cross_validation_problem(const CrossValidation& candidate, const CrossValidation& now) {
+  // The rule cannot be applied: the addition is not checked, so it is not made.
+  for (const CrossValidation* cv : {&now, &candidate})
+    if (!(cv->gap >= 0.0))
+      return std::string(not_checked) + ": " +
+             (cv->why.empty() ? std::string("the cross-validated gap could not be computed")
+                              : cv->why);
+  if (candidate.gap < now.gap) return {};
   return fmt::format("does not predict held-out tests better (cross-validated gap {} vs {} now)",
-                     number(cv_gap), number(cv_now));
+                     number(candidate.gap), number(now.gap));
+}
+
+bool only_unchecked(const Candidate& candidate) {
+  return candidate.rejected.starts_with(not_checked);
 }
 
 std::vector<std::size_t> screen(std::vector<Candidate>& ranking, const State& now,
@@ -128,7 +178,7 @@ std::vector<std::size_t> screen(std::vector<Candidate>& ranking, const State& no
   for (std::size_t i = 0; i < order.size(); ++i) {
     order[i] = i;
     Candidate& c = ranking[i];
-    c.explained = explained(c.gap, now.gap);
+    c.explained = explained(c.gap, c.gap_now >= 0.0 ? c.gap_now : now.gap);
     if (c.rejected.empty()) c.rejected = criterion_problem(c, now.criterion);
     if (c.rejected.empty()) c.rejected = explained_problem(c, min_explained);
   }
@@ -139,8 +189,8 @@ std::vector<std::size_t> screen(std::vector<Candidate>& ranking, const State& no
 }
 
 Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& order,
-              const std::function<double()>& cv_now,
-              const std::function<double(std::size_t)>& cv_of) {
+              const std::function<CrossValidation(std::size_t)>& cv_now,
+              const std::function<CrossValidation(std::size_t)>& cv_of) {
   Choice choice;
   for (std::size_t i : order) {
     Candidate& c = ranking[i];
@@ -149,9 +199,11 @@ Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& o
       choice.outside = i;
       break;
     }
-    if (!choice.cv_now) choice.cv_now = cv_now();
-    c.cv_gap = cv_of(i);
-    c.rejected = cross_validation_problem(c.cv_gap, *choice.cv_now);
+    const CrossValidation now = cv_now(i);
+    if (now.gap >= 0.0) choice.cv_now = now.gap;
+    const CrossValidation with = now.gap >= 0.0 ? cv_of(i) : CrossValidation{};
+    c.cv_gap = with.gap;
+    c.rejected = cross_validation_problem(with, now);
     if (!c.rejected.empty()) continue;
     choice.chosen = i;
     break;
@@ -167,14 +219,14 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
   });
   std::vector<std::size_t> out;
   for (std::size_t i : by)
-    if (std::isfinite(ranking[i].criterion) && ranking[i].converged && !ranking[i].varies &&
+    if (std::isfinite(ranking[i].criterion) && !ranking[i].varies &&
         out.size() < static_cast<std::size_t>(count))
       out.push_back(i);
   return out;
 }
 
 std::vector<std::vector<int>> held_out(int tests, int folds) {
-  if (tests < 4) return {};
+  if (tests < min_tests_held_out) return {};
   const int k = tests <= 30 ? tests : folds;
   std::vector<std::vector<int>> held(k);
   for (int i = 0; i < tests; ++i)
@@ -182,16 +234,24 @@ std::vector<std::vector<int>> held_out(int tests, int folds) {
   return held;
 }
 
-double cross_validated(Problem& problem, const std::vector<joints::Joint>& joints, double scale) {
+CrossValidation cross_validated(Problem& problem, const std::vector<joints::Joint>& joints,
+                                double scale, const std::vector<int>& left_out) {
   const int n = static_cast<int>(problem.tests().size());
   const std::vector<std::vector<int>> folds = held_out(n, problem.options().folds);
-  if (folds.empty()) return -1.0;
+  if (folds.empty())
+    return {-1.0,
+            fmt::format("{} test{}, at least {} needed", n, n == 1 ? "" : "s", min_tests_held_out)};
   const Simulator& sim = problem.simulator(scale);
   const Compared& compared = problem.compared();
-  // One job per fold: the squared error of its held-out tests; -1 when it cannot be fitted.
-  std::vector<std::function<double()>> jobs;
+  // One job per fold: the squared error of its held-out tests and their Σ |X_meas|², or why the
+  // fold cannot be fitted.
+  struct Part {
+    double squared = 0.0, measured2 = 0.0;
+    std::string why;
+  };
+  std::vector<std::function<Part()>> jobs;
   for (std::size_t f = 0; f < folds.size(); ++f)
-    jobs.push_back([&, f]() -> double {
+    jobs.push_back([&, f]() -> Part {
       const std::vector<int>& held = folds[f];
       std::vector<int> train;
       for (int i = 0; i < n; ++i)
@@ -199,28 +259,34 @@ double cross_validated(Problem& problem, const std::vector<joints::Joint>& joint
       std::vector<joints::Joint> fitted;
       try {
         fitted = problem.identify(joints, sim, train).identified(joints);
-      } catch (const std::invalid_argument&) {
-        return -1.0;
+      } catch (const std::invalid_argument& e) {
+        return {0.0, 0.0,
+                fmt::format("without {} the terms cannot be identified ({})",
+                            join(problem.sources(held)), e.what())};
       }
       // A fold's estimate may come out with negative damping or friction (fewer tests, more
       // noise): brought back to 0, as the output-error refinement does.
       clamp_dissipative(fitted);
-      double S = 0.0;
+      Part part;
       for (int i : held) {
+        // Tests the models compared cannot re-simulate at all are in neither sum.
+        if (std::binary_search(left_out.begin(), left_out.end(), i)) continue;
         const frf::HarmonicBalanceResult r = problem.solve(sim, i, fitted);
         for (const auto& e : compared.entries) // a failed prediction counts as predicting nothing
-          if (e.test == i)
-            S += r.status.ok() ? std::norm(e.measured - r.X(e.harmonic, e.response))
-                               : std::norm(e.measured);
+          if (e.test == i) {
+            part.squared += r.status.ok() ? std::norm(e.measured - r.X(e.harmonic, e.response))
+                                          : std::norm(e.measured);
+            part.measured2 += std::norm(e.measured);
+          }
       }
-      return S;
+      return part;
     });
-  double S = 0.0;
-  for (double part : fem::parallel_map(jobs)) {
-    if (part < 0.0) return -1.0;
-    S += part;
+  double S = 0.0, M = 0.0;
+  for (const Part& part : fem::parallel_map(jobs)) {
+    if (!part.why.empty()) return {-1.0, part.why};
+    S += part.squared, M += part.measured2;
   }
-  return std::sqrt(S / compared.measured2);
+  return {std::sqrt(S / M), {}};
 }
 
 void summarise(Variation& variation, Candidate& candidate, const joints::Joint& joint) {

@@ -10,6 +10,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace jointid::discover::detail {
@@ -23,8 +24,16 @@ class Problem;
 /// values compared); +∞ for a model whose re-simulations did not all converge.
 double information_criterion(const Compared& compared, const Misfit& misfit, int parameters,
                              bool converged);
-/// A simulated state's gap, χ² (NaN when the noise is unknown) and information criterion.
+/// A simulated state's gap, χ² (NaN when the noise is unknown) and information criterion, over
+/// the tests it re-simulated; +∞ (gap and criterion) when it left out more than max_left_out.
 void score(State& state, const Compared& compared);
+/// A candidate whose state (or the model now) left tests out is compared with the model now on
+/// the tests both re-simulated: its gap and `gap_now` over those, its criterion now's plus the
+/// difference there (so that every candidate is on now's scale). Names the tests it left out
+/// (`sources`: every test's), and, when it left out too many to be compared, rejects it saying
+/// how many and which. Nothing for a refused candidate (a state without simulations).
+void compare_on_common_tests(Candidate& candidate, const State& state, const State& now,
+                             const Compared& compared, const std::vector<std::string>& sources);
 
 // Rule 1: every re-simulation converged and the values are physical.
 
@@ -34,8 +43,8 @@ std::string physical_problem(const std::vector<joints::Joint>& joints);
 std::string friction_problem(const std::vector<joints::Joint>& joints);
 /// Negative damping and friction among the identified terms brought back to 0.
 void clamp_dissipative(std::vector<joints::Joint>& joints);
-/// The candidate's gap, criterion and convergence from its state; a state that did not
-/// converge rejects it ("a re-simulation did not converge").
+/// The candidate's gap, criterion and convergence from its state; a state that could not be
+/// compared (too many tests left out) rejects it ("a re-simulation did not converge").
 void fill(Candidate& candidate, const State& state);
 /// The value and interval of `joint`'s `term` in a fit.
 void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::string& joint,
@@ -43,7 +52,8 @@ void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::s
 /// Rules 1 and 2 for a candidate and the state it gives (its value taken from the state's fit).
 void judge(Candidate& candidate, const State& state);
 
-// Rule 2: the 95 % interval is known and excludes 0 (a term) or 1 (the damping scale).
+// Rule 2: the 95 % interval is known, of non-zero width, and excludes 0 (a term) or 1 (the
+// damping scale).
 std::string interval_problem(const Candidate& candidate);
 
 // Rule 3: the information criterion falls.
@@ -54,8 +64,22 @@ std::string criterion_problem(const Candidate& candidate, double criterion_now);
 double explained(double gap, double gap_now);
 std::string explained_problem(const Candidate& candidate, double min_explained);
 
-// Rule 5: the cross-validated gap falls (both known: < 0 is "could not be computed").
-std::string cross_validation_problem(double cv_gap, double cv_now);
+// Rule 5: the cross-validated gap falls.
+
+/// How rule 5's reason starts when the rule could not be applied.
+inline constexpr std::string_view not_checked = "cannot be checked against held-out tests";
+/// Rejected only because rule 5 could not be applied: admissible by the other rules.
+bool only_unchecked(const Candidate& candidate);
+
+/// A cross-validated gap, or why it could not be computed (gap < 0).
+struct CrossValidation {
+  double gap = -1.0;
+  std::string why;
+};
+/// The candidate's cross-validated gap must be below the model's. Where either could not be
+/// computed the rule cannot be applied, and the candidate is not added: "cannot be checked
+/// against held-out tests: …" (fewer than four tests, or a fold that cannot be identified).
+std::string cross_validation_problem(const CrossValidation& candidate, const CrossValidation& now);
 
 /// Sets every candidate's share explained and applies rules 3 and 4 to those not yet rejected.
 /// Returns the candidates' indices by criterion, lowest first (a stable order).
@@ -69,11 +93,13 @@ struct Choice {
 };
 /// Walks `order` (from screen) to the first candidate not rejected: a coefficient that varies
 /// per test is `outside`; an addition must also pass rule 5, else it is rejected with the reason
-/// and the walk goes on. The cross-validated gaps are computed as needed: the current model's
-/// once, and each candidate's walked to (stored in its cv_gap).
+/// and the walk goes on. The cross-validated gaps are computed as needed, for each candidate
+/// walked to: the current model's on the tests that candidate is compared on (`cv_now(i)`; the
+/// caller keeps what it computed), then the candidate's (stored in its cv_gap) if that one
+/// could be computed.
 Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& order,
-              const std::function<double()>& cv_now,
-              const std::function<double(std::size_t)>& cv_of);
+              const std::function<CrossValidation(std::size_t)>& cv_now,
+              const std::function<CrossValidation(std::size_t)>& cv_of);
 
 /// The candidates refined by output error: the best `count` by the criterion among those with a
 /// finite criterion, converged, and not varying per test.
@@ -86,9 +112,11 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
 std::vector<std::vector<int>> held_out(int tests, int folds);
 /// The gap of the folds' predictions: each fold's tests predicted by the model identified from
 /// the others (negative damping or friction brought back to 0; a failed prediction counts as
-/// predicting nothing). < 0 when it cannot be computed (fewer than 4 tests, or a fold that
-/// cannot be identified).
-double cross_validated(Problem& problem, const std::vector<joints::Joint>& joints, double scale);
+/// predicting nothing), the tests `left_out` (ascending: those the models compared cannot
+/// re-simulate) in neither sum. Not computed, saying why, for fewer than 4 tests or a fold that
+/// cannot be identified.
+CrossValidation cross_validated(Problem& problem, const std::vector<joints::Joint>& joints,
+                                double scale, const std::vector<int>& left_out = {});
 
 // A coefficient identified per test.
 

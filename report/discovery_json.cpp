@@ -20,13 +20,21 @@ Json candidate_json(const discover::Candidate& c) {
                        : std::string("damping_scale");
   j["effect"] = c.effect();
   j["value"] = number(c.value);
-  j["std"] = number(c.std);
-  j["ci95"] = Json::array({number(c.ci_low), number(c.ci_high)});
+  // An undetermined interval (not finite, or of zero width) is never written as a result.
+  const bool determined = c.determined();
+  j["std"] = determined ? number(c.std) : Json(nullptr);
+  j["ci95"] = determined ? Json::array({number(c.ci_low), number(c.ci_high)})
+                         : Json::array({nullptr, nullptr});
+  j["determined"] = determined;
   j["gap"] = number(c.gap);
   j["explained"] = number(c.explained);
   j["criterion"] = number(c.criterion);
   j["cv_gap"] = c.cv_gap >= 0.0 ? number(c.cv_gap) : Json(nullptr);
   j["converged"] = c.converged;
+  if (!c.left_out.empty()) {
+    j["left_out"] = c.left_out;
+    j["gap_now"] = number(c.gap_now);
+  }
   j["admissible"] = c.rejected.empty();
   if (!c.rejected.empty()) j["rejected"] = c.rejected;
   if (c.varies) {
@@ -62,9 +70,14 @@ Json joints_json(const std::vector<joints::Joint>& joints, const identify::FitRe
         for (const auto& je : fit->joints)
           if (je.name == joint.name)
             for (const auto& te : je.terms)
-              if (te.term == joint.terms[t]) {
-                term["std"] = number(te.std);
-                term["ci95"] = Json::array({number(te.ci_low), number(te.ci_high)});
+              if (te.term == joint.terms[t] && !te.fixed) {
+                const bool determined = std::isfinite(te.std) && te.std > 0.0 &&
+                                        std::isfinite(te.ci_low) && std::isfinite(te.ci_high) &&
+                                        te.ci_high > te.ci_low;
+                term["std"] = determined ? number(te.std) : Json(nullptr);
+                term["ci95"] = determined ? Json::array({number(te.ci_low), number(te.ci_high)})
+                                          : Json::array({nullptr, nullptr});
+                term["determined"] = determined;
               }
       term["fixed"] = static_cast<bool>(joint.fixed[t]);
       terms.push_back(std::move(term));
@@ -74,6 +87,14 @@ Json joints_json(const std::vector<joints::Joint>& joints, const identify::FitRe
     j["terms"] = std::move(terms);
     out.push_back(std::move(j));
   }
+  return out;
+}
+
+// The tests a state left out (its re-simulation did not converge), by name.
+Json left_out_json(const std::vector<discover::Comparison>& list) {
+  Json out = Json::array();
+  for (const auto& c : list)
+    if (!c.converged && (out.empty() || out.back() != c.test)) out.push_back(c.test);
   return out;
 }
 
@@ -91,6 +112,7 @@ Json comparisons_json(const std::vector<discover::Comparison>& list) {
     j["phase_error_deg"] = number(c.phase_error_deg);
     j["harmonics_measured"] = number(c.harmonics_measured);
     j["harmonics_simulated"] = number(c.harmonics_simulated);
+    j["converged"] = c.converged;
     out.push_back(std::move(j));
   }
   return out;
@@ -116,6 +138,7 @@ std::string discovery_json(const discover::Result& r) {
   start["joints"] =
       joints_json(r.states.front().joints,
                   r.states.front().fit.joints.empty() ? nullptr : &r.states.front().fit);
+  start["left_out"] = left_out_json(r.comparisons.front());
   out["start"] = std::move(start);
   Json steps = Json::array();
   for (const auto& s : r.steps) {
@@ -158,6 +181,7 @@ std::string discovery_json(const discover::Result& r) {
   const discover::State& last = r.states.back();
   model["joints"] = joints_json(last.joints, last.fit.joints.empty() ? nullptr : &last.fit);
   model["substructure_damping_scale"] = number(last.damping_scale);
+  model["left_out"] = left_out_json(r.comparisons.back());
   out["final_model"] = std::move(model);
   out["stop_reason"] = r.stop_reason;
   Json last_ranking = Json::array();
@@ -168,6 +192,7 @@ std::string discovery_json(const discover::Result& r) {
   comparisons["start"] = comparisons_json(r.comparisons.front());
   comparisons["final"] = comparisons_json(r.comparisons.back());
   out["comparisons"] = std::move(comparisons);
+  out["limits"] = r.limits;
   out["warnings"] = r.warnings;
   return text(out);
 }

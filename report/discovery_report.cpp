@@ -2,6 +2,7 @@
 
 #include "io/files.hpp"
 #include "report/chart.hpp"
+#include "report/discovery_figures.hpp"
 #include "report/vtk_output.hpp"
 
 #include <fmt/format.h>
@@ -25,109 +26,6 @@ std::string pct(double f) {
   return std::isfinite(f) ? fmt::format("{:.3g} %", 100.0 * f) : std::string("—");
 }
 
-// One panel for one channel: measured receptance (points) and the model's response curves
-// (lines), one colour per force level (or per frequency, for sweeps over level).
-Chart response_chart(const std::vector<discover::Comparison>& list,
-                     const std::vector<discover::ResponseCurve>& curves, const std::string& channel,
-                     const std::string& title) {
-  std::vector<const discover::Comparison*> rows;
-  for (const auto& c : list)
-    if (c.channel == channel) rows.push_back(&c);
-  const bool over_frequency = curves.empty() || curves.front().over_frequency;
-  const bool by_force =
-      std::all_of(rows.begin(), rows.end(), [](auto* c) { return c->force > 0.0; });
-  Chart chart;
-  chart.title = title;
-  chart.x_label = over_frequency ? "excitation frequency (Hz)" : "force amplitude (N)";
-  chart.y_label = by_force ? fmt::format("|X1/F1| at {} (m/N)", channel)
-                           : fmt::format("|X1| at {} (m)", channel);
-  chart.log_y = true;
-  // The sweeps up give the colours; a sweep down (another branch) is drawn dashed in its colour.
-  std::vector<const discover::ResponseCurve*> up, down;
-  for (const auto& c : curves)
-    (c.descending ? down : up).push_back(&c);
-  auto same = [&](const discover::ResponseCurve& a, const discover::ResponseCurve& b) {
-    return over_frequency ? a.level == b.level : a.frequency_hz == b.frequency_hz;
-  };
-  // Each test belongs to the curve of the nearest level (or frequency).
-  auto nearest = [&](const discover::Comparison& c) {
-    std::size_t best = 0;
-    for (std::size_t g = 0; g < up.size(); ++g) {
-      auto key = [&](std::size_t i) {
-        return over_frequency ? std::abs(std::log(c.force / up[i]->level))
-                              : std::abs(std::log(c.frequency_hz / up[i]->frequency_hz));
-      };
-      if (key(g) < key(best)) best = g;
-    }
-    return best;
-  };
-  auto line = [&](const discover::ResponseCurve& curve, Series& model) {
-    const auto it = std::find(curve.channels.begin(), curve.channels.end(), channel);
-    if (it == curve.channels.end()) return;
-    const auto& X = curve.X1[static_cast<std::size_t>(it - curve.channels.begin())];
-    for (std::size_t p = 0; p < curve.x.size(); ++p) {
-      const double force = over_frequency ? curve.level : curve.x[p];
-      const double y = std::abs(X[p]) / (by_force ? force : 1.0);
-      if (std::isfinite(y) && y > 0.0) model.x.push_back(curve.x[p]), model.y.push_back(y);
-    }
-  };
-  for (std::size_t g = 0; g < std::max<std::size_t>(1, up.size()); ++g) {
-    Series measured, model;
-    measured.style = Series::Style::points;
-    measured.width = 2.5;
-    model.style = Series::Style::line;
-    measured.color = model.color = palette_color(g);
-    std::vector<std::pair<double, double>> pts;
-    for (const auto* c : rows) {
-      if (!up.empty() && nearest(*c) != g) continue;
-      const double y = std::abs(c->measured) / (by_force ? c->force : 1.0);
-      if (y > 0.0) pts.push_back({over_frequency ? c->frequency_hz : c->force, y});
-    }
-    std::sort(pts.begin(), pts.end());
-    for (const auto& [x, y] : pts)
-      measured.x.push_back(x), measured.y.push_back(y);
-    if (!up.empty()) {
-      const auto& curve = *up[g];
-      const std::string label = over_frequency ? fmt::format("{:.3g} N", curve.level)
-                                               : fmt::format("{:.3g} Hz", curve.frequency_hz);
-      measured.label = "measured, " + label;
-      model.label = "model, " + label;
-      line(curve, model);
-      for (const auto* d : down)
-        if (same(*d, curve)) {
-          Series back = model;
-          back.label = "model, " + label + ", swept down";
-          back.style = Series::Style::dashed;
-          back.x.clear(), back.y.clear();
-          line(*d, back);
-          if (!back.x.empty()) chart.series.push_back(std::move(back));
-        }
-    } else { // no curves: the model at the tests
-      measured.label = "measured";
-      model.label = "model";
-      std::vector<std::pair<double, double>> sim;
-      for (const auto* c : rows) {
-        const double y = std::abs(c->simulated) / (by_force ? c->force : 1.0);
-        if (std::isfinite(y) && y > 0.0) sim.push_back({c->frequency_hz, y});
-      }
-      std::sort(sim.begin(), sim.end());
-      for (const auto& [x, y] : sim)
-        model.x.push_back(x), model.y.push_back(y);
-    }
-    if (!model.x.empty()) chart.series.push_back(std::move(model));
-    if (!measured.x.empty()) chart.series.push_back(std::move(measured));
-  }
-  return chart;
-}
-
-std::vector<std::string> channels_of(const std::vector<discover::Comparison>& list) {
-  std::vector<std::string> out;
-  for (const auto& c : list)
-    if (std::find(out.begin(), out.end(), c.channel) == out.end()) out.push_back(c.channel);
-  if (out.size() > 4) out.resize(4);
-  return out;
-}
-
 std::string model_text(const discover::State& s) {
   std::string text;
   for (const auto& j : s.joints) {
@@ -138,6 +36,26 @@ std::string model_text(const discover::State& s) {
   }
   if (s.damping_scale != 1.0)
     text += fmt::format("; substructure damping ×{}", g4(s.damping_scale));
+  return text;
+}
+
+// An interval as the report shows it: "[lo, hi]", or "undetermined" (never a number ± 0).
+std::string interval(double lo, double hi) {
+  if (!(std::isfinite(lo) && std::isfinite(hi) && hi > lo)) return "undetermined";
+  return fmt::format("[{}, {}]", g4(lo), g4(hi));
+}
+
+std::string capitalised(std::string text) {
+  if (!text.empty() && text.front() >= 'a' && text.front() <= 'z') text.front() -= 'a' - 'A';
+  return text;
+}
+
+// "a, b, c" (at most six, then "and n more").
+std::string listed(const std::vector<std::string>& items) {
+  std::string text;
+  for (std::size_t i = 0; i < items.size() && i < 6; ++i)
+    text += (i ? ", " : "") + items[i];
+  if (items.size() > 6) text += fmt::format(" and {} more", items.size() - 6);
   return text;
 }
 
@@ -180,6 +98,32 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
         "the force's propagated through the model).\n\n";
   md += fmt::format("**Result.** {}\n\n",
                     r.diagnosis.findings.empty() ? std::string() : r.diagnosis.findings.back());
+  if (!r.limits.empty()) {
+    md += "## What these tests cannot tell\n\n";
+    for (const auto& l : r.limits)
+      md += "- " + capitalised(l) + ".\n";
+    md += "\n";
+  }
+  {
+    // The tests a model could not re-simulate: named, with the model.
+    std::string left_out;
+    for (std::size_t i = 0; i < r.comparisons.size(); ++i) {
+      std::vector<std::string> tests;
+      for (const auto& c : r.comparisons[i])
+        if (!c.converged && (tests.empty() || tests.back() != c.test)) tests.push_back(c.test);
+      if (tests.empty()) continue;
+      left_out +=
+          fmt::format("- {}: {}\n",
+                      i == 0 ? std::string("the starting model")
+                             : fmt::format("after step {} (+ {})", i, r.steps[i - 1].added.name()),
+                      listed(tests));
+    }
+    if (!left_out.empty())
+      md += "## Tests left out\n\nTheir re-simulation did not converge, even from the measured "
+            "response and from the nearest tests: each is left out of that model's gap, and of "
+            "its comparison with the model before it.\n\n" +
+            left_out + "\n";
+  }
 
   md += "## Diagnosis\n\n";
   for (std::size_t i = 0; i + 1 < r.diagnosis.findings.size(); ++i)
@@ -197,10 +141,11 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
           "|\n|---|---|---|---|---|---|---|---|\n";
     for (std::size_t i = 0; i < r.steps.size(); ++i) {
       const auto& s = r.steps[i];
-      md +=
-          fmt::format("| {} | {} | {} | {} | [{}, {}] | {} | {} | {} |\n", i + 1, s.added.name(),
-                      s.added.effect(), g4(s.added.value), g4(s.added.ci_low), g4(s.added.ci_high),
-                      g4(s.gap_before), g4(s.gap_after), pct(s.added.explained));
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", i + 1, s.added.name(),
+                        s.added.effect(), g4(s.added.value),
+                        s.added.determined() ? interval(s.added.ci_low, s.added.ci_high)
+                                             : std::string("undetermined"),
+                        g4(s.gap_before), g4(s.gap_after), pct(s.added.explained));
     }
     md += "\n";
   }
@@ -263,34 +208,21 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
 
   // Measured and simulated responses, before and after each step.
   md += "## Measured and simulated response\n\n";
-  md += "Points: measured; lines: the model's response (harmonic balance, continued from point to "
-        "point) driven by a pure sine at each force level. Colours: force levels (or "
-        "frequencies).\n\n";
+  md += stepped_sine_sweeps(r.comparisons.front())
+            ? "Stepped-sine sweeps, as frequency response functions in the quantity each "
+              "channel measured (magnitude, and phase below it): dots measured, lines the "
+              "model's response (harmonic balance, continued from point to point, dashed where "
+              "a sweep down finds another branch) driven by a pure sine at each force level; one "
+              "colour per level, dark for the lowest, light for the highest.\n\n"
+            : "Points: measured; lines: the model's response (harmonic balance, continued from "
+              "point to point) driven by a pure sine at each force level. Colours: force levels "
+              "(or frequencies).\n\n";
   const std::size_t figures = std::max<std::size_t>(1, r.steps.size());
   for (std::size_t i = 0; i < figures; ++i) {
-    Figure f;
     const bool none = r.steps.empty();
-    const auto& before = r.comparisons[none ? 0 : i];
-    const auto& after = r.comparisons[none ? 0 : i + 1];
-    const auto channels = channels_of(after);
-    f.columns = none ? 1 : 2;
-    f.width = none ? 900 : 1600;
-    f.height = 520 * static_cast<int>(channels.size());
-    for (const auto& ch : channels) {
-      if (none) {
-        f.charts.push_back(
-            response_chart(after, r.curves.front(), ch, "Starting model (nothing added)"));
-        continue;
-      }
-      f.charts.push_back(
-          response_chart(before, r.curves[i], ch,
-                         fmt::format("Before step {}: {}", i + 1, model_text(r.states[i]))));
-      f.charts.push_back(
-          response_chart(after, r.curves[i + 1], ch,
-                         fmt::format("After step {} (+ {})", i + 1, r.steps[i].added.name())));
-    }
     md += none ? "" : fmt::format("### Step {}: {}\n\n", i + 1, r.steps[i].finding);
-    md += plot(fmt::format("response_{}.png", i + 1), f);
+    md +=
+        plot(fmt::format("response_{}.png", i + 1), discovery_response_figure(r, none ? 0 : i + 1));
   }
 
   // The candidates of every step.
@@ -343,10 +275,16 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     }
     md += "| candidate | effect | value | 95 % interval | gap | explained | verdict |\n"
           "|---|---|---|---|---|---|---|\n";
-    for (const auto& cand : *ranking)
-      md += fmt::format("| {} | {} | {} | [{}, {}] | {} | {} | {} |\n", cand.name(), cand.effect(),
-                        g4(cand.value), g4(cand.ci_low), g4(cand.ci_high), g4(cand.gap),
-                        pct(cand.explained), cand.rejected.empty() ? "admissible" : cand.rejected);
+    for (const auto& cand : *ranking) {
+      std::string verdict = cand.rejected.empty() ? "admissible" : cand.rejected;
+      if (!cand.left_out.empty() && cand.rejected.find("did not converge") == std::string::npos)
+        verdict += fmt::format(" (compared without the {} test{} it could not re-simulate: {})",
+                               cand.left_out.size(), cand.left_out.size() == 1 ? "" : "s",
+                               listed(cand.left_out));
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", cand.name(), cand.effect(),
+                        g4(cand.value), interval(cand.ci_low, cand.ci_high), g4(cand.gap),
+                        pct(cand.explained), verdict);
+    }
     md += "\n";
   }
 
@@ -360,8 +298,7 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
       for (const auto& je : last.fit.joints)
         if (je.name == j.name)
           for (const auto& te : je.terms)
-            if (te.term == j.terms[t] && !te.fixed)
-              ci = fmt::format("[{}, {}]", g4(te.ci_low), g4(te.ci_high));
+            if (te.term == j.terms[t] && !te.fixed) ci = interval(te.ci_low, te.ci_high);
       md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", j.name, joints::term_name(j.terms[t]),
                         joints::term_effect(j.terms[t]), g4(j.values[t]),
                         joints::term_unit(j.terms[t]), ci);
@@ -375,15 +312,26 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
         "|---|---|---|---|---|---|---|---|---|---|\n";
   const auto& first = r.comparisons.front();
   const auto& final = r.comparisons.back();
+  // A model that could not re-simulate a test has no error there: "left out".
+  auto error = [](const discover::Comparison& c, double value, bool percent) {
+    return !c.converged ? std::string("left out") : percent ? pct(value) : g4(value);
+  };
   for (std::size_t i = 0; i < final.size(); ++i)
     md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", final[i].test,
                       final[i].channel, g4(final[i].frequency_hz), g4(final[i].force),
-                      pct(first[i].amplitude_error), pct(final[i].amplitude_error),
-                      g4(first[i].phase_error_deg), g4(final[i].phase_error_deg),
-                      pct(final[i].harmonics_measured), pct(final[i].harmonics_simulated));
-  if (!r.warnings.empty()) {
+                      error(first[i], first[i].amplitude_error, true),
+                      error(final[i], final[i].amplitude_error, true),
+                      error(first[i], first[i].phase_error_deg, false),
+                      error(final[i], final[i].phase_error_deg, false),
+                      pct(final[i].harmonics_measured),
+                      error(final[i], final[i].harmonics_simulated, true));
+  // The limits are said near the top; the other warnings here.
+  std::vector<std::string> others;
+  for (const auto& w : r.warnings)
+    if (std::find(r.limits.begin(), r.limits.end(), w) == r.limits.end()) others.push_back(w);
+  if (!others.empty()) {
     md += "\n## Warnings\n\n";
-    for (const auto& w : r.warnings)
+    for (const auto& w : others)
       md += "- " + w + "\n";
   }
   io::write_file_atomically(dir / "report.md", md);

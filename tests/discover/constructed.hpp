@@ -61,6 +61,7 @@ inline discover::Candidate candidate(std::optional<joints::Term> term, double ga
   c.joint = term ? "tip" : "substructure";
   c.term = term;
   c.value = 0.5 * (ci_low + ci_high);
+  c.std = (ci_high - ci_low) / 3.92;
   c.ci_low = ci_low;
   c.ci_high = ci_high;
   c.gap = gap;

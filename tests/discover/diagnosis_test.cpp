@@ -71,7 +71,7 @@ TEST(Diagnosis, AReceptanceThatFallsWithLevelIsNonLinearConservativeAtTheJoint) 
   const std::vector<discover::Candidate> ranking{explaining(std::nullopt, 0.10, 400.0),
                                                  explaining(Term::k3, 0.97, 20.0, 1.6e8),
                                                  explaining(Term::c2, 0.20, 300.0)};
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr, {});
   ASSERT_TRUE(d.level_dependent.has_value());
   EXPECT_TRUE(*d.level_dependent);
   EXPECT_EQ(d.joint, "tip");
@@ -101,6 +101,26 @@ TEST(Diagnosis, AReceptanceThatFallsWithLevelIsNonLinearConservativeAtTheJoint) 
       << all(d);
 }
 
+TEST(Diagnosis, TestsAtOneForceLevelNeverSayTheDisagreementChangesWithLevel) {
+  // The same disagreement and ranking as above, from tests that the preconditions found to be
+  // at one force level: the level dependence cannot be seen, and nothing may claim it.
+  const auto measured = tests(0.96 * H, 0.8 * H);
+  const Compared c = compared_values(measured, 2);
+  const std::vector<discover::Candidate> ranking{explaining(std::nullopt, 0.10, 400.0),
+                                                 explaining(Term::k3, 0.97, 20.0, 1.6e8),
+                                                 explaining(Term::c2, 0.20, 300.0)};
+  Preconditions one_level;
+  one_level.several_levels = false;
+  const discover::Diagnosis d =
+      diagnose(c, measured, linear_model(0.25), ranking, nullptr, one_level);
+  EXPECT_FALSE(d.level_dependent.has_value());
+  EXPECT_FALSE(says(d, "changes with force level")) << all(d);
+  EXPECT_FALSE(says(d, "with level")) << all(d);
+  EXPECT_TRUE(says(d, "The tests are all at one force level: they cannot tell whether the "
+                      "disagreement changes with the level."))
+      << all(d);
+}
+
 TEST(Diagnosis, AReceptanceTheSameAtBothLevelsIsALinearModelError) {
   // Measured X = 1.125 H F at both levels: the noise explains the change (0); the damping scale
   // explains 95 %. k3's criterion is lower, 49 against 50, but by less than ln 8 = 2.08: one
@@ -109,7 +129,7 @@ TEST(Diagnosis, AReceptanceTheSameAtBothLevelsIsALinearModelError) {
   const Compared c = compared_values(measured, 2);
   const std::vector<discover::Candidate> ranking{explaining(std::nullopt, 0.95, 50.0),
                                                  explaining(Term::k3, 0.96, 49.0, 1e7)};
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.1), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.1), ranking, nullptr, {});
   ASSERT_TRUE(d.level_dependent.has_value());
   EXPECT_FALSE(*d.level_dependent);
   EXPECT_EQ(d.joint, "substructure");
@@ -141,7 +161,7 @@ TEST(Diagnosis, EvenHarmonicsInEveryTestPointToAnAsymmetricForce) {
   const Compared c = compared_values(measured, 2);
   const std::vector<discover::Candidate> ranking{explaining(std::nullopt, 0.10, 400.0),
                                                  explaining(Term::k2, 0.90, 20.0, 5e4)};
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.25), ranking, nullptr, {});
   EXPECT_TRUE(d.even_harmonics);
   EXPECT_TRUE(d.asymmetric);
   EXPECT_NEAR(d.even_content, 0.05, 1e-12);
@@ -157,7 +177,7 @@ TEST(Diagnosis, NothingAdmissibleSaysNothingIsMissing) {
   const Compared c = compared_values(measured, 2);
   std::vector<discover::Candidate> ranking{explaining(Term::k3, 0.01, 60.0)};
   ranking[0].rejected = "explains too little";
-  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.001), ranking, nullptr);
+  const discover::Diagnosis d = diagnose(c, measured, linear_model(0.001), ranking, nullptr, {});
   EXPECT_FALSE(d.level_dependent.has_value());
   EXPECT_TRUE(says(d, "No candidate explains a significant share of the disagreement: nothing is "
                       "missing that these tests can reveal."))

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 namespace jointid {
 namespace {
@@ -52,6 +53,22 @@ TEST(Result, AStepsFindingAndTheSummaryInWords) {
   c.noise_known = false;
   EXPECT_EQ(summary(r, c), "Nothing was added: the gap stays at 0.1; the noise level is unknown "
                            "(stepped-sine tables).");
+}
+
+TEST(Result, AZeroWidthIntervalIsFlaggedNeverPrintedAsAResult) {
+  discover::Step step;
+  step.added = test::candidate(Term::k3, 0.001, 10.0, 1.6e8, 1.6e8); // zero width
+  step.added.value = 1.6e8;
+  step.added.explained = 0.99;
+  step.gap_before = 0.1, step.gap_after = 0.01;
+  EXPECT_FALSE(step.added.determined());
+  EXPECT_EQ(finding(step), "Added k3 at 'tip' (cubic stiffness) = 1.6e+08 (its interval "
+                           "undetermined: the value is not a result): the gap fell from 0.1 to "
+                           "0.01 (99 % of it explained).");
+  step.added.ci_high = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(step.added.determined());
+  step.added.ci_high = 1.7e8, step.added.std = 0.1e8 / 1.96;
+  EXPECT_TRUE(step.added.determined());
 }
 
 TEST(Result, CandidatesAreNamedByTheirTermAndJoint) {

@@ -99,7 +99,8 @@ TEST(Rule1, ACandidateWhoseReSimulationDidNotConvergeIsRejected) {
   judge(c, s);
   EXPECT_EQ(c.rejected, "") << "a converged state with a clear interval is admissible";
   EXPECT_EQ(c.value, 1.6e8);
-  s.converged = false;
+  s.converged = false; // and too many tests left out: not compared (score gives +∞)
+  s.criterion = std::numeric_limits<double>::infinity();
   judge(c, s);
   EXPECT_EQ(c.rejected, "a re-simulation did not converge");
 }
@@ -160,7 +161,13 @@ TEST(Rule5, ACandidateThatPredictsHeldOutTestsWorseIsRejectedAndTheNextChosen) {
   int model_cv = 0;
   const std::vector<double> cv{0.1, 0.3};
   const Choice choice = choose(
-      ranking, {1, 0}, [&] { return ++model_cv, 0.2; }, [&](std::size_t i) { return cv[i]; });
+      ranking, {1, 0},
+      [&](std::size_t) {
+        return ++model_cv, CrossValidation{0.2, {}};
+      },
+      [&](std::size_t i) {
+        return CrossValidation{cv[i], {}};
+      });
   EXPECT_EQ(ranking[1].name(), "k3 at 'tip'");
   EXPECT_EQ(ranking[1].rejected,
             "does not predict held-out tests better (cross-validated gap 0.3 vs 0.2 now)");
@@ -168,12 +175,36 @@ TEST(Rule5, ACandidateThatPredictsHeldOutTestsWorseIsRejectedAndTheNextChosen) {
   EXPECT_EQ(*choice.chosen, 0u);
   EXPECT_EQ(ranking[0].cv_gap, 0.1);
   EXPECT_EQ(choice.cv_now, 0.2);
-  EXPECT_EQ(model_cv, 1);
-  // Not computable (< 0, too few tests) on either side: no verdict.
-  EXPECT_EQ(cross_validation_problem(0.3, -1.0), "");
-  EXPECT_EQ(cross_validation_problem(-1.0, 0.2), "");
-  EXPECT_EQ(cross_validation_problem(0.2, 0.2),
+  EXPECT_EQ(model_cv, 2) << "asked for each candidate walked to (the caller keeps the values)";
+  EXPECT_EQ(cross_validation_problem({0.2, {}}, {0.2, {}}),
             "does not predict held-out tests better (cross-validated gap 0.2 vs 0.2 now)");
+}
+
+TEST(Rule5, WhenItCannotBeAppliedNothingIsAddedAndItSaysWhy) {
+  // Not computable on either side (fewer than four tests, a fold that cannot be identified):
+  // the addition is not checked, so it is not made, with the reason.
+  EXPECT_EQ(cross_validation_problem({0.3, {}}, {-1.0, "3 tests, at least 4 needed"}),
+            "cannot be checked against held-out tests: 3 tests, at least 4 needed");
+  EXPECT_EQ(
+      cross_validation_problem({-1.0, "without a.csv the terms cannot be identified"}, {0.2, {}}),
+      "cannot be checked against held-out tests: without a.csv the terms cannot be "
+      "identified");
+  std::vector<discover::Candidate> ranking{candidate(Term::k3, 0.04, 70.0)};
+  int candidate_cv = 0;
+  const Choice choice = choose(
+      ranking, {0},
+      [](std::size_t) {
+        return CrossValidation{-1.0, "2 tests, at least 4 needed"};
+      },
+      [&](std::size_t) {
+        return ++candidate_cv, CrossValidation{0.1, {}};
+      });
+  EXPECT_FALSE(choice.chosen.has_value());
+  EXPECT_EQ(ranking[0].rejected, "cannot be checked against held-out tests: 2 tests, at least 4 "
+                                 "needed");
+  EXPECT_TRUE(only_unchecked(ranking[0]));
+  EXPECT_EQ(candidate_cv, 0) << "the candidate's is not computed when the model's cannot be";
+  EXPECT_FALSE(choice.cv_now.has_value());
 }
 
 TEST(Selection, EachRuleRejectsItsCandidateAndTheAdmissibleOneIsAdded) {
@@ -189,6 +220,7 @@ TEST(Selection, EachRuleRejectsItsCandidateAndTheAdmissibleOneIsAdded) {
       candidate(std::nullopt, 0.06, 64.0, 1.5, 2.5)}; // admissible
   State unconverged = with_estimate(Term::k2, 1e4, 0.5e4, 1.5e4);
   unconverged.converged = false;
+  unconverged.criterion = std::numeric_limits<double>::infinity();
   judge(ranking[0], unconverged);
   ranking[0].criterion = 60.0, ranking[0].gap = 0.05; // (as an unconverged state would not have)
   judge(ranking[1], with_estimate(Term::c3, 1.0, -1.0, 3.0));
@@ -196,7 +228,13 @@ TEST(Selection, EachRuleRejectsItsCandidateAndTheAdmissibleOneIsAdded) {
   const std::vector<std::size_t> order = screen(ranking, now, 0.05);
   EXPECT_EQ(order, (std::vector<std::size_t>{0, 3, 1, 4, 5, 2}));
   const Choice choice = choose(
-      ranking, order, [] { return 0.2; }, [](std::size_t i) { return i == 4 ? 0.25 : 0.1; });
+      ranking, order,
+      [](std::size_t) {
+        return CrossValidation{0.2, {}};
+      },
+      [](std::size_t i) {
+        return CrossValidation{i == 4 ? 0.25 : 0.1, {}};
+      });
   EXPECT_EQ(ranking[0].rejected, "a re-simulation did not converge");
   EXPECT_EQ(ranking[1].rejected, "not significant: its 95 % interval [-1, 3] holds 0");
   EXPECT_EQ(ranking[2].rejected, "not significant (information criterion 101 vs 100 now)");
@@ -213,10 +251,13 @@ TEST(Selection, FinalistsAreTheBestSimulatedAdditions) {
       candidate(Term::k2, 0.1, 50.0), candidate(Term::k3, 0.1, 40.0),
       candidate(Term::c2, 0.1, 45.0), candidate(Term::c3, 0.1, 30.0),
       candidate(Term::fc, 0.1, std::numeric_limits<double>::infinity())};
-  ranking[3].converged = false;
   ranking[2].varies = discover::Variation{};
-  EXPECT_EQ(finalists(ranking, 2), (std::vector<std::size_t>{1, 0}));
-  EXPECT_EQ(finalists(ranking, 5), (std::vector<std::size_t>{1, 0}));
+  EXPECT_EQ(finalists(ranking, 2), (std::vector<std::size_t>{3, 1}));
+  EXPECT_EQ(finalists(ranking, 5), (std::vector<std::size_t>{3, 1, 0}));
+  // One that left a few tests out (not every re-simulation converged) is still compared, on
+  // the others, and may be refined; one that could not be compared (+∞, fc here) may not.
+  ranking[3].converged = false;
+  EXPECT_EQ(finalists(ranking, 2), (std::vector<std::size_t>{3, 1}));
 }
 
 TEST(CrossValidation, LeavesOneTestOutUpTo30TestsElseUsesFolds) {
@@ -304,7 +345,13 @@ TEST(VariesPerTest, ValuesThatFallWithTheAmplitudeAreAdmittedAndChosenAsOutside)
   const State now = current(0.01, 100.0);
   std::vector<discover::Candidate> ranking{candidate(Term::k3, 0.005, 60.0), c};
   const Choice choice = choose(
-      ranking, screen(ranking, now, 0.05), [] { return 0.2; }, [](std::size_t) { return 0.1; });
+      ranking, screen(ranking, now, 0.05),
+      [](std::size_t) {
+        return CrossValidation{0.2, {}};
+      },
+      [](std::size_t) {
+        return CrossValidation{0.1, {}};
+      });
   EXPECT_FALSE(choice.chosen.has_value());
   ASSERT_TRUE(choice.outside.has_value());
   EXPECT_EQ(*choice.outside, 1u);
