@@ -79,7 +79,9 @@ void check_amplitudes(const std::vector<double>& amplitudes) {
   io::check_amplitudes("--amplitude", amplitudes);
 }
 
-void check_noise(double noise) { io::check_noise("--noise", noise); }
+void check_noise(double noise) {
+  io::check_noise("--noise", noise);
+}
 
 std::pair<double, double> parse_pair(const std::string& option, const std::string& text,
                                      const char* example) {

@@ -351,7 +351,8 @@ Result discover(const frf::Substructure& substructure, const std::vector<joints:
   for (const auto& m : tests)
     if (m.kind == identify::RecordKind::periodic)
       throw std::invalid_argument(
-          m.source + ": a periodic broadband test (lines every " + fmt::format("{:.6g}", m.frequency_hz) +
+          m.source + ": a periodic broadband test (lines every " +
+          fmt::format("{:.6g}", m.frequency_hz) +
           " Hz): discover re-simulates each test by the harmonic balance of one excitation "
           "frequency, which this test is not; give discover sine tests, stepped-sine tables or "
           "sweeps (jointid identify takes periodic records)");

@@ -222,8 +222,7 @@ TransientResponse integrate(const ForceHistory& history, int n_outputs, const Tr
         if (m != j) w *= (x - m) / static_cast<double>(j - m);
       if (w == 0.0) continue;
       const Eigen::Index node = first + j;
-      f += w * fade(static_cast<double>(node) * history.dt) *
-           history.samples.row(node).transpose();
+      f += w * fade(static_cast<double>(node) * history.dt) * history.samples.row(node).transpose();
     }
     return f;
   };

@@ -215,7 +215,8 @@ TimeDomainModel time_domain_model(const Substructure& sub, const TimeModelOption
     out.residual_dofs += part.residual_dofs;
     out.parts.push_back(part.description);
     for (const std::string& w : part.warnings)
-      out.warnings.push_back(composite ? fmt::format("substructure {}: {}", &part - parts.data() + 1, w) : w);
+      out.warnings.push_back(
+          composite ? fmt::format("substructure {}: {}", &part - parts.data() + 1, w) : w);
   }
   out.every_mode = parts.size() == 1 && parts.front().every_mode;
   int n_w = 0;

@@ -249,8 +249,8 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
   }
   for (std::size_t f = 0; f < m.force_noise.size(); ++f) {
     s.f_variance.push_back(m.force_noise[f] * m.force_noise[f] / P);
-    s.noise_known =
-        s.noise_known && meaningful(m.force_noise[f], largest(m.F, static_cast<Eigen::Index>(f), 0));
+    s.noise_known = s.noise_known &&
+                    meaningful(m.force_noise[f], largest(m.F, static_cast<Eigen::Index>(f), 0));
   }
   if (periodic) {
     // The noise of a periodic test is the scatter of its periods: each one's equations.
@@ -500,7 +500,8 @@ std::vector<std::string> explain_identifiability(const FitResult& result,
   auto main_line = [&](const TestSpectrum& test, int joint) {
     int best = 1;
     for (int k : test.lines)
-      if (std::abs(deformation(test, joint, k)) > std::abs(deformation(test, joint, best))) best = k;
+      if (std::abs(deformation(test, joint, k)) > std::abs(deformation(test, joint, best)))
+        best = k;
     return best;
   };
   // Per joint and test: the main line of the deformation and of each term's force b_t g_t.
@@ -667,8 +668,7 @@ Eigen::MatrixXd test_covariance(const Equations& eq, const std::vector<int>& idx
 // scatter.
 Eigen::MatrixXd scatter_covariance(const Equations& eq, const std::vector<int>& block,
                                    const TestSpectrum& test, std::size_t ti,
-                                   const std::vector<joints::Joint>& at,
-                                   const Eigen::MatrixXd& B) {
+                                   const std::vector<joints::Joint>& at, const Eigen::MatrixXd& B) {
   const int k = eq.rows[static_cast<std::size_t>(block.front())].k;
   const auto line = static_cast<Eigen::Index>(
       std::lower_bound(test.lines.begin(), test.lines.end(), k) - test.lines.begin());
@@ -684,12 +684,12 @@ Eigen::MatrixXd scatter_covariance(const Equations& eq, const std::vector<int>& 
       const auto& J = at[static_cast<std::size_t>(j)];
       Complex sum = 0.0;
       for (std::size_t t = 0; t < J.terms.size(); ++t)
-        sum += J.values[t] *
-               period.G[static_cast<std::size_t>(j)](line, static_cast<Eigen::Index>(t));
+        sum +=
+            J.values[t] * period.G[static_cast<std::size_t>(j)](line, static_cast<Eigen::Index>(t));
       g(j) = sum;
     }
-    const Eigen::VectorXcd r = -R.H22B * g - period.X2.row(line).transpose() +
-                               R.H2f * period.F.row(line).transpose();
+    const Eigen::VectorXcd r =
+        -R.H22B * g - period.X2.row(line).transpose() + R.H2f * period.F.row(line).transpose();
     for (Eigen::Index i = 0; i < q; ++i) {
       const Row& row = eq.rows[static_cast<std::size_t>(block[static_cast<std::size_t>(i)])];
       E(i, p) = row.imaginary ? r(row.d).imag() : r(row.d).real();
@@ -726,9 +726,9 @@ struct Whitening {
   }
 };
 
-Whitening test_whitening(const Equations& eq, const std::vector<int>& idx,
-                         const TestSpectrum& test, std::size_t ti,
-                         const std::vector<joints::Joint>& at, const Eigen::MatrixXd& B) {
+Whitening test_whitening(const Equations& eq, const std::vector<int>& idx, const TestSpectrum& test,
+                         std::size_t ti, const std::vector<joints::Joint>& at,
+                         const Eigen::MatrixXd& B) {
   Whitening w;
   if (test.periods.empty()) {
     w.blocks.emplace_back(idx.size());
@@ -1014,7 +1014,7 @@ TestInformation information(const ReceptanceFn& H, const fem::DofMap& dofs,
     b(static_cast<Eigen::Index>(u)) = joints[static_cast<std::size_t>(unknowns[u].first)]
                                           .values[static_cast<std::size_t>(unknowns[u].second)];
   const Whitening C = test_whitening(eq, idx, test, 0, joints, B);
-  const Eigen::MatrixXd W = C.apply(eq.Q);                                            // C^-1/2 Q
+  const Eigen::MatrixXd W = C.apply(eq.Q);                             // C^-1/2 Q
   const Eigen::VectorXd w = C.apply(Eigen::VectorXd(eq.p - eq.Q * b)); // C^-1/2 r
   TestInformation out;
   out.information = W.transpose() * W;
@@ -1090,8 +1090,8 @@ FitResult fit(const ReceptanceFn& H, const fem::DofMap& dofs,
     tables += m.fundamental_only ? 1 : 0;
   }
   if (tests.empty())
-    throw std::invalid_argument("identify: every test is left out (" + std::to_string(measurements.size()) +
-                                "; the warnings say why)");
+    throw std::invalid_argument("identify: every test is left out (" +
+                                std::to_string(measurements.size()) + "; the warnings say why)");
   if (tables > 0 && (o.harmonics.size() != 1 || o.harmonics[0] != 1))
     warnings.push_back(std::to_string(tables) +
                        " test(s) from stepped-sine tables give harmonic 1 only; their other "

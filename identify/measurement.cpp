@@ -5,9 +5,9 @@
 #include "identify/sweep.hpp"
 
 #include <Eigen/Dense>
-#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
+#include <fmt/format.h>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -111,8 +111,7 @@ int transient_periods(const Record& r, double frequency_hz, const MeasureOptions
                       Measurement& m) {
   const double dt = r.dt(), per_period = 1.0 / (frequency_hz * dt);
   const auto per = static_cast<int>(std::lround(per_period));
-  if (!o.average_periods || per < 2 || !(std::abs(per_period - per) <= 1e-6 * per_period))
-    return 0;
+  if (!o.average_periods || per < 2 || !(std::abs(per_period - per) <= 1e-6 * per_period)) return 0;
   const int periods = whole_period_samples(r.t, frequency_hz) / per;
   if (periods < 2) return 0;
   std::vector<const Channel*> all;
@@ -159,7 +158,8 @@ Measurement measure_sine(const Record& r, double frequency_hz, const MeasureOpti
   if (best.empty())
     fail("no response channel among its channels (" + channel_list() +
          "): a test needs a displacement, velocity or acceleration recorded with its force, "
-         "e.g. x@" + fem::to_string(forces.front()->at));
+         "e.g. x@" +
+         fem::to_string(forces.front()->at));
 
   // A force channel that is zero in every sample measured no force.
   std::vector<const Channel*> loaded;

@@ -45,8 +45,8 @@ struct SteadyPeriods {
 /// `channels`: every channel of the record (its first periods × samples are used). `tolerance`:
 /// a relative change (RMS) between periods that is always allowed (MeasureOptions::
 /// steady_tolerance), so that a noise-free record is not held to rounding.
-SteadyPeriods steady_periods(const std::vector<const Channel*>& channels, int samples,
-                             int periods, double tolerance);
+SteadyPeriods steady_periods(const std::vector<const Channel*>& channels, int samples, int periods,
+                             double tolerance);
 
 /// The per-sample noise variance of x (its first `periods` × N samples, N = x.size() /
 /// periods), from its spectrum off the lines k·periods (see above). NaN when periods < 2 or

@@ -29,19 +29,16 @@ void check_harmonics(const std::string& name, const std::vector<int>& harmonics,
 void check_balance_harmonics(const std::string& name, int harmonics, int lowest,
                              const std::string& why) {
   if (harmonics < lowest || harmonics > 200)
-    throw Error(why.empty()
-                    ? fmt::format("{}: expected {} to 200, got {}", name, lowest, harmonics)
-                    : fmt::format("{}: expected from {} ({}) to 200, got {}", name, lowest, why,
-                                  harmonics));
+    throw Error(why.empty() ? fmt::format("{}: expected {} to 200, got {}", name, lowest, harmonics)
+                            : fmt::format("{}: expected from {} ({}) to 200, got {}", name, lowest,
+                                          why, harmonics));
 }
 
 void check_amplitudes(const std::string& name, const std::vector<double>& amplitudes) {
-  if (amplitudes.empty())
-    throw Error(fmt::format("{}: expected at least one amplitude (N)", name));
+  if (amplitudes.empty()) throw Error(fmt::format("{}: expected at least one amplitude (N)", name));
   for (double a : amplitudes)
     if (!(std::isfinite(a) && a > 0.0))
-      throw Error(
-          fmt::format("{}: expected finite amplitudes > 0 (N or N m), got {}", name, a));
+      throw Error(fmt::format("{}: expected finite amplitudes > 0 (N or N m), got {}", name, a));
 }
 
 void check_noise(const std::string& name, double noise) {
@@ -67,4 +64,4 @@ std::vector<identify::Quantity> parse_channels(const std::string& name,
   return out;
 }
 
-}  // namespace jointid::io
+} // namespace jointid::io

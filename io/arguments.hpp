@@ -26,4 +26,4 @@ void check_noise(const std::string& name, double noise);
 std::vector<identify::Quantity> parse_channels(const std::string& name,
                                                const std::vector<std::string>& channels);
 
-}  // namespace jointid::io
+} // namespace jointid::io

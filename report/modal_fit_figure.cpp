@@ -123,8 +123,8 @@ Figure modal_fit_figure(const identify::ModalFit& fit, const identify::MeasuredF
     const std::string to = fem::to_string(data.responses[k]);
     mag.title = data.response_names[k] == to
                     ? fmt::format("receptance {} / {}", to, fem::to_string(data.drive))
-                    : fmt::format("receptance {} / {} (from {})", to,
-                                  fem::to_string(data.drive), data.response_names[k]);
+                    : fmt::format("receptance {} / {} (from {})", to, fem::to_string(data.drive),
+                                  data.response_names[k]);
     mag.x_label = ph.x_label = "frequency (Hz)";
     mag.y_label = "|H| (" + unit(data.responses[k], data.drive) + ")";
     mag.log_y = true;

@@ -81,7 +81,8 @@ void Identify::run() {
                             "the largest of --harmonics");
   }
   identify::MeasureOptions measure = identify::measure_options(fit_);
-  if (!band_.empty()) std::tie(measure.band_from_hz, measure.band_to_hz) = parse_band("--band", band_);
+  if (!band_.empty())
+    std::tie(measure.band_from_hz, measure.band_to_hz) = parse_band("--band", band_);
   check_output_file(output_);
   for (const fs::path& png : {fit_png_, params_png_})
     if (!png.empty()) check_output_file(png);

@@ -21,8 +21,8 @@ std::vector<identify::Measurement> at_forces(const std::vector<double>& forces) 
   for (double F : forces) {
     std::string name = "t"; // (not "t" + to_string: GCC 12's -Wrestrict false positive)
     name += std::to_string(++i);
-    out.push_back(test::measurement(name, 3.0, F, {0.0, 1e-3 * F, 0.0}, {1e-12, 1e-12, 1e-12},
-                                    false));
+    out.push_back(
+        test::measurement(name, 3.0, F, {0.0, 1e-3 * F, 0.0}, {1e-12, 1e-12, 1e-12}, false));
   }
   return out;
 }

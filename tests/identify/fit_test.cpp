@@ -397,11 +397,11 @@ TEST_F(FitTest, ATransientOnOneRecordIsNamedAndDropped) {
   ASSERT_TRUE(r.status.ok()) << r.status.reason;
   bool named = false;
   for (const auto& w : r.warnings)
-    named = named || (w.find(hit.source) != std::string::npos &&
-                      w.find("not steady: a transient") != std::string::npos &&
-                      w.find("periods 1 to") != std::string::npos &&
-                      (w.find("dropped") != std::string::npos ||
-                       w.find("left out") != std::string::npos));
+    named = named ||
+            (w.find(hit.source) != std::string::npos &&
+             w.find("not steady: a transient") != std::string::npos &&
+             w.find("periods 1 to") != std::string::npos &&
+             (w.find("dropped") != std::string::npos || w.find("left out") != std::string::npos));
   EXPECT_TRUE(named);
   const identify::TermEstimate& c = r.joints[0].terms[1];
   const identify::TermEstimate& c_clean = reference.joints[0].terms[1];
@@ -552,11 +552,11 @@ TEST_P(EveryTermTest, SimulatedByTimeIntegrationAndRecovered) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Library, EveryTermTest,
-    ::testing::ValuesIn(std::vector<Term>(joints::coefficient_terms.begin() + 2,
-                                          joints::coefficient_terms.end())),
-    term_case_name);
+INSTANTIATE_TEST_SUITE_P(Library, EveryTermTest,
+                         ::testing::ValuesIn(std::vector<Term>(joints::coefficient_terms.begin() +
+                                                                   2,
+                                                               joints::coefficient_terms.end())),
+                         term_case_name);
 
 // The parameterised test covers every coefficient term but k and c (present in every case); the
 // parametric terms (jenkins, iwan, gap) are identified by output error, each in
@@ -569,8 +569,8 @@ TEST(EveryTermCases, CoverTheWholeLibrary) {
         << joints::term_name(joints::coefficient_terms[i]);
   for (Term t : joints::all_terms)
     EXPECT_TRUE(joints::has_parameters(t) ||
-                std::find(joints::coefficient_terms.begin(), joints::coefficient_terms.end(),
-                          t) != joints::coefficient_terms.end())
+                std::find(joints::coefficient_terms.begin(), joints::coefficient_terms.end(), t) !=
+                    joints::coefficient_terms.end())
         << joints::term_name(t);
 }
 
