@@ -116,4 +116,20 @@ int whole_period_samples(const Eigen::VectorXd& t, double frequency_hz) {
   return samples >= n ? n : static_cast<int>(samples);
 }
 
+Eigen::VectorXd synthesise(const Eigen::VectorXd& t, const Eigen::VectorXcd& X, double omega) {
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(t.size(), X(0).real());
+  for (Eigen::Index i = 0; i < t.size(); ++i)
+    for (Eigen::Index k = 1; k < X.size(); ++k)
+      x(i) += (X(k) * std::polar(1.0, static_cast<double>(k) * omega * t(i))).real();
+  return x;
+}
+
+Eigen::VectorXcd differentiate(const Eigen::VectorXcd& X, double omega, int power) {
+  Eigen::VectorXcd Y(X.size());
+  Y(0) = 0.0;
+  for (Eigen::Index k = 1; k < X.size(); ++k)
+    Y(k) = X(k) * std::pow(std::complex<double>(0.0, static_cast<double>(k) * omega), power);
+  return Y;
+}
+
 } // namespace jointid::identify

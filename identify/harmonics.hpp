@@ -28,6 +28,13 @@ double estimate_frequency(const Eigen::VectorXd& t, const Eigen::VectorXd& x);
 /// 0 <= K < N/2.
 Eigen::MatrixXcd period_harmonics(const Eigen::MatrixXd& x, double t0, double omega, int K);
 
+/// A periodic signal from its harmonics X_0 … X_K at the times t: Re(Σ X_k e^{ikωt}).
+Eigen::VectorXd synthesise(const Eigen::VectorXd& t, const Eigen::VectorXcd& X, double omega);
+
+/// Harmonics of the derivative (power > 0) or of the integral (power < 0) of a periodic signal:
+/// harmonic k multiplied by (ikω)^power; the mean of an integral is unknown and set to 0.
+Eigen::VectorXcd differentiate(const Eigen::VectorXcd& X, double omega, int power);
+
 /// Number of leading samples spanning the largest whole number of periods (at least one
 /// period), or 0 if the record is shorter than one period.
 int whole_period_samples(const Eigen::VectorXd& t, double frequency_hz);

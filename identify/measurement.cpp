@@ -51,25 +51,6 @@ double clipped_fraction(const Eigen::VectorXd& x, const Eigen::VectorXd* velocit
   return static_cast<double>(at_edge) / static_cast<double>(x.size());
 }
 
-// A periodic signal from its harmonics 0 … K at the times t.
-Eigen::VectorXd synthesise(const Eigen::VectorXd& t, const Eigen::VectorXcd& X, double omega) {
-  Eigen::VectorXd x = Eigen::VectorXd::Constant(t.size(), X(0).real());
-  for (Eigen::Index i = 0; i < t.size(); ++i)
-    for (Eigen::Index k = 1; k < X.size(); ++k)
-      x(i) += (X(k) * std::polar(1.0, static_cast<double>(k) * omega * t(i))).real();
-  return x;
-}
-
-// Harmonics of the derivative (power > 0) or of the integral (power < 0) of a periodic signal:
-// multiply harmonic k by (ikω)^power; the mean of an integral is unknown and set to 0.
-Eigen::VectorXcd differentiate(const Eigen::VectorXcd& X, double omega, int power) {
-  Eigen::VectorXcd Y(X.size());
-  Y(0) = 0.0;
-  for (Eigen::Index k = 1; k < X.size(); ++k)
-    Y(k) = X(k) * std::pow(Complex(0.0, static_cast<double>(k) * omega), power);
-  return Y;
-}
-
 // The samples of one channel's data over the analysed span (whole periods), with the span's
 // noise estimate: either the synchronous average of the periods or the trimmed record.
 struct Span {
@@ -141,20 +122,7 @@ Measurement measure_sine(const Record& r, double frequency_hz, const MeasureOpti
     fail("no force channel among its channels (" + channel_list() +
          "): a test needs its excitation force (a channel f@NODE:DOF) recorded with the "
          "responses");
-  // Response DOFs in order of first appearance, each with its best channel (x, then v, then a).
-  std::vector<const Channel*> best;
-  for (const auto& c : r.channels) {
-    if (c.quantity == Quantity::force) continue;
-    const int i = m.response_index(c.at);
-    if (i < 0) {
-      m.response_at.push_back(c.at);
-      m.measured_as.push_back(c.quantity);
-      best.push_back(&c);
-    } else if (static_cast<int>(c.quantity) < static_cast<int>(m.measured_as[i])) {
-      m.measured_as[i] = c.quantity;
-      best[i] = &c;
-    }
-  }
+  const std::vector<const Channel*> best = best_response_channels(r, m);
   if (best.empty())
     fail("no response channel among its channels (" + channel_list() +
          "): a test needs a displacement, velocity or acceleration recorded with its force, "
@@ -495,6 +463,23 @@ std::vector<Measurement> measure(const std::vector<SineTest>& tests,
     out.push_back(measure(t, options));
   }
   return out;
+}
+
+std::vector<const Channel*> best_response_channels(const Record& r, Measurement& m) {
+  std::vector<const Channel*> best;
+  for (const auto& c : r.channels) {
+    if (c.quantity == Quantity::force) continue;
+    const int i = m.response_index(c.at);
+    if (i < 0) {
+      m.response_at.push_back(c.at);
+      m.measured_as.push_back(c.quantity);
+      best.push_back(&c);
+    } else if (static_cast<int>(c.quantity) < static_cast<int>(m.measured_as[i])) {
+      m.measured_as[i] = c.quantity;
+      best[static_cast<std::size_t>(i)] = &c;
+    }
+  }
+  return best;
 }
 
 std::vector<Measurement> usable(const std::vector<Measurement>& measurements,

@@ -160,6 +160,10 @@ Measurement measure(const SineTest& test, const MeasureOptions& options = {});
 /// Every test reduced; a sweep record becomes its stepped-sine rows, in order.
 std::vector<Measurement> measure(const std::vector<SineTest>& tests,
                                  const MeasureOptions& options = {});
+/// The response DOFs of a record, in order of first appearance, appended to m.response_at with
+/// m.measured_as: each DOF's best channel (x, then v, then a), returned in that order.
+std::vector<const Channel*> best_response_channels(const Record& r, Measurement& m);
+
 /// The tests not left out, and the left-out ones' reasons appended to `notes`.
 std::vector<Measurement> usable(const std::vector<Measurement>& measurements,
                                 std::vector<std::string>& notes);

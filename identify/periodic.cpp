@@ -280,20 +280,7 @@ Measurement measure_periodic(const Record& r, const RecordClass& kind, const Mea
   const auto forces = r.all(Quantity::force);
   if (forces.empty()) fail(no_force_channel(r));
 
-  // Response DOFs in order of first appearance, each with its best channel (x, then v, then a).
-  std::vector<const Channel*> best;
-  for (const auto& c : r.channels) {
-    if (c.quantity == Quantity::force) continue;
-    const int i = m.response_index(c.at);
-    if (i < 0) {
-      m.response_at.push_back(c.at);
-      m.measured_as.push_back(c.quantity);
-      best.push_back(&c);
-    } else if (static_cast<int>(c.quantity) < static_cast<int>(m.measured_as[i])) {
-      m.measured_as[i] = c.quantity;
-      best[i] = &c;
-    }
-  }
+  const std::vector<const Channel*> best = best_response_channels(r, m);
   if (best.empty()) fail(no_response_channel(r));
   for (const Channel* c : forces)
     if (c->samples.cwiseAbs().maxCoeff() == 0.0)

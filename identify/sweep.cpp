@@ -1,4 +1,5 @@
 #include "identify/sweep.hpp"
+#include "identify/harmonics.hpp"
 
 #include "fem/fft.hpp"
 #include "identify/record_messages.hpp"
@@ -59,23 +60,6 @@ Eigen::Vector3d phase_fit(const Eigen::VectorXd& t, const Eigen::VectorXd& phase
     D(j, 0) = 1.0, D(j, 1) = tau, D(j, 2) = tau * tau;
   }
   return D.colPivHouseholderQr().solve(phase.segment(i, L));
-}
-
-// A periodic signal from its harmonics 0 … K at the times t.
-Eigen::VectorXd synthesise(const Eigen::VectorXd& t, const Eigen::VectorXcd& X, double omega) {
-  Eigen::VectorXd x = Eigen::VectorXd::Constant(t.size(), X(0).real());
-  for (Eigen::Index i = 0; i < t.size(); ++i)
-    for (Eigen::Index k = 1; k < X.size(); ++k)
-      x(i) += (X(k) * std::polar(1.0, static_cast<double>(k) * omega * t(i))).real();
-  return x;
-}
-
-Eigen::VectorXcd differentiate(const Eigen::VectorXcd& X, double omega, int power) {
-  Eigen::VectorXcd Y(X.size());
-  Y(0) = 0.0;
-  for (Eigen::Index k = 1; k < X.size(); ++k)
-    Y(k) = X(k) * std::pow(Complex(0.0, static_cast<double>(k) * omega), power);
-  return Y;
 }
 
 } // namespace

@@ -54,19 +54,6 @@ std::vector<std::string> channels_of(const std::vector<discover::Comparison>& li
   return out;
 }
 
-std::string model_text(const discover::State& s) {
-  std::string text;
-  for (const auto& j : s.joints) {
-    std::string terms;
-    for (const auto t : j.terms)
-      terms += (terms.empty() ? "" : " + ") + std::string(joints::term_name(t));
-    text += fmt::format("{}'{}': {}", text.empty() ? "" : "; ", j.name, terms);
-  }
-  if (s.damping_scale != 1.0)
-    text += fmt::format("; substructure damping ×{:.4g}", s.damping_scale);
-  return text;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Stepped-sine sweeps: FRF magnitude and phase over frequency, a colour per level.
 
@@ -348,6 +335,19 @@ Figure sine_figure(const discover::Result& r, std::size_t step) {
 }
 
 } // namespace
+
+std::string model_text(const discover::State& s) {
+  std::string text;
+  for (const auto& j : s.joints) {
+    std::string terms;
+    for (const auto t : j.terms)
+      terms += (terms.empty() ? "" : " + ") + std::string(joints::term_name(t));
+    text += fmt::format("{}'{}': {}", text.empty() ? "" : "; ", j.name, terms);
+  }
+  if (s.damping_scale != 1.0)
+    text += fmt::format("; substructure damping ×{:.4g}", s.damping_scale);
+  return text;
+}
 
 bool stepped_sine_sweeps(const std::vector<discover::Comparison>& tests) {
   const std::vector<double> levels = levels_of(tests);

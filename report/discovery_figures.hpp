@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace jointid::report {
@@ -26,6 +27,9 @@ bool stepped_sine_sweeps(const std::vector<discover::Comparison>& tests);
 /// it (right); `step` 0: the starting model alone (a run that added nothing). At most four
 /// channels.
 Figure discovery_response_figure(const discover::Result& result, std::size_t step);
+
+/// The model of a discovery state in words: "'tip': k + c + k3; substructure damping ×1.2".
+std::string model_text(const discover::State& s);
 
 /// The colour of level i of n (ascending) on a sequential map (viridis, from its dark violet to
 /// its yellow-green, without the last yellow that is hard to see on white).

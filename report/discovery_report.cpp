@@ -26,19 +26,6 @@ std::string pct(double f) {
   return std::isfinite(f) ? fmt::format("{:.3g} %", 100.0 * f) : std::string("—");
 }
 
-std::string model_text(const discover::State& s) {
-  std::string text;
-  for (const auto& j : s.joints) {
-    std::string terms;
-    for (const auto t : j.terms)
-      terms += (terms.empty() ? "" : " + ") + std::string(joints::term_name(t));
-    text += fmt::format("{}'{}': {}", text.empty() ? "" : "; ", j.name, terms);
-  }
-  if (s.damping_scale != 1.0)
-    text += fmt::format("; substructure damping ×{}", g4(s.damping_scale));
-  return text;
-}
-
 // An interval as the report shows it: "[lo, hi]", or "undetermined" (never a number ± 0).
 std::string interval(double lo, double hi) {
   if (!(std::isfinite(lo) && std::isfinite(hi) && hi > lo)) return "undetermined";

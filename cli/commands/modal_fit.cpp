@@ -7,69 +7,19 @@
 #include "cli/common.hpp"
 #include "identify/measured_frfs.hpp"
 #include "io/files.hpp"
-#include "io/measured_frf_file.hpp"
+#include "io/low_level_test.hpp"
 #include "io/modal_fit_output.hpp"
-#include "io/record_csv.hpp"
-#include "io/uff58.hpp"
 #include "report/modal_fit_figure.hpp"
 
 #include <fmt/format.h>
 
 #include <cmath>
-#include <map>
-#include <variant>
 
 namespace jointid::cli {
 
 namespace {
 
 namespace fs = std::filesystem;
-
-enum class InputKind { csv_record, uff_record, frf };
-
-std::string_view trim(std::string_view s) {
-  const auto a = s.find_first_not_of(" \t\r");
-  if (a == std::string_view::npos) return {};
-  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
-
-// What a file holds: a universal file (first non-blank line "-1") of time responses or of FRFs;
-// a CSV file by its header's first column, `t` (a record) or `freq_hz` with NODE:DOF columns (an
-// FRF table). A stepped-sine table (`freq_hz` with channel columns) is refused.
-InputKind kind_of(const fs::path& path) {
-  const std::string text = io::read_file(path);
-  std::string_view rest = text;
-  if (rest.starts_with("\xEF\xBB\xBF")) rest.remove_prefix(3);
-  std::string_view first; // the first line that is neither blank nor a comment
-  bool universal = false, seen = false;
-  while (!rest.empty()) {
-    const auto end = rest.find('\n');
-    const std::string_view line = trim(rest.substr(0, end));
-    rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 1);
-    if (line.empty()) continue;
-    if (!seen && line == "-1") universal = true;
-    seen = true;
-    if (universal) break;
-    if (line.front() == '#') continue;
-    first = line;
-    break;
-  }
-  if (universal) {
-    const std::vector<io::Uff58Function> functions = io::read_uff58(path);
-    if (!functions.empty() &&
-        functions.front().function_type == io::uff_function_type::frequency_response)
-      return InputKind::frf;
-    return InputKind::uff_record; // uff58_tests says what it refuses
-  }
-  const std::string_view column = trim(first.substr(0, first.find(',')));
-  if (column != "freq_hz") return InputKind::csv_record; // read_record says what it refuses
-  if (first.find('@') != std::string_view::npos)
-    throw io::Error(path.string() +
-                    ": a stepped-sine table (freq_hz and channel columns such as f@7:uy.re): "
-                    "modal-fit reads time records (t, f@..., a@...) or FRF files (freq_hz and "
-                    "NODE:DOF.re, NODE:DOF.im columns, or universal files of FRFs)");
-  return InputKind::frf;
-}
 
 class ModalFit final : public Command {
 public:
@@ -131,79 +81,20 @@ private:
 void ModalFit::run() {
   // 1. The options.
   const auto [f0, f1] = parse_band("--band", band_);
-  if (modes_ < 0) throw io::Error(fmt::format("--modes: expected 0 or more, got {}", modes_));
-  if (max_order_ != 0 && max_order_ < 4)
-    throw io::Error(
-        fmt::format("--max-order: expected 0 (automatic) or at least 4, got {}", max_order_));
-  if (segment_ != 0 && segment_ < 8)
-    throw io::Error(
-        fmt::format("--segment: expected at least 8 samples (or 0: automatic), got {}", segment_));
-  if (!(std::isfinite(period_) && period_ >= 0.0))
-    throw io::Error(fmt::format("--period: expected seconds > 0, got {}", period_));
-  const identify::SpectraMethod method = spectra_ == "welch"     ? identify::SpectraMethod::welch
-                                         : spectra_ == "periods" ? identify::SpectraMethod::periods
-                                         : spectra_ == "whole"   ? identify::SpectraMethod::whole
-                                                               : identify::SpectraMethod::automatic;
-  if (segment_ != 0 && method != identify::SpectraMethod::welch &&
-      method != identify::SpectraMethod::automatic)
-    throw io::Error(fmt::format("--segment: only with --spectra welch or auto, not {}", spectra_));
-  if (period_ > 0.0 && method != identify::SpectraMethod::periods &&
-      method != identify::SpectraMethod::automatic)
-    throw io::Error(fmt::format("--period: only with --spectra periods or auto, not {}", spectra_));
+  const io::ModalFitArguments arguments{f0,       f1,       modes_,  max_order_,
+                                        spectra_, segment_, period_, true};
+  io::check_modal_fit_arguments(arguments);
   check_output_dir(output_dir_);
 
   // 2. The inputs: time records or FRF files, not both.
-  std::vector<identify::Record> records;
-  std::vector<fs::path> frf_files;
-  std::map<fs::path, std::string> seen;
-  for (const fs::path& path : inputs_) {
-    std::error_code ec;
-    fs::path key = fs::weakly_canonical(path, ec);
-    if (ec) key = path;
-    if (!seen.emplace(key, path.string()).second)
-      throw io::Error(path.string() + ": given twice (its blocks would count twice)");
-    const InputKind kind = kind_of(path);
-    if (kind == InputKind::frf) {
-      frf_files.push_back(path);
-    } else if (kind == InputKind::csv_record) {
-      records.push_back(io::read_record(path));
-    } else {
-      for (auto& test : io::uff58_tests(io::read_uff58(path), path))
-        records.push_back(std::get<identify::Record>(std::move(test)));
-    }
-  }
-  if (!records.empty() && !frf_files.empty())
-    throw io::Error(fmt::format("{} is a time record but {} holds FRFs: give modal-fit one or the "
-                                "other",
-                                records.front().source, frf_files.front().string()));
-  if (!frf_files.empty() && (segment_ != 0 || period_ > 0.0 || spectra_ != "auto"))
-    throw io::Error("--spectra, --segment, --period: for time records, not FRF files");
+  io::LowLevelTest test;
+  io::add_low_level_files(test, inputs_);
   const fs::path toml = output_dir_ / "substructure.toml", json = output_dir_ / "modal_fit.json";
   for (const fs::path& p : {toml, json, output_dir_ / "stabilisation.png", output_dir_ / "fit.png"})
     io::check_not_an_input(p);
 
   // 3. The FRFs and the fit.
-  identify::MeasuredFrfs data;
-  identify::ModalFit fit;
-  try {
-    if (!frf_files.empty()) {
-      data = identify::frfs_from_measured(io::read_measured_frf(frf_files), f0, f1);
-    } else {
-      identify::FrfEstimateOptions options;
-      options.f0_hz = f0;
-      options.f1_hz = f1;
-      options.method = method;
-      options.segment = segment_;
-      options.period_s = period_;
-      data = identify::frfs_from_records(records, options);
-    }
-    identify::ModalFitOptions options;
-    options.modes = modes_;
-    options.max_order = max_order_;
-    fit = identify::modal_fit(data, options);
-  } catch (const std::invalid_argument& e) {
-    throw io::Error(e.what()); // it names the record, the band or the channels
-  }
+  const auto [data, fit] = io::fit_low_level_test(test, arguments);
   require(fit.status.within("no substructure: "));
 
   // 4. Write: the model file and the JSON together, then the pictures.

@@ -9,7 +9,7 @@
     result.values["tip"]["k"], result.ci95["tip"]["k"], result.to_dict()
 
 Every call does what the command of the same name does (`jointid modes`, `frf`, `simulate`,
-`identify`, `discover`, `response`) and raises what it reports: jointid.Error (a ValueError)
+`identify`, `discover`, `response`, `modal-fit`) and raises what it reports: jointid.Error (a ValueError)
 with the command's message for bad input. Long calls release the GIL and stop on Ctrl-C
 (KeyboardInterrupt). See docs/python.md.
 """
@@ -18,6 +18,7 @@ from ._jointid import (
     DiscoveryResult,
     Error,
     IdentifyResult,
+    ModalFitResult,
     Model,
     Modes,
     Record,
@@ -27,6 +28,7 @@ from ._jointid import (
     __version__,
     discover,
     identify,
+    modal_fit,
     read_model,
     read_record,
     read_tests,
@@ -38,6 +40,7 @@ __all__ = [
     "DiscoveryResult",
     "Error",
     "IdentifyResult",
+    "ModalFitResult",
     "Model",
     "Modes",
     "Record",
@@ -47,6 +50,7 @@ __all__ = [
     "__version__",
     "discover",
     "identify",
+    "modal_fit",
     "read_model",
     "read_record",
     "read_tests",

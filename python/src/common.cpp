@@ -218,12 +218,12 @@ void check_amplitudes(const std::vector<double>& amplitudes) {
 // ---------------------------------------------------------------------------------------------
 // Tests.
 
-namespace {
-
 bool is_path(const py::handle& item) {
   return py::isinstance<py::str>(item) ||
          py::isinstance(item, py::module_::import("os").attr("PathLike"));
 }
+
+namespace {
 
 TestPtr wrap(identify::SineTest&& test) {
   if (std::holds_alternative<identify::Record>(test)) {

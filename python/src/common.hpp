@@ -159,6 +159,9 @@ using TestPtr = std::shared_ptr<Test>;
 struct Record : Test {};
 struct SteppedSineRow : Test {};
 
+/// A str or an os.PathLike.
+bool is_path(const py::handle& item);
+
 /// Records, stepped-sine rows and paths of files holding them (CSV records and tables,
 /// universal files) in a list, as the tests they are. Paths are read as `jointid identify`
 /// reads its TESTS (io::read_tests: a file given twice is refused).
@@ -177,5 +180,6 @@ void bind_records(py::module_& m);
 void bind_identify(py::module_& m);
 void bind_discover(py::module_& m);
 void bind_response(py::module_& m);
+void bind_modal_fit(py::module_& m);
 
 } // namespace jointid::python

@@ -29,4 +29,5 @@ PYBIND11_MODULE(_jointid, m) {
   bind_identify(m);
   bind_discover(m);
   bind_response(m);
+  bind_modal_fit(m);
 }

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 using namespace jointid;
 using joints::Term;
@@ -255,4 +256,78 @@ TEST(Design, AModalAnalysisThatFailsLeavesEveryCandidateOutWithTheReason) {
               std::string::npos)
         << c.reason;
   }
+}
+
+// The predicted bias is the mean error of repeated identifications. A friction joint that
+// sticks for part of each period (1 Hz, 10 N and 3 Hz, 20 N: TestsWhereFrictionSticksAreLeftOut)
+// has equations that miss at the true values — sign(ẏ) does not describe the stuck force — so
+// fit() is biased, by (Σ Iᵢ)⁻¹ Σ scoreᵢ to first order. Kept here (max_misfit infinite), the
+// tests are simulated by harmonic balance as the design predicts them and identified 60 times
+// with 0.1 % noise (at 1 %, the noise's own second-order bias of c and fc was as large as the
+// misfit's): the mean error of each term must have the predicted sign and lie within 25 % of the
+// predicted bias plus four standard errors of the mean (σ/√60). Measured: k 64.69 predicted,
+// 65.04 mean error; c −0.928, −0.921; fc 0.507, 0.506. Flipping the bias's sign or leaving out a
+// test's score fails.
+TEST(Design, PredictedBiasIsTheMeanErrorOfRepeatedIdentifications) {
+  const frf::Substructure sub(test::paper_cantilever());
+  const std::vector<joints::Joint> joints{
+      tip_joint({Term::k, Term::c, Term::fc}, {4800.0, 20.0, 3.0})};
+  const std::vector<identify::SineTestPlan> plans{
+      {1.0, 10.0}, {3.0, 20.0}, {5.0, 40.0}, {19.0, 80.0}};
+  identify::DesignOptions d;
+  d.harmonics = {1, 2, 3};
+  d.noise = 1e-3;
+  d.periods = 8;
+  d.samples_per_period = 256;
+  d.max_misfit = std::numeric_limits<double>::infinity();
+  const auto candidates = identify::predict_candidates(sub, joints, tip, plans, d);
+  std::vector<int> all;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    ASSERT_TRUE(candidates[i].usable) << candidates[i].reason;
+    all.push_back(static_cast<int>(i));
+  }
+  const Eigen::VectorXd bias = identify::predicted_bias(candidates, all);
+  const Eigen::VectorXd std = identify::predicted_std(candidates, all);
+  ASSERT_TRUE(bias.allFinite());
+
+  identify::SimulationOptions so;
+  so.method = identify::SimulationMethod::harmonic_balance;
+  so.periods = d.periods;
+  so.steps_per_period = d.samples_per_period;
+  so.balance = d.balance;
+  const auto clean = identify::simulate_sine_tests(sub, joints, tip, plans, so);
+  identify::FitOptions fo;
+  fo.harmonics = d.harmonics;
+  constexpr int reps = 60;
+  const auto nu = bias.size();
+  Eigen::VectorXd mean_error = Eigen::VectorXd::Zero(nu);
+  for (int r = 0; r < reps; ++r) {
+    std::vector<identify::SineTest> tests;
+    for (std::size_t i = 0; i < clean.size(); ++i) {
+      identify::Record rec = clean[i].record;
+      identify::add_noise(rec, d.noise, 104729ull * static_cast<unsigned long long>(r) + i);
+      tests.emplace_back(std::move(rec));
+    }
+    const identify::FitResult fit =
+        identify::fit(sub, joints, identify::measure(tests, identify::measure_options(fo)), fo);
+    ASSERT_TRUE(fit.status.ok()) << fit.status.reason;
+    for (Eigen::Index u = 0; u < nu; ++u)
+      mean_error(u) += (fit.joints[0].terms[static_cast<std::size_t>(u)].value -
+                        joints[0].values[static_cast<std::size_t>(u)]) /
+                       reps;
+  }
+  int significant = 0;
+  for (Eigen::Index u = 0; u < nu; ++u) {
+    const std::string name(joints::term_name(joints[0].terms[static_cast<std::size_t>(u)]));
+    const double standard_error = std(u) / std::sqrt(static_cast<double>(reps));
+    std::printf("  %-3s predicted bias %.4g, mean error %.4g (standard error %.3g)\n", name.c_str(),
+                bias(u), mean_error(u), standard_error);
+    EXPECT_LE(std::abs(mean_error(u) - bias(u)), 0.25 * std::abs(bias(u)) + 4.0 * standard_error)
+        << name;
+    if (std::abs(bias(u)) > 8.0 * standard_error) {
+      ++significant;
+      EXPECT_GT(mean_error(u) * bias(u), 0.0) << name << ": the bias has the wrong sign";
+    }
+  }
+  EXPECT_GE(significant, 1) << "no term is biased beyond the scatter: the test would not fail";
 }
