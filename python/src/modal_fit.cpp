@@ -30,6 +30,14 @@ py::array complex_array(const Eigen::MatrixXcd& m) {
   return a;
 }
 
+// One number of every mode, in frequency order.
+std::vector<double> per_mode(const ModalFitResult& self, double identify::FittedMode::*field) {
+  std::vector<double> out;
+  for (const auto& mode : self.result.fit.modes)
+    out.push_back(mode.*field);
+  return out;
+}
+
 // The comment lines of substructure.toml, as `jointid modal-fit` writes them.
 std::vector<std::string> comments(const ModalFitResult& self) {
   std::string sources;
@@ -90,20 +98,12 @@ void bind_modal_fit(py::module_& m) {
       .def_property_readonly(
           "frequencies_hz",
           [](const R& self) {
-            std::vector<double> f;
-            for (const auto& mode : self.result.fit.modes)
-              f.push_back(mode.frequency_hz);
-            return to_numpy(f);
+            return to_numpy(per_mode(self, &identify::FittedMode::frequency_hz));
           },
           "The modes' undamped natural frequencies (Hz), increasing.")
       .def_property_readonly(
           "damping",
-          [](const R& self) {
-            std::vector<double> z;
-            for (const auto& mode : self.result.fit.modes)
-              z.push_back(mode.damping);
-            return to_numpy(z);
-          },
+          [](const R& self) { return to_numpy(per_mode(self, &identify::FittedMode::damping)); },
           "The modes' damping ratios ζ.")
       .def_property_readonly(
           "in_model",
