@@ -31,6 +31,20 @@ std::vector<joints::Joint> model_I() {
   return {tip_joint({Term::k, Term::c, Term::c2, Term::k3}, {4800.0, 20.0, 500.0, 1.6e8})};
 }
 
+// fit() on the clean records with fresh noise: test i with seed `seed` + i.
+identify::FitResult noisy_fit(const frf::Substructure& sub,
+                              const std::vector<joints::Joint>& joints,
+                              const std::vector<identify::SimulatedTest>& clean, double noise,
+                              unsigned long long seed, const identify::FitOptions& fo) {
+  std::vector<identify::SineTest> tests;
+  for (std::size_t i = 0; i < clean.size(); ++i) {
+    identify::Record rec = clean[i].record;
+    identify::add_noise(rec, noise, seed + i);
+    tests.emplace_back(std::move(rec));
+  }
+  return identify::fit(sub, joints, identify::measure(tests, identify::measure_options(fo)), fo);
+}
+
 } // namespace
 
 // The predicted standard deviation of every term is the scatter of the estimates over noisy
@@ -68,14 +82,8 @@ TEST(Design, PredictedStdIsTheMonteCarloScatter) {
   const auto nu = predicted.size();
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(nu), square = sum, reported = sum;
   for (int r = 0; r < reps; ++r) {
-    std::vector<identify::SineTest> tests;
-    for (std::size_t i = 0; i < clean.size(); ++i) {
-      identify::Record rec = clean[i].record;
-      identify::add_noise(rec, d.noise, 7919ull * static_cast<unsigned long long>(r) + i);
-      tests.emplace_back(std::move(rec));
-    }
     const identify::FitResult fit =
-        identify::fit(sub, joints, identify::measure(tests, identify::measure_options(fo)), fo);
+        noisy_fit(sub, joints, clean, d.noise, 7919ull * static_cast<unsigned long long>(r), fo);
     for (Eigen::Index u = 0; u < nu; ++u) {
       const double v = fit.joints[0].terms[static_cast<std::size_t>(u)].value;
       sum(u) += v / reps;
@@ -302,14 +310,8 @@ TEST(Design, PredictedBiasIsTheMeanErrorOfRepeatedIdentifications) {
   const auto nu = bias.size();
   Eigen::VectorXd mean_error = Eigen::VectorXd::Zero(nu);
   for (int r = 0; r < reps; ++r) {
-    std::vector<identify::SineTest> tests;
-    for (std::size_t i = 0; i < clean.size(); ++i) {
-      identify::Record rec = clean[i].record;
-      identify::add_noise(rec, d.noise, 104729ull * static_cast<unsigned long long>(r) + i);
-      tests.emplace_back(std::move(rec));
-    }
     const identify::FitResult fit =
-        identify::fit(sub, joints, identify::measure(tests, identify::measure_options(fo)), fo);
+        noisy_fit(sub, joints, clean, d.noise, 104729ull * static_cast<unsigned long long>(r), fo);
     ASSERT_TRUE(fit.status.ok()) << fit.status.reason;
     for (Eigen::Index u = 0; u < nu; ++u)
       mean_error(u) += (fit.joints[0].terms[static_cast<std::size_t>(u)].value -
