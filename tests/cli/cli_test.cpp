@@ -2493,11 +2493,17 @@ TEST_F(SteppedSineCli, ATestTheModelCannotReSimulateIsLeftOutAndNamed) {
                              (dir() / "no_time").string()});
     expect_one_line_error(jointid(hb, dir()), "no periodic solution found");
     expect_one_line_error(jointid(time, dir()), "the joints' Newton iteration failed");
-    // It is compared with nothing.
+    // It is compared with nothing: what its solve left is not written as a simulated response.
+    int comparisons = 0;
     for (const auto& c : j["comparisons"]["start"])
       if (c["test"] == s) {
+        ++comparisons;
         EXPECT_FALSE(c["converged"].get<bool>());
+        EXPECT_TRUE(c["simulated"][0].is_null() && c["simulated"][1].is_null()) << c.dump();
+        EXPECT_TRUE(c["amplitude_error"].is_null()) << c.dump();
+        EXPECT_TRUE(c["measured"][0].is_number()) << c.dump();
       }
+    EXPECT_EQ(comparisons, 1); // one channel
   }
   const std::string warning =
       "the re-simulation of " + std::to_string(left_out.size()) +
