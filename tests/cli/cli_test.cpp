@@ -2569,27 +2569,13 @@ TEST_F(SteppedSineCli, AnUndeterminedIntervalIsFlaggedNeverWrittenAsAResult) {
 // reduced by identify to stepped-sine rows, the joint's values identified.
 TEST_F(CliTest, IdentifyTakesASineSweepRecord) {
   const fs::path data = dir() / "sweep", result = dir() / "sweep.json";
-  const Outcome sim = jointid({"simulate",
-                               model().string(),
-                               "--excitation",
-                               "sweep",
-                               "--force",
-                               "7:uy",
-                               "--band",
-                               "2:6",
-                               "--amplitude",
-                               "40",
-                               "--duration",
-                               "200",
-                               "--sample-rate",
-                               "200",
-                               "--channels",
-                               "a",
-                               "--noise",
-                               "0.01",
-                               "-o",
-                               data.string()},
-                              dir());
+  // 2 → 6 Hz in 200 s (0.02 Hz/s) at 40 N, sampled at 200 Hz, acceleration at the tip.
+  std::vector<std::string> args{
+      "simulate", model().string(), "--excitation", "sweep",       "--force",
+      "7:uy",     "--band",         "2:6",          "--amplitude", "40"};
+  args.insert(args.end(), {"--duration", "200", "--sample-rate", "200", "--channels", "a",
+                           "--noise", "0.01", "-o", data.string()});
+  const Outcome sim = jointid(args, dir());
   ASSERT_EQ(sim.status, 0) << sim.err;
   const fs::path record = data / "sweep_2-6Hz_40N.csv";
   ASSERT_TRUE(fs::exists(record));
