@@ -169,9 +169,10 @@ struct Step {
   std::string finding;            ///< one sentence
 };
 
-/// The fundamental of one test at one channel, measured and simulated (a periodic test: its
-/// excited line where the measured response is largest, and as "harmonics" the lines where only
-/// the joints put response, over the excited lines).
+/// The fundamental of one test at one channel, measured and simulated; a periodic test has one
+/// per excited line (its FRF over them: frequency_hz and force_phasor the line's; force the
+/// test's level, identify::force_level), and as "harmonics" the lines where only the joints put
+/// response, over the excited lines.
 struct Comparison {
   std::string test, channel;
   double frequency_hz = 0.0, force = 0.0;

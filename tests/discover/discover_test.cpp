@@ -582,6 +582,10 @@ TEST(Discover, PeriodicMultisineTestsNameAHiddenCubicStiffness) {
   EXPECT_EQ(r.diagnosis.joint, "tip");
   EXPECT_EQ(r.diagnosis.nature, "conservative");
   EXPECT_TRUE(r.curves.empty() || r.curves.back().empty()); // no sine sweep through a multisine
+  // The report's comparisons: every excited line of every test (its FRF over them).
+  ASSERT_EQ(r.comparisons.back().size(), tests.size() * 13);
+  EXPECT_EQ(r.comparisons.back()[0].frequency_hz, 1.0);
+  EXPECT_EQ(r.comparisons.back()[0].measured, tests[0].X(4, 0));
 }
 
 // A periodic test re-simulated through measured FRFs needs them to twice line max(K, 10) × its
