@@ -194,18 +194,21 @@ TEST(IdentifyParametric, RefusesWhatOutputErrorCannotTake) {
   fs::create_directories(records);
   const fs::path record = records / "r.csv"; // never read: the model is refused first
   test::write_text(record, "t,f@7:uy,x@7:uy\n0,0,0\n");
-  // Without --output-error a non-fixed parametric term is named with what it needs. The joint
-  // starts on line 42 of the model file (cantilever_toml's 41 lines before it).
+  // Without --output-error a non-fixed parametric term is named with what it needs, at the
+  // line of its [[joints]] table.
   const std::string jenkins = "terms = [\"k\", \"c\", \"jenkins\"]\n";
+  const std::string text = cantilever_with(jenkins);
+  const auto line = std::count(text.begin(), text.begin() + text.find("[[joints]]"), '\n') + 1;
+  const std::string at = (dir.path() / "unknown.toml").string() + ":" + std::to_string(line) + ":";
   const Outcome plain = identify(dir.path(), jenkins, {record.string()}, false);
-  expect_one_line_error(plain, (dir.path() / "unknown.toml").string() + ":");
+  expect_one_line_error(plain, at);
   expect_one_line_error(plain, "joint 'tip': term 'jenkins' is not fixed: its parameters (kt, "
                                "fs) enter the joint's force non-linearly and need --output-error");
   EXPECT_FALSE(fs::exists(dir.path() / "result.json"));
   // Two parametric terms not fixed at one joint: output error takes one at a time.
   const Outcome two =
       identify(dir.path(), "terms = [\"k\", \"jenkins\", \"gap\"]\n", {record.string()});
-  expect_one_line_error(two, (dir.path() / "unknown.toml").string() + ":");
+  expect_one_line_error(two, at);
   expect_one_line_error(two, "joint 'tip': its terms jenkins and gap both have parameters that "
                              "are not fixed; output error identifies one parametric term of a "
                              "joint at a time");
