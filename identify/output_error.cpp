@@ -237,7 +237,13 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     Eigen::MatrixXcd F = t.F;
     for (Eigen::Index c = 0; c < F.cols(); ++c)
       F(1, c) = Complex(th(at + 2 * c), th(at + 2 * c + 1));
-    const frf::HarmonicBalanceResult r = t.balance->solve(js, F, t.Y.size() > 0 ? &t.Y : nullptr);
+    frf::HarmonicBalanceResult r;
+    try { // a step may take a parameter out of its range (fs → 0 by underflow): not a point
+      r = t.balance->solve(js, F, t.Y.size() > 0 ? &t.Y : nullptr);
+    } catch (const std::invalid_argument& e) {
+      failure = fem::Status::failure(fem::Status::Code::not_converging, e.what());
+      return std::nullopt;
+    }
     if (!r.status.ok()) {
       failure = r.status;
       return std::nullopt;

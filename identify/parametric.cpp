@@ -342,6 +342,27 @@ DescribingFunctionStart describing_function_start(const frf::Substructure& sub,
                             info[q].name, P.value);
     }
     if (!out[jj].given.empty()) out[jj].given[T] = true;
+    try { // the fit may run a parameter out of its range (fs → 0: the term vanishes)
+      joints::check_parameters(out[jj]);
+    } catch (const std::invalid_argument& e) {
+      const double change = (hi.Z.real() - lo.Z.real()) / std::max(std::abs(lo.Z), 1e-300);
+      start.status = fem::Status::failure(
+          fem::Status::Code::not_converging,
+          fmt::format("{}: the fit left the parameters' range ({}; {}): over the tests' "
+                      "deformation amplitudes {:.3g} … {:.3g} the joint's equivalent stiffness "
+                      "changes by {:.2g} % — the tests may not reach its {} (deformation beyond "
+                      "{}): add tests at larger forces, or give the term's parameters and fix "
+                      "them",
+                      what, e.what(), values, lo.amplitude, hi.amplitude, 100.0 * change,
+                      term == joints::Term::gap       ? "contact"
+                      : term == joints::Term::jenkins ? "slip"
+                                                      : "macroslip",
+                      term == joints::Term::gap       ? "delta"
+                      : term == joints::Term::jenkins ? "fs/kt"
+                                                      : "phi_max"));
+      start.joints = joints;
+      return start;
+    }
     notes.push_back(fmt::format(
         "joint '{}': {} started from a describing-function fit of the equivalent stiffness and "
         "damping of {} test(s) at deformation amplitudes {:.3g} … {:.3g} (relative misfit "
