@@ -35,12 +35,13 @@ EvenHarmonics disagreement(Diagnosis& d, const Compared& compared,
   for (const auto& e : compared.entries) {
     const auto& m = tests[e.test];
     const std::string ch = channel_name(m, e.response);
-    const Complex err = e.measured - s.X[e.test](e.harmonic, e.response);
+    const Complex err = e.measured - s.X[e.test](e.row, e.response);
     per_channel[ch].first += std::norm(err);
     per_channel[ch].second += std::norm(e.measured);
     // The second harmonic (a mean displacement can also come from a sensor's offset or a
-    // friction joint's memory of where it stuck).
-    if (e.harmonic == 2) {
+    // friction joint's memory of where it stuck). A periodic test's lines are not harmonics of
+    // one fundamental: they say nothing of even harmonics.
+    if (e.harmonic == 2 && !e.line) {
       const double x1 = std::abs(m.X(1, e.response));
       const double ratio = std::abs(err) / std::max(x1, 1e-300);
       const double noise = e.variance > 0.0 ? std::sqrt(e.variance) / std::max(x1, 1e-300) : 0.0;
@@ -240,8 +241,13 @@ Diagnosis diagnose(const Compared& compared, const std::vector<identify::Measure
   Diagnosis d;
   const EvenHarmonics even = disagreement(d, compared, tests, s);
   d.even_content = even.content;
-  const bool any_harmonics =
-      std::any_of(tests.begin(), tests.end(), [](const auto& m) { return !m.fundamental_only; });
+  // Harmonics of one excitation frequency: a sine test's (a periodic test's lines are not).
+  const bool any_harmonics = std::any_of(tests.begin(), tests.end(), [](const auto& m) {
+    return !m.fundamental_only && m.kind != identify::RecordKind::periodic;
+  });
+  const bool any_periodic = std::any_of(tests.begin(), tests.end(), [](const auto& m) {
+    return m.kind == identify::RecordKind::periodic;
+  });
   d.even_harmonics = any_harmonics && even.content > 5.0 * even.noise &&
                      (compared.noise_known || even.content > 1e-3);
   const Families f = families(ranking);
@@ -303,6 +309,10 @@ Diagnosis diagnose(const Compared& compared, const std::vector<identify::Measure
     even_finding(d, even, ranking, tests.size(), compared.noise_known);
   else if (any_harmonics)
     d.findings.push_back("No even harmonics beyond the noise: the missing force is symmetric.");
+  else if (any_periodic)
+    d.findings.push_back("The periodic tests' lines are not harmonics of one frequency: even "
+                         "harmonics are not judged apart (the even terms are candidates as the "
+                         "others are).");
   else
     d.findings.push_back("The tables give the fundamental only: harmonics cannot be judged.");
   return d;
@@ -316,6 +326,10 @@ std::vector<std::string> level_evidence(const std::vector<identify::Measurement>
   for (std::size_t a = 0; a < tests.size(); ++a)
     for (std::size_t b = a + 1; b < tests.size(); ++b) {
       const auto &ta = tests[a], &tb = tests[b];
+      // A periodic test's lines are compared in the gap; a receptance at one frequency is a
+      // sine test's.
+      if (ta.kind == identify::RecordKind::periodic || tb.kind == identify::RecordKind::periodic)
+        continue;
       if (std::abs(ta.frequency_hz - tb.frequency_hz) > 0.005 * ta.frequency_hz) continue;
       const double Fa = identify::force_level(ta), Fb = identify::force_level(tb);
       if (std::max(Fa, Fb) < 1.5 * std::min(Fa, Fb) || ta.force_at.empty() || tb.force_at.empty())

@@ -346,16 +346,6 @@ Result discover(const frf::Substructure& substructure, const std::vector<joints:
                                   "' is not a candidate: the terms with named parameters (" +
                                   "jenkins, iwan, gap) are simulated, and may be held fixed in "
                                   "the model, but are not yet discovered");
-  // A periodic broadband test would need a harmonic balance over every line of its period (or a
-  // time integration per candidate): not supported, said with the test's name.
-  for (const auto& m : tests)
-    if (m.kind == identify::RecordKind::periodic)
-      throw std::invalid_argument(
-          m.source + ": a periodic broadband test (lines every " +
-          fmt::format("{:.6g}", m.frequency_hz) +
-          " Hz): discover re-simulates each test by the harmonic balance of one excitation "
-          "frequency, which this test is not; give discover sine tests, stepped-sine tables or "
-          "sweeps (jointid identify takes periodic records)");
   // Tests left out (too few steady periods) are passed over, with their reason.
   std::vector<std::string> left_out;
   const std::vector<identify::Measurement> kept = identify::usable(tests, left_out);

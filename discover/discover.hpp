@@ -10,6 +10,16 @@
 ///
 ///     gap = sqrt( Σ |X_meas − X_sim|² / Σ |X_meas|² )       (sums over tests, channels, k)
 ///
+/// A periodic broadband test (a multisine; identify/periodic.hpp) is compared at its lines
+/// (Measurement::lines: the excited lines in the band and those where the joints put response
+/// out of the noise), its noise per line from the scatter of its periods. It is re-simulated by
+/// the harmonic balance at its line spacing 1/T, driven by the measured force at the lines that
+/// drive it (its excited lines, and any other out of the force's noise), to its highest line or
+/// max(K, 10) times its highest driven line where that is higher (K the largest harmonic
+/// compared: the joints' harmonics and combinations); the simulation's error from twice that.
+/// Its "harmonics" judged on their own (the stop rule's χ² per harmonic) are two groups: the
+/// excited lines, and the others.
+///
 /// The noise level is what a perfect model would leave: the same formula with the variance of
 /// each measured harmonic (identify::measure estimates it from the record itself) plus that of
 /// the measured force's noise propagated through the model; it is unknown for stepped-sine
@@ -159,11 +169,14 @@ struct Step {
   std::string finding;            ///< one sentence
 };
 
-/// The fundamental of one test at one channel, measured and simulated.
+/// The fundamental of one test at one channel, measured and simulated; a periodic test has one
+/// per excited line (its FRF over them: frequency_hz and force_phasor the line's; force the
+/// test's level, identify::force_level), and as "harmonics" the lines where only the joints put
+/// response, over the excited lines.
 struct Comparison {
   std::string test, channel;
   double frequency_hz = 0.0, force = 0.0;
-  std::complex<double> force_phasor;        ///< F_1 of its (first) force channel, N or N·m
+  std::complex<double> force_phasor;        ///< F_1 (or the line's) of its first force, N or N·m
   std::complex<double> measured, simulated; ///< X_1, m or rad
   double amplitude_error = 0.0;             ///< |X_sim| / |X_meas| − 1
   double phase_error_deg = 0.0;             ///< arg(X_sim / X_meas)

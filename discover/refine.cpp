@@ -164,7 +164,7 @@ private:
     for (std::size_t i = 0; i < compared_.entries.size(); ++i) {
       const auto& e = compared_.entries[i];
       if (std::binary_search(left_out_.begin(), left_out_.end(), e.test)) continue;
-      const Complex err = e.measured - st.X[e.test](e.harmonic, e.response);
+      const Complex err = e.measured - st.X[e.test](e.row, e.response);
       r(n++) = weight_[i] * err.real();
       if (e.harmonic != 0) r(n++) = weight_[i] * err.imag();
     }

@@ -274,7 +274,7 @@ CrossValidation cross_validated(Problem& problem, const std::vector<joints::Join
         const frf::HarmonicBalanceResult r = problem.solve(sim, i, fitted);
         for (const auto& e : compared.entries) // a failed prediction counts as predicting nothing
           if (e.test == i) {
-            part.squared += r.status.ok() ? std::norm(e.measured - r.X(e.harmonic, e.response))
+            part.squared += r.status.ok() ? std::norm(e.measured - r.X(e.row, e.response))
                                           : std::norm(e.measured);
             part.measured2 += std::norm(e.measured);
           }

@@ -114,6 +114,11 @@ public:
                     "Leave out candidates whose equations, at the model's values, miss by more "
                     "than this many noise standard deviations (e.g. where a friction joint sticks)")
         ->capture_default_str();
+    app()
+        .add_option("--excitation", excitation_,
+                    "Kind of candidate test: sine (multisine candidates are not designed yet: "
+                    "refused, saying why)")
+        ->capture_default_str();
     add_output_dir();
     add_engine();
   }
@@ -129,10 +134,22 @@ private:
   std::vector<std::string> frequencies_; ///< Hz: values or ranges F0:STEP:F1
   std::vector<std::string> amplitudes_;  ///< N or N·m (peak): values or ranges A0:STEP:A1
   int count_ = 10;                       ///< tests to choose
+  std::string excitation_ = "sine";      ///< the candidates' kind (only sine is designed)
   identify::DesignOptions options_;      ///< the library's defaults
 };
 
 void Design::check_options() const {
+  // Periodic broadband candidates would need each multisine's prediction at all its lines and
+  // the information of its lines (noise per line from the period scatter): not there yet.
+  if (excitation_ == "multisine" || excitation_ == "periodic")
+    throw io::Error(
+        "--excitation multisine: design chooses sine tests only; multisine candidates (a band "
+        "and RMS levels) are not designed yet: their prediction would be a harmonic balance at "
+        "every line of the period and their information that of every line, which design does "
+        "not compute. Design sine tests, or run multisine tests at a few levels and let "
+        "identify's intervals say what they determine");
+  if (excitation_ != "sine")
+    throw io::Error(fmt::format("--excitation: expected sine, got \"{}\"", excitation_));
   check_harmonics(options_.harmonics, 0);
   if (count_ < 1) throw io::Error(fmt::format("-n: expected at least 1 test, got {}", count_));
   if (!(options_.noise > 0.0 && options_.noise < 1.0))

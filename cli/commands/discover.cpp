@@ -32,7 +32,13 @@ public:
         .add_option("TESTS", records_, "Measurement records or stepped-sine tables (CSV)")
         ->required();
     add_output_dir();
-    add_harmonics(options_.harmonics, "Harmonics used in the fits; 0 to the largest are compared");
+    add_harmonics(options_.harmonics,
+                  "Harmonics used in the fits; 0 to the largest are compared (a periodic test: "
+                  "its lines where a response stands out of the noise, up to the largest of "
+                  "these times the highest excited line)");
+    app().add_option("--band", band_,
+                     "F0:F1 in Hz: a periodic test's excited lines used (default: all); its other "
+                     "lines from F0 up");
     add_balance_harmonics(options_.balance.harmonics,
                           "Harmonics 0 … K of the harmonic-balance re-simulations");
     app().add_option("--max-steps", options_.max_steps, "Most terms added")->capture_default_str();
@@ -60,6 +66,7 @@ private:
   std::vector<fs::path> records_;
   discover::Options options_; ///< the library's defaults
   std::vector<std::string> terms_;
+  std::string band_; ///< F0:F1, Hz; empty: every line
 };
 
 void Discover::run() {
@@ -88,6 +95,9 @@ void Discover::run() {
             }()));
     }
   }
+  identify::MeasureOptions measure{.harmonics = K};
+  if (!band_.empty())
+    std::tie(measure.band_from_hz, measure.band_to_hz) = parse_band("--band", band_);
   check_output_dir(output_dir_);
 
   // 2. The inputs.
@@ -98,7 +108,7 @@ void Discover::run() {
   const std::vector<identify::SineTest> tests = io::read_tests(records_);
   for (const char* name : {"discovery.json", "report.md"})
     io::check_not_an_input(output_dir_ / name);
-  const std::vector<identify::Measurement> measured = identify::measure(tests, {.harmonics = K});
+  const std::vector<identify::Measurement> measured = identify::measure(tests, measure);
 
   // 3. Discover.
   const discover::Result result =
