@@ -2400,6 +2400,91 @@ TEST_F(ModalFitCli, BadInputsAreRefusedAndNothingIsWritten) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST_F(CliTest, BackboneWritesTheContractWithTheMeasuredLevels) {
+  // The README's hardening cantilever (k3 at the tip): mode 1's frequency rises with the
+  // amplitude from the linear mode's (the physics is tested in frf/backbone_test.cpp and
+  // identify/one_mode_fit_test.cpp; here the command and its JSON contract). Then a stepped-sine
+  // table from `simulate --method hb --table` at one small force level, over the linear mode's
+  // half-power band, gives the measured level: near the linear mode.
+  const fs::path model =
+      fs::path(JOINTID_SOURCE_DIR) / "examples" / "response" / "hardening_tip.toml";
+  const fs::path out = dir() / "backbone";
+  const Outcome run = jointid({"backbone", model.string(), "--mode", "1", "--amplitude-range",
+                               "1e-4:1e-2", "--points", "8", "--no-plot", "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_FALSE(fs::exists(out / "backbone.png"));
+  const json j = json::parse(test::read_text(out / "backbone.json"));
+  EXPECT_EQ(j.at("mode").get<int>(), 1);
+  EXPECT_EQ(j.at("amplitude").at("dof").get<std::string>(), "7:uy");
+  EXPECT_EQ(j.at("amplitude").at("unit").get<std::string>(), "m");
+  EXPECT_EQ(j.at("status").get<std::string>(), "ok");
+  const double f0 = j.at("linear").at("frequency_hz").get<double>();
+  const double D0 = j.at("linear").at("damping_ratio").get<double>();
+  const json& points = j.at("points");
+  ASSERT_EQ(points.size(), 8u);
+  EXPECT_NEAR(points.front().at("amplitude").get<double>(), 1e-4,
+              1e-6); // within the shape's change
+  EXPECT_NEAR(points.front().at("frequency_hz").get<double>(), f0, 1e-3 * f0);
+  EXPECT_GT(points.back().at("frequency_hz").get<double>(), 1.1 * f0); // hardening
+  EXPECT_TRUE(j.at("measured").empty());
+
+  std::string freqs;
+  for (int i = -4; i <= 4; ++i) {
+    if (!freqs.empty()) freqs += ',';
+    freqs += std::to_string(f0 * (1.0 + 0.25 * i * D0));
+  }
+  const fs::path level = dir() / "backbone_level";
+  const Outcome sim =
+      jointid({"simulate", model.string(), "--force", "7:uy", "--freq", freqs, "--amplitude",
+               "0.01", "--method", "hb", "--table", "-o", level.string()},
+              dir());
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const fs::path with = dir() / "backbone_measured";
+  const Outcome measured =
+      jointid({"backbone", model.string(), "--mode", "1", "--tables",
+               (level / "stepped_sine.csv").string(), "--no-plot", "-o", with.string()},
+              dir());
+  ASSERT_EQ(measured.status, 0) << measured.err;
+  const json m = json::parse(test::read_text(with / "backbone.json"));
+  ASSERT_EQ(m.at("measured").size(), 1u);
+  const json& l = m["measured"][0];
+  EXPECT_EQ(l.at("status").get<std::string>(), "ok");
+  EXPECT_NEAR(l.at("force_amplitude").get<double>(), 0.01, 1e-12);
+  EXPECT_NEAR(l.at("frequency_hz").get<double>(), f0, 2e-3 * f0);
+  // The range from the level: its amplitude widened 3 times either way.
+  const double a = l.at("amplitude").get<double>();
+  EXPECT_NEAR(m.at("points").front().at("amplitude").get<double>(), a / 3.0, 0.01 * a);
+}
+
+TEST_F(CliTest, BackboneRefusesBadInput) {
+  const fs::path model =
+      fs::path(JOINTID_SOURCE_DIR) / "examples" / "response" / "hardening_tip.toml";
+  const fs::path out = dir() / "backbone_bad";
+  auto run = [&](const std::vector<std::string>& extra) {
+    std::vector<std::string> args{"backbone", model.string(), "--no-plot", "-o", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return jointid(args, dir());
+  };
+  expect_one_line_error(run({"--mode", "40", "--amplitude-range", "1e-4:1e-2"}),
+                        "mode 40 is out of range");
+  expect_one_line_error(run({"--mode", "0", "--amplitude-range", "1e-4:1e-2"}), "--mode");
+  expect_one_line_error(run({"--mode", "1"}), "--amplitude-range: required without --tables");
+  expect_one_line_error(run({"--mode", "1", "--amplitude-range", "1e-2:1e-4"}), "0 < A0 < A1");
+  expect_one_line_error(run({"--mode", "1", "--tables", model.string()}), model.string());
+  EXPECT_FALSE(fs::exists(out));
+  // No joints: the cantilever alone.
+  const fs::path linear = dir() / "backbone_linear.toml";
+  std::string text = test::read_text(model);
+  text = text.substr(0, text.find("[[joints]]"));
+  test::write_text(linear, text);
+  expect_one_line_error(jointid({"backbone", linear.string(), "--mode", "1", "--amplitude-range",
+                                 "1e-4:1e-2", "--no-plot", "-o", out.string()},
+                                dir()),
+                        "no [[joints]]");
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // A number as a command line would give it (3, 2.5).
 std::string shortest(double v) {
   std::ostringstream s;
