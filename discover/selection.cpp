@@ -112,6 +112,7 @@ void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::s
     if (je.name == joint)
       for (const auto& te : je.terms)
         if (te.term == term) {
+          candidate.parameters = te.parameters;
           candidate.value = te.value;
           candidate.std = te.std;
           candidate.ci_low = te.ci_low;
@@ -129,6 +130,13 @@ void judge(Candidate& candidate, const State& state) {
 }
 
 std::string interval_problem(const Candidate& candidate) {
+  // A parametric term: its parameters are in their ranges by construction (identify/
+  // parametric.hpp); what the tests leave undetermined is said, not held against it, as long
+  // as they determine some of it (the criterion and cross-validation judge whether it matters).
+  if (candidate.term && joints::has_parameters(*candidate.term)) {
+    if (candidate.determined()) return {};
+    return "not determined: the tests determine none of its parameters (no 95 % interval)";
+  }
   const double none = candidate.term ? 0.0 : 1.0;
   if (!std::isfinite(candidate.ci_low) || !std::isfinite(candidate.ci_high))
     return "not determined: its 95 % interval could not be estimated";
@@ -220,6 +228,7 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
   std::vector<std::size_t> out;
   for (std::size_t i : by)
     if (std::isfinite(ranking[i].criterion) && !ranking[i].varies &&
+        !(ranking[i].term && joints::has_parameters(*ranking[i].term)) &&
         out.size() < static_cast<std::size_t>(count))
       out.push_back(i);
   return out;

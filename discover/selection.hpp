@@ -102,7 +102,7 @@ Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& o
               const std::function<CrossValidation(std::size_t)>& cv_of);
 
 /// The candidates refined by output error: the best `count` by the criterion among those with a
-/// finite criterion, converged, and not varying per test.
+/// finite criterion, converged, not varying per test, and not parametric (refined already).
 std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int count);
 
 // Cross-validation.

@@ -36,6 +36,22 @@ double joint_amplitude(const Measurement& m, const joints::Joint& joint);
 double parameter_to_u(const joints::ParameterInfo& info, double p);
 double parameter_from_u(const joints::ParameterInfo& info, double u);
 
+/// One test's equivalent dynamic stiffness of a joint: Z = k_eq + iω c_eq of the linear spring
+/// and damper that reproduce its force's fundamental at the amplitude of its deformation's (m),
+/// ω in rad/s. π a² Im Z is the joint's dissipation per cycle there (J).
+struct EquivalentStiffness {
+  double amplitude = 0.0, omega = 0.0;
+  std::complex<double> Z;
+};
+
+/// Step 2 alone: term `term` of `joint` (its fixed parameters held) fitted to the points, with
+/// the joint's own k and c (`k_open`, `c_open`) taken by least squares. Returns the joint with the
+/// term's parameters set (given, not fixed); `note` gets the line describing_function_start()
+/// adds. Throws std::invalid_argument naming the joint when there are no points or no start fits.
+joints::Joint fit_describing_function(const joints::Joint& joint, std::size_t term,
+                                      std::vector<EquivalentStiffness> points, bool k_open,
+                                      bool c_open, std::string& note);
+
 /// The joints with every non-fixed parameter of a parametric term set (given, not fixed) to its
 /// describing-function estimate; `notes` gets one line per term (the amplitudes used, the
 /// relative misfit). At most one non-fixed parametric term per joint. Throws
