@@ -1,7 +1,6 @@
 #include "discover/candidates.hpp"
 
 #include "discover/diagnosis.hpp"
-#include "discover/refine.hpp"
 #include "discover/selection.hpp"
 #include "fem/minimise.hpp"
 #include "identify/parametric.hpp"
@@ -120,8 +119,13 @@ Outcome consider_parametric(const Problem& problem, const State& state, const Si
     joints = fit.identified(joints);
     State s = problem.evaluate(joints, sim);
     s.fit = fit;
-    if (std::isfinite(s.criterion)) s = refine(problem, s, sim);
     judge(c, s);
+    // Its parameters from the start have no intervals: only output error (finalists) gives them.
+    for (auto& p : c.parameters) {
+      p.fixed = p.determined = false;
+      p.std = p.ci_low = p.ci_high = std::numeric_limits<double>::quiet_NaN();
+    }
+    if (c.rejected.empty()) c.rejected = interval_problem(c);
     return {std::move(c), std::move(s)};
   } catch (const std::invalid_argument& e) {
     return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());

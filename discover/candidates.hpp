@@ -26,8 +26,9 @@ Outcome consider_term(const Problem& problem, const State& state, const Simulato
                       const std::string& joint, joints::Term term);
 /// The parametric `term` (jenkins, iwan, gap) added at `joint`: its parameters started from a
 /// describing-function fit to each test's equivalent stiffness of the joint (less its other
-/// terms), the coefficient terms by equation error with its force known, then every non-fixed
-/// term and parameter refined by output error (refine.hpp).
+/// terms), the coefficient terms by equation error with its force known. Its parameters get
+/// intervals only from output error: the best parametric candidate of a step is among the
+/// finalists (selection.hpp), the others stay undetermined.
 Outcome consider_parametric(const Problem& problem, const State& state, const Simulator& sim,
                             const std::string& joint, joints::Term term);
 /// The joint's `term` identified from each test alone (every other term held at the state's

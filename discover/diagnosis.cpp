@@ -14,6 +14,7 @@
 #include <numbers>
 #include <set>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 namespace jointid::discover::detail {
@@ -455,11 +456,17 @@ void model_lines(JointBehaviour& b, const joints::Joint& start, const joints::Jo
   const auto [lo, hi] = std::minmax_element(b.amplitude.begin(), b.amplitude.end());
   const double a0 = *lo / 1.5, a1 = *hi * 1.5;
   b.model_amplitude.clear(), b.start_dissipation.clear(), b.final_dissipation.clear();
+  b.start_stiffness.clear(), b.final_stiffness.clear();
   for (int i = 0; i <= 40; ++i) {
     const double a = a0 * std::pow(a1 / a0, i / 40.0);
     b.model_amplitude.push_back(a);
-    b.start_dissipation.push_back(joint_dissipation(start, a, w));
-    b.final_dissipation.push_back(joint_dissipation(last, a, w));
+    for (const auto& [joint, D, K] :
+         {std::tuple{&start, &b.start_dissipation, &b.start_stiffness},
+          std::tuple{&last, &b.final_dissipation, &b.final_stiffness}}) {
+      const Complex N = joint_describing_function(*joint, a, w);
+      D->push_back(std::numbers::pi * a * a * N.imag());
+      K->push_back(N.real());
+    }
   }
 }
 

@@ -78,7 +78,8 @@ struct Options {
   double min_explained = 0.05;
   /// Cross-validation leaves one test out up to 30 tests, and uses this many folds above.
   int folds = 10;
-  /// Candidates refined by output error at each step (the best by the equation-error screen).
+  /// Candidates refined by output error at each step (the best by the equation-error screen),
+  /// and besides them the best parametric one (by its describing-function start).
   int finalists = 3;
   /// Points of each state's response curves for the report (0: none).
   int curve_points = 30;
@@ -219,9 +220,10 @@ struct JointBehaviour {
   /// "microslip", "macroslip", "microslip to macroslip", "clearance", or empty (none of these).
   std::string behaviour;
   std::string finding; ///< in one sentence
-  /// Model lines: D per cycle of the starting and the final model's joint force at
+  /// Model lines: D per cycle (J) and k_eq of the starting and the final model's joint force at
   /// `model_amplitude`, at `model_frequency_hz` (the tests' median).
   std::vector<double> model_amplitude, start_dissipation, final_dissipation;
+  std::vector<double> start_stiffness, final_stiffness;
   double model_frequency_hz = 0.0;
 };
 

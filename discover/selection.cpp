@@ -226,11 +226,16 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
     return ranking[a].criterion < ranking[b].criterion;
   });
   std::vector<std::size_t> out;
-  for (std::size_t i : by)
-    if (std::isfinite(ranking[i].criterion) && !ranking[i].varies &&
-        !(ranking[i].term && joints::has_parameters(*ranking[i].term)) &&
-        out.size() < static_cast<std::size_t>(count))
+  bool parametric_taken = false;
+  for (std::size_t i : by) {
+    if (!std::isfinite(ranking[i].criterion) || ranking[i].varies) continue;
+    if (ranking[i].term && joints::has_parameters(*ranking[i].term)) {
+      if (!parametric_taken) out.push_back(i); // the best one, besides the count
+      parametric_taken = true;
+    } else if (static_cast<int>(out.size()) - (parametric_taken ? 1 : 0) < count) {
       out.push_back(i);
+    }
+  }
   return out;
 }
 
