@@ -171,6 +171,16 @@ std::string named_share(const Best& b) {
 // level only where the tests have several levels.
 void nature_finding(Diagnosis& d, const Families& f, bool several_levels) {
   const Best &cons = f.conservative, &diss = f.dissipative;
+  // A slider term (jenkins, iwan) explains it best: its loop both softens and dissipates.
+  if (const Candidate* best = f.nonlinear.who;
+      best && best->term && joints::is_hysteretic(*best->term)) {
+    d.nature = "hysteretic";
+    d.findings.push_back(fmt::format(
+        "Hysteretic: a slider term ({}) explains {}, the best stiffness term {}, the best damping "
+        "term {}: the joint softens and dissipates at once.",
+        best->name(), pct(f.nonlinear.share), named_share(cons), named_share(diss)));
+    return;
+  }
   d.nature = cons.share > diss.share ? "conservative" : "dissipative";
   if (d.nature == "conservative") {
     std::string how;
@@ -271,7 +281,7 @@ Complex joint_describing_function(const joints::Joint& j, double a, double omega
   constexpr int n = 128;
   Complex N = 0.0;
   for (std::size_t t = 0; t < j.terms.size(); ++t) {
-    if ((include && !include(t)) || !j.has_value(t)) continue;
+    if (include && !include(t)) continue;
     if (joints::has_parameters(j.terms[t])) {
       try {
         N += identify::describing_function(j, t, a);

@@ -54,7 +54,7 @@ equivalent_stiffness(const Problem& problem, const State& state, const Simulator
 
 /// The describing function N(a) = G₁/a of the joint's terms that `include` keeps (all when
 /// empty), under y = a cos ωt: its equivalent stiffness k_eq + iω c_eq at that amplitude.
-/// Terms without values are left out.
+/// A parametric term without its parameters is left out.
 std::complex<double>
 joint_describing_function(const joints::Joint& joint, double amplitude, double omega,
                           const std::function<bool(std::size_t)>& include = {});

@@ -236,7 +236,7 @@ struct Diagnosis {
   std::string joint;               ///< where it sits (joint name, or "substructure")
   std::string channel;             ///< the channel with the largest relative error
   double channel_error = 0.0;      ///< its relative error, ‖e‖/‖X_meas‖ over the tests
-  std::string nature;              ///< "conservative", "dissipative", or empty
+  std::string nature;              ///< "conservative", "dissipative", "hysteretic", or empty
   double conservative_explains = 0.0, dissipative_explains = 0.0;
   bool even_harmonics = false; ///< an unexplained 2nd harmonic, 5 × above the noise
   double even_content = 0.0;   ///< largest |X_meas − X_sim| at k = 2 over |X_1|

@@ -120,8 +120,10 @@ void Discover::print(const discover::Result& result) const {
              "gap before", "gap after");
   for (std::size_t i = 0; i < result.steps.size(); ++i) {
     const auto& s = result.steps[i];
-    fmt::print("{:<5} {:<28} {:<26} {:>12.5g} {:>11.4g} {:>11.4g}\n", i + 1, s.added.name(),
-               s.added.effect(), s.added.value, s.gap_before, s.gap_after);
+    fmt::print("{:<5} {:<28} {:<26} {:>12} {:>11.4g} {:>11.4g}\n", i + 1, s.added.name(),
+               s.added.effect(),
+               s.added.parameters.empty() ? fmt::format("{:.5g}", s.added.value) : "(below)",
+               s.gap_before, s.gap_after);
     for (const auto& p : s.added.parameters) // a parametric term: its parameters below it
       fmt::print("      {:<33} {}\n",
                  fmt::format("{}.{}", joints::term_name(*s.added.term), p.name),

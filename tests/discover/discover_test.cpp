@@ -261,6 +261,7 @@ TEST_P(HiddenParametricTerm, IsNamedWithItsParametersAndTheDiagnosisSaysWhatItDo
     EXPECT_NEAR(value_of(r, "tip", Term::k) + kt, 4800.0 + h.parameters[1], 0.02 * 7800.0);
   }
   // The diagnosis, from the equivalent stiffness and damping of each test alone.
+  EXPECT_EQ(r.diagnosis.nature, joints::is_hysteretic(h.term) ? "hysteretic" : "conservative");
   ASSERT_FALSE(r.diagnosis.behaviour.empty());
   const discover::JointBehaviour& b = r.diagnosis.behaviour.front();
   EXPECT_EQ(b.joint, "tip");
