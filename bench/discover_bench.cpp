@@ -1,18 +1,25 @@
 // Times model discovery on the paper's cantilever (21 sine tests: 2–5 Hz × 3 levels, made by time
 // integration with 1 % noise) with a hidden cubic stiffness, and with a hidden cubic stiffness
 // and Coulomb friction; with a hidden jenkins, iwan or gap (each with the library's terms as
-// candidates, and with the coefficient terms alone: what the parametric candidates cost); and
-// one steady-state point by harmonic balance against time integration. Results:
-// docs/benchmarks.md.
+// candidates, and with the coefficient terms alone: what the parametric candidates cost);
+// discovery on a stepped-sine table of 492 tests (a bolted beam's stand-in, read from its CSV
+// file as `jointid discover` reads it); and one steady-state point by harmonic balance against
+// time integration. Results: docs/benchmarks.md.
 #include "discover/discover.hpp"
 #include "fem/time_integration.hpp"
 #include "identify/sine_tests.hpp"
+#include "io/files.hpp"
+#include "io/record_csv.hpp"
+#include "support/bolted_beam.hpp"
 #include "support/cantilever.hpp"
 
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
 #include <map>
 #include <stdexcept>
+#include <sys/resource.h>
+#include <unistd.h>
 
 using namespace jointid;
 using joints::Term;
@@ -112,6 +119,64 @@ void BM_DiscoverHiddenParametricTerm(benchmark::State& state) {
     benchmark::DoNotOptimize(discover::discover(d.sub, {d.start}, measured, o));
 }
 
+// The bolted beam's stepped-sine table (tests/support/bolted_beam.hpp: a hidden softening
+// cubic stiffness and cubic damping): 12 force levels from 0.1 to 1.5 N (evenly in ratio) × 41
+// frequencies from 66 to 86 Hz around the first mode, force and drive-point acceleration, 1 %
+// noise on every phasor; written once to a CSV file in the temporary directory.
+struct Table {
+  fem::Model model = test::bolted_beam();
+  frf::Substructure sub{model};
+  std::filesystem::path path = std::filesystem::temp_directory_path() /
+                               ("jointid_bench_bolted_beam_" + std::to_string(::getpid()) + ".csv");
+  Table() {
+    const identify::SteppedSineTable table = test::stepped_sine_table(
+        model, test::bolt_truth(), test::stepped_sine_plan(12, 0.1, 1.5, 41, 66.0, 86.0));
+    io::write_file_atomically(path, io::stepped_sine_csv(table, {"bolted beam stand-in"}));
+  }
+  ~Table() { std::filesystem::remove(path); }
+};
+
+// User and system time of every thread of the process, s.
+double process_cpu_seconds() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; };
+  return seconds(u.ru_utime) + seconds(u.ru_stime);
+}
+
+const Table& table() {
+  static const Table t;
+  return t;
+}
+
+// As `jointid discover MODEL TABLE` runs it: the table read and measured (harmonics 1, 2, 3
+// asked, a table gives the fundamental), the library's default options; state.range(0): points
+// of the report's response curves (30: the default; 0: none). The report's pictures are not
+// drawn.
+void BM_DiscoverSteppedSineTable(benchmark::State& state) {
+  const Table& t = table();
+  discover::Options o;
+  o.curve_points = static_cast<int>(state.range(0));
+  discover::Result r;
+  const double cpu_before = process_cpu_seconds();
+  for (auto _ : state) {
+    const std::vector<identify::Measurement> measured =
+        identify::measure(io::read_tests({t.path}), {.harmonics = 3});
+    r = discover::discover(t.sub, {test::bolt_start()}, measured, o);
+  }
+  // Every thread's CPU time (Google Benchmark's CPU column counts the main thread only): on a
+  // shared machine, the time this run would take alone on one core.
+  state.counters["cpu_all_threads_s"] = process_cpu_seconds() - cpu_before;
+  state.counters["tests"] = r.tests;
+  state.counters["steps"] = static_cast<double>(r.steps.size());
+  state.counters["gap_start"] = r.gap.front();
+  state.counters["gap_final"] = r.gap.back();
+  std::string added;
+  for (const auto& s : r.steps)
+    added += (added.empty() ? "" : ", ") + s.added.name();
+  state.SetLabel(added);
+}
+
 // One steady state at 4 Hz, 80 N (near the joined structure's first mode) with the joint k + c
 // + k3 (range 0) or k + c + k3 + fc (range 1).
 joints::Joint point_joint(int friction) {
@@ -164,6 +229,7 @@ BENCHMARK(BM_DiscoverHiddenParametricTerm)
     ->ArgsProduct({{0, 1, 2}, {0, 1}})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
+BENCHMARK(BM_DiscoverSteppedSineTable)->Arg(30)->Arg(0)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_SteadyStateHarmonicBalance)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SteadyStateTimeIntegration)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

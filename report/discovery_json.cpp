@@ -3,6 +3,8 @@
 #include "io/json_text.hpp"
 
 #include <cmath>
+#include <complex>
+#include <limits>
 
 namespace jointid::report {
 
@@ -186,11 +188,14 @@ Json comparisons_json(const std::vector<discover::Comparison>& list) {
     j["frequency_hz"] = number(c.frequency_hz);
     j["force"] = number(c.force);
     j["measured"] = Json::array({number(c.measured.real()), number(c.measured.imag())});
-    j["simulated"] = Json::array({number(c.simulated.real()), number(c.simulated.imag())});
-    j["amplitude_error"] = number(c.amplitude_error);
-    j["phase_error_deg"] = number(c.phase_error_deg);
+    // A re-simulation that did not converge left its last iterate, which is not a result.
+    const double none = std::numeric_limits<double>::quiet_NaN();
+    const std::complex<double> simulated = c.converged ? c.simulated : std::complex(none, none);
+    j["simulated"] = Json::array({number(simulated.real()), number(simulated.imag())});
+    j["amplitude_error"] = number(c.converged ? c.amplitude_error : none);
+    j["phase_error_deg"] = number(c.converged ? c.phase_error_deg : none);
     j["harmonics_measured"] = number(c.harmonics_measured);
-    j["harmonics_simulated"] = number(c.harmonics_simulated);
+    j["harmonics_simulated"] = number(c.converged ? c.harmonics_simulated : none);
     j["converged"] = c.converged;
     out.push_back(std::move(j));
   }

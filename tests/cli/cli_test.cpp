@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -2425,6 +2426,239 @@ TEST_F(ModalFitCli, BadInputsAreRefusedAndNothingIsWritten) {
                                 dir()),
                         good.string() + ": given twice");
   EXPECT_FALSE(fs::exists(out));
+}
+
+// A number as a command line would give it (3, 2.5).
+std::string shortest(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Stepped-sine tables of the cantilever with its cubic stiffness (the truth of CliTest's model:
+// k = 4800 N/m, c = 20 N s/m, k3 = 1.6e8 N/m³), force and drive-point acceleration, as
+// `simulate --method hb --table` writes them (1 % noise on the time samples, the fundamental
+// fitted over 8 periods of 2048 samples: about 1e-4 of each phasor).
+class SteppedSineCli : public CliTest {
+protected:
+  static fs::path table(const std::string& name, const std::string& freq) {
+    const fs::path out = dir() / ("table_" + name);
+    if (!fs::exists(out / "stepped_sine.csv")) {
+      const Outcome sim = jointid({"simulate", model().string(), "--force", "7:uy", "--freq", freq,
+                                   "--amplitude", "10,40,80", "--method", "hb", "--channels", "a",
+                                   "--noise", "0.01", "--table", "-o", out.string()},
+                                  dir());
+      EXPECT_EQ(sim.status, 0) << sim.err;
+    }
+    return out / "stepped_sine.csv";
+  }
+  // 18 tests around the joined structure's first mode (about 4.2 Hz).
+  static fs::path near_the_mode() { return table("near_mode", "3.6,3.8,4,4.2,4.4,4.6"); }
+  // 21 tests from 2 to 5 Hz.
+  static fs::path wide() { return table("wide", "2,2.5,3,3.5,4,4.5,5"); }
+  // The tests' frequency and force amplitude, by source ("<table>:<line>").
+  static std::map<std::string, std::pair<double, double>> rows(const fs::path& path) {
+    const io::SteppedSineTable t = io::read_stepped_sine(path);
+    std::map<std::string, std::pair<double, double>> out;
+    for (std::size_t i = 0; i < t.freq_hz.size(); ++i)
+      out[path.string() + ":" + std::to_string(t.lines[i])] = {
+          t.freq_hz[i], std::abs(t.values(static_cast<Eigen::Index>(i), 0))};
+    return out;
+  }
+};
+
+TEST_F(SteppedSineCli, DiscoverNamesTheHiddenCubicStiffnessOfATableAndWritesItsReport) {
+  const fs::path start = dir() / "table_linear.toml", out = dir() / "table_discover";
+  test::write_text(start, linear_start_toml());
+  const Outcome run =
+      jointid({"discover", start.string(), near_the_mode().string(), "-o", out.string()}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("1     k3 at 'tip'"), std::string::npos) << run.out;
+  // A table carries no noise estimate: said, never claimed as reached.
+  EXPECT_NE(run.err.find("the noise level is unknown (18 of 18 tests"), std::string::npos)
+      << run.err;
+  const json j = json::parse(test::read_text(out / "discovery.json"));
+  EXPECT_EQ(j["tests"], 18);
+  EXPECT_EQ(j["compared_values"], 36); // the fundamental of one channel: re, im per test
+  EXPECT_TRUE(j["noise_gap"].is_null());
+  EXPECT_FALSE(j["at_noise_level"].get<bool>());
+  ASSERT_EQ(j["steps"].size(), 1u) << j["steps"].dump();
+  const json& step = j["steps"][0];
+  EXPECT_EQ(step["term"], "k3");
+  EXPECT_EQ(step["effect"], "cubic stiffness");
+  ASSERT_TRUE(step["determined"].get<bool>());
+  // The phasors' noise (about 1e-4 of each) and the harmonic balance's truncation (9 harmonics
+  // in the table, 15 in the re-simulation) move k3 by far less than 1 %.
+  const double k3 = step["value"].get<double>();
+  EXPECT_NEAR(k3, 1.6e8, 0.01 * 1.6e8);
+  EXPECT_LT(step["ci95"][0].get<double>(), k3);
+  EXPECT_GT(step["ci95"][1].get<double>(), k3);
+  ASSERT_EQ(j["gap"].size(), 2u);
+  EXPECT_LT(j["gap"][1].get<double>(), 0.01 * j["gap"][0].get<double>());
+  EXPECT_TRUE(j["start"]["left_out"].empty());
+  EXPECT_TRUE(j["final_model"]["left_out"].empty());
+  // What a table cannot tell is listed (no noise estimate, no harmonics), and also warned.
+  ASSERT_EQ(j["limits"].size(), 2u) << j["limits"].dump();
+  for (const auto& limit : j["limits"])
+    EXPECT_NE(run.err.find(limit.get<std::string>()), std::string::npos) << limit;
+  const std::string report = test::read_text(out / "report.md");
+  EXPECT_NE(report.find("| 1 | k3 at 'tip' | cubic stiffness |"), std::string::npos) << report;
+#if JOINTID_WITH_VTK
+  // The stepped-sine tests drawn as FRFs over frequency per force level, with the gap.
+  for (const char* png : {"gap.png", "response_1.png"}) {
+    ASSERT_TRUE(fs::exists(out / png)) << png << "\n" << run.err;
+    EXPECT_GT(fs::file_size(out / png), 5000u) << png;
+  }
+#endif
+}
+
+TEST_F(SteppedSineCli, ATestTheModelCannotReSimulateIsLeftOutAndNamed) {
+  // A model that softens (k3 = −5e8 N/m³, given) where the structure hardens: near 3 Hz its
+  // response at the joint approaches the escape amplitude of its softening spring, and at a test
+  // there the model has no periodic steady state. That test is left out and named, never read as
+  // "nothing missing".
+  const fs::path bad = dir() / "table_softening.toml", out = dir() / "table_left_out";
+  test::write_text(bad, test::replaced(test::cantilever_toml(), "k3 = 1.6e8", "k3 = -5e8"));
+  const fs::path tab = wide();
+  const Outcome run =
+      jointid({"discover", bad.string(), tab.string(), "--no-plot", "-o", out.string()}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(run.out.find("nothing is missing"), std::string::npos) << run.out;
+  const json j = json::parse(test::read_text(out / "discovery.json"));
+  EXPECT_FALSE(j["at_noise_level"].get<bool>());
+  const json& left_out = j["start"]["left_out"];
+  ASSERT_FALSE(left_out.empty()) << j["start"].dump();
+  EXPECT_LE(left_out.size(), 2u); // a tenth of 21 tests: more, and the model is not compared
+  const auto tests = rows(tab);
+  std::string named;
+  for (const auto& source : left_out) {
+    const std::string s = source.get<std::string>();
+    named += (named.empty() ? "" : ", ") + s;
+    ASSERT_TRUE(tests.count(s)) << s;
+    const auto [f, force] = tests.at(s);
+    // Independently: simulate finds no steady state of the model at that test, by harmonic
+    // balance (from the linear response, with load steps) nor in time (the response escapes).
+    const std::vector<std::string> test_args{
+        "--force", "7:uy", "--freq", shortest(f), "--amplitude", shortest(std::round(force))};
+    std::vector<std::string> hb{"simulate", bad.string()}, time{"simulate", bad.string()};
+    hb.insert(hb.end(), test_args.begin(), test_args.end());
+    time.insert(time.end(), test_args.begin(), test_args.end());
+    hb.insert(hb.end(), {"--method", "hb", "--table", "-o", (dir() / "no_hb").string()});
+    time.insert(time.end(), {"--periods", "20", "--steps-per-period", "256", "-o",
+                             (dir() / "no_time").string()});
+    expect_one_line_error(jointid(hb, dir()), "no periodic solution found");
+    expect_one_line_error(jointid(time, dir()), "the joints' Newton iteration failed");
+    // It is compared with nothing: what its solve left is not written as a simulated response.
+    int comparisons = 0;
+    for (const auto& c : j["comparisons"]["start"])
+      if (c["test"] == s) {
+        ++comparisons;
+        EXPECT_FALSE(c["converged"].get<bool>());
+        EXPECT_TRUE(c["simulated"][0].is_null() && c["simulated"][1].is_null()) << c.dump();
+        EXPECT_TRUE(c["amplitude_error"].is_null()) << c.dump();
+        EXPECT_TRUE(c["measured"][0].is_number()) << c.dump();
+      }
+    EXPECT_EQ(comparisons, 1); // one channel
+  }
+  const std::string warning =
+      "the re-simulation of " + std::to_string(left_out.size()) +
+      (left_out.size() == 1 ? " test" : " tests") +
+      " with the starting model did not converge, even from the measured response and from the "
+      "nearest tests: " +
+      named + "; left out of its gap";
+  EXPECT_NE(run.err.find(warning), std::string::npos) << warning << "\n" << run.err;
+  // The gap is over the other tests: a number.
+  EXPECT_TRUE(std::isfinite(j["gap"][0].get<double>()));
+}
+
+TEST_F(SteppedSineCli, AnUndeterminedIntervalIsFlaggedNeverWrittenAsAResult) {
+  // Around one mode with the cubic stiffness missing, the substructure's damping scale barely
+  // changes the misfit: its interval cannot be estimated, and every output says so instead of
+  // giving one.
+  const fs::path start = dir() / "table_linear_2.toml", out = dir() / "table_undetermined";
+  test::write_text(start, linear_start_toml());
+  const Outcome run = jointid(
+      {"discover", start.string(), near_the_mode().string(), "--no-plot", "-o", out.string()},
+      dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json j = json::parse(test::read_text(out / "discovery.json"));
+  int undetermined = 0, determined = 0;
+  auto check = [&](const json& c) {
+    if (c["determined"].get<bool>()) {
+      ++determined;
+      ASSERT_TRUE(c["ci95"][0].is_number() && c["ci95"][1].is_number()) << c.dump();
+      EXPECT_LT(c["ci95"][0].get<double>(), c["ci95"][1].get<double>()) << c.dump();
+      EXPECT_GT(c["std"].get<double>(), 0.0) << c.dump();
+      return;
+    }
+    ++undetermined;
+    EXPECT_TRUE(c["ci95"][0].is_null() && c["ci95"][1].is_null()) << c.dump();
+    EXPECT_TRUE(c["std"].is_null()) << c.dump();
+    if (c.contains("admissible") && c["term"] != "refit") {
+      EXPECT_FALSE(c["admissible"].get<bool>()) << c.dump();
+      EXPECT_EQ(c["rejected"].get<std::string>().rfind("not determined: its 95 % interval", 0), 0u)
+          << c.dump();
+    }
+  };
+  for (const auto& step : j["steps"]) {
+    check(step);
+    for (const auto& c : step["ranking"])
+      check(c);
+  }
+  for (const auto& c : j["last_ranking"])
+    check(c);
+  for (const auto& term : j["final_model"]["joints"][0]["terms"])
+    if (term.contains("determined")) check(term);
+  ASSERT_GT(undetermined, 0) << "no undetermined interval in this run: the test checks nothing";
+  EXPECT_GT(determined, 0);
+  // The step added has its interval; the report's table shows intervals for those alone.
+  const std::string report = test::read_text(out / "report.md");
+  for (const auto& step : j["steps"]) {
+    if (!step["determined"].get<bool>()) {
+      EXPECT_NE(report.find("| undetermined |"), std::string::npos) << report;
+    }
+  }
+}
+
+// A sine sweep of the cantilever with its joint, end to end: simulated in time (1 % noise),
+// reduced by identify to stepped-sine rows, the joint's values identified.
+TEST_F(CliTest, IdentifyTakesASineSweepRecord) {
+  const fs::path data = dir() / "sweep", result = dir() / "sweep.json";
+  // 2 → 6 Hz in 200 s (0.02 Hz/s) at 40 N, sampled at 200 Hz, acceleration at the tip.
+  std::vector<std::string> args{
+      "simulate", model().string(), "--excitation", "sweep",       "--force",
+      "7:uy",     "--band",         "2:6",          "--amplitude", "40"};
+  args.insert(args.end(), {"--duration", "200", "--sample-rate", "200", "--channels", "a",
+                           "--noise", "0.01", "-o", data.string()});
+  const Outcome sim = jointid(args, dir());
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const fs::path record = data / "sweep_2-6Hz_40N.csv";
+  ASSERT_TRUE(fs::exists(record));
+  EXPECT_NE(test::read_text(record).find("\n# excitation = sweep\n"), std::string::npos);
+  const Outcome run =
+      jointid({"identify", model().string(), record.string(), "-o", result.string()}, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  // The reduction and the sweep rate's bias are said: "… reduced to N stepped-sine rows …; the
+  // sweep rate biases their response by up to B % …".
+  const std::string said = "the sweep rate biases their response by up to ";
+  const std::size_t at = run.err.find(said);
+  ASSERT_NE(at, std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("reduced to "), std::string::npos) << run.err;
+  const double bias = 0.01 * std::stod(run.err.substr(at + said.size()));
+  // 0.02 Hz/s: well below 10 %, and not nothing.
+  EXPECT_GT(bias, 1e-4);
+  EXPECT_LT(bias, 0.1);
+  const json j = json::parse(test::read_text(result));
+  EXPECT_EQ(j["status"], "ok");
+  ASSERT_EQ(j["joints"][0]["terms"].size(), 3u);
+  // Each value within 3 standard deviations (the noise, propagated) plus the rows' stated bias,
+  // relative: responses off by at most that share move a coefficient by about as much.
+  const std::vector<double> truth{4800.0, 20.0, 1.6e8};
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const json& t = j["joints"][0]["terms"][i];
+    const double tolerance = 3.0 * t["std"].get<double>() + bias * truth[i];
+    EXPECT_NEAR(t["value"].get<double>(), truth[i], tolerance) << t.dump();
+  }
 }
 
 } // namespace
