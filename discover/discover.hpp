@@ -79,7 +79,8 @@ struct Options {
   /// Cross-validation leaves one test out up to 30 tests, and uses this many folds above.
   int folds = 10;
   /// Candidates refined by output error at each step (the best by the equation-error screen),
-  /// and besides them the best parametric one (by its describing-function start).
+  /// and besides them the best parametric one where its describing-function start ranks among
+  /// the best finalists + 1.
   int finalists = 3;
   /// Points of each state's response curves for the report (0: none).
   int curve_points = 30;

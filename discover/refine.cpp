@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace jointid::discover::detail {
@@ -19,6 +20,20 @@ namespace {
 
 using Complex = std::complex<double>;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// Every named parameter in its range: a step far out in a parameter's coordinate saturates it
+// (an exponent at −1, a logarithm's exponential at +∞), which no simulation takes.
+bool in_range(const std::vector<joints::Joint>& joints) {
+  for (const joints::Joint& j : joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      const auto list = j.parameters_of(t);
+      const auto& info = joints::term_info(j.terms[t]).parameters;
+      for (std::size_t p = 0; p < list.size() && p < info.size(); ++p)
+        if (!joints::in_range(info[p], list[p].value) || !(std::abs(list[p].value) < 1e100))
+          return false;
+    }
+  return true;
+}
 
 // The Levenberg–Marquardt search of one refinement: the parameters (every non-fixed term), the
 // weighted residual of a state, and the Jacobian by finite differences.
@@ -106,7 +121,7 @@ public:
         for (Eigen::Index q = 0; q < p; ++q) // projected onto non-negative damping and friction
           if (dissipative[q]) nb(q) = std::max(nb(q), 0.0);
         const std::vector<joints::Joint> nj = joints_with(nb);
-        if (!nb.allFinite() || !physical_problem(nj).empty()) continue;
+        if (!nb.allFinite() || !physical_problem(nj).empty() || !in_range(nj)) continue;
         State sn = problem_.evaluate(nj, sim_, &current_);
         if (!covers(sn)) continue;
         const Eigen::VectorXd rn = residual(sn);
@@ -318,7 +333,7 @@ private:
         Eigen::VectorXd bq = b_;
         bq(q) += h;
         const std::vector<joints::Joint> jq = joints_with(bq);
-        if (!physical_problem(jq).empty()) continue;
+        if (!physical_problem(jq).empty() || !in_range(jq)) continue;
         const State sq = problem_.evaluate(jq, sim_, &current_);
         if (!covers(sq)) continue;
         J_.col(q) = (residual(sq) - r_) / h;
@@ -368,6 +383,8 @@ Eigen::MatrixXd covariance(const Eigen::MatrixXd& J, double s2) {
   const Eigen::MatrixXd W = svd.matrixV() * sv.cwiseInverse().asDiagonal();
   return s2 * scale.asDiagonal() * (W * W.transpose()) * scale.asDiagonal();
 }
+
+static State refine_from(const Problem& problem, const State& start, const Simulator& sim);
 
 Eigen::MatrixXd covariance_without(const Eigen::MatrixXd& J, double s2, int nulls) {
   const Eigen::Index p = J.cols();
@@ -430,6 +447,14 @@ Eigen::MatrixXd covariance_of_determined(const Eigen::MatrixXd& J, double s2,
 }
 
 State refine(const Problem& problem, const State& start, const Simulator& sim) {
+  try {
+    return refine_from(problem, start, sim);
+  } catch (const std::invalid_argument&) {
+    return start; // a model the simulators refuse (out of range): the start stands
+  }
+}
+
+State refine_from(const Problem& problem, const State& start, const Simulator& sim) {
   OutputError search(problem, sim, start);
   if (search.size() == 0) return start;
   const State begin = search.begin(start);

@@ -226,15 +226,20 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
     return ranking[a].criterion < ranking[b].criterion;
   });
   std::vector<std::size_t> out;
-  bool parametric_taken = false;
+  bool parametric_seen = false;
+  int coefficient = 0, place = 0; // place: among the candidates that may be refined
   for (std::size_t i : by) {
     if (!std::isfinite(ranking[i].criterion) || ranking[i].varies) continue;
     if (ranking[i].term && joints::has_parameters(*ranking[i].term)) {
-      if (!parametric_taken) out.push_back(i); // the best one, besides the count
-      parametric_taken = true;
-    } else if (static_cast<int>(out.size()) - (parametric_taken ? 1 : 0) < count) {
+      // The best one, besides the count, where it ranks among the best count + 1 (its start
+      // screens it: further down, coefficient terms explain the data better).
+      if (!parametric_seen && place <= count) out.push_back(i);
+      parametric_seen = true;
+    } else if (coefficient < count) {
       out.push_back(i);
+      ++coefficient;
     }
+    ++place;
   }
   return out;
 }

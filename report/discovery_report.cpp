@@ -55,7 +55,7 @@ std::string parameters_text(const std::vector<identify::ParameterEstimate>& list
   for (std::size_t p = 0; p < list.size(); ++p) {
     const auto& e = list[p];
     const std::string unit =
-        p < info.size() && info[p].unit != "1" ? " " + std::string(info[p].unit) : std::string();
+        p < info.size() && info[p].unit != "1" ? fmt::format(" {}", info[p].unit) : std::string();
     out += fmt::format("{}{} = {}", out.empty() ? "" : ", ", e.name,
                        e.fixed        ? g4(e.value) + unit + " (fixed)"
                        : e.determined ? g4(e.value) + unit + " " + interval(e.ci_low, e.ci_high)
