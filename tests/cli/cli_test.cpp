@@ -1,4 +1,5 @@
 // Runs the built `jointid` program on the cantilever of DESIGN.md, as a user would.
+#include "cli/run_jointid.hpp"
 #include "io/cantilever_toml.hpp"
 #include "io/model_file.hpp"
 #include "io/record_csv.hpp"
@@ -27,46 +28,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Outcome {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string quoted(const std::string& s) {
-  std::string q = "'";
-  for (char c : s)
-    q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-// Runs jointid with `args`, capturing stdout and stderr through files in `dir`; `launcher`
-// (e.g. mpirun and its options, already quoted) goes in front.
-Outcome jointid(const std::vector<std::string>& args, const fs::path& dir,
-                const std::string& launcher = "") {
-  std::string command = launcher + quoted(JOINTID_EXE);
-  for (const auto& a : args)
-    command.append(" ").append(quoted(a));
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  command.append(" > ").append(quoted(out.string())).append(" 2> ").append(quoted(err.string()));
-  const int raw = std::system(command.c_str());
-  Outcome run;
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  run.out = test::read_text(out);
-  run.err = test::read_text(err);
-  fs::remove(out);
-  fs::remove(err);
-  return run;
-}
-
-// A failed run: non-zero status and exactly one line "jointid: ..." on stderr.
-void expect_one_line_error(const Outcome& run, const std::string& part = "") {
-  EXPECT_NE(run.status, 0);
-  EXPECT_EQ(run.err.rfind("jointid: ", 0), 0u) << run.err;
-  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
-  if (!part.empty()) {
-    EXPECT_NE(run.err.find(part), std::string::npos) << "'" << part << "' not in: " << run.err;
-  }
-}
+using test::expect_one_line_error;
+using test::jointid;
+using test::Outcome;
+using test::quoted;
 
 const std::vector<double> frequencies{3.4, 4.2, 5.0};
 constexpr double amplitude = 10.0;
