@@ -1,6 +1,7 @@
 #include "discover/problem.hpp"
 
 #include "discover/selection.hpp"
+#include "identify/parametric.hpp"
 
 #include <fmt/format.h>
 
@@ -251,8 +252,12 @@ const Problem::Spectra& Problem::spectra(const std::vector<joints::Joint>& joint
   std::string key;
   for (const auto& j : joints) {
     key += j.name + ':';
-    for (const joints::Term t : j.terms)
-      key += std::string(joints::term_name(t)) + ',';
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      key += std::string(joints::term_name(j.terms[t])) + ',';
+      // A parametric term's force (fixed) is in the spectrum: its parameters are in the key.
+      for (const joints::Parameter& p : j.parameters_of(t))
+        key += fmt::format("{:a},", p.value);
+    }
     key += ';';
   }
   const std::lock_guard<std::mutex> lock(spectra_mutex_);
@@ -269,8 +274,12 @@ const Problem::Spectra& Problem::spectra(const std::vector<joints::Joint>& joint
 }
 
 identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
-                                      const Simulator& sim, const std::vector<int>& use) const {
-  const Spectra& all = spectra(joints);
+                                      const Simulator& sim, const std::vector<int>& use,
+                                      const std::vector<int>* harmonics) const {
+  // The parametric terms with their parameters as they are: their forces known (the
+  // equation error identifies coefficients; their parameters are refined by output error).
+  const std::vector<joints::Joint> held = identify::with_parametric_fixed(joints);
+  const Spectra& all = spectra(held);
   std::vector<std::string> warnings;
   for (int i : use)
     warnings.insert(warnings.end(), all.warnings[i].begin(), all.warnings[i].end());
@@ -285,8 +294,8 @@ identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
     return sim.synthesis.receptance(w, rows, cols);
   };
   identify::FitOptions fo;
-  fo.harmonics = o_.harmonics;
-  identify::FitResult fit = identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
+  fo.harmonics = harmonics ? *harmonics : o_.harmonics;
+  identify::FitResult fit = identify::fit(H, dofs_, held, spectra, fo, std::move(warnings));
   // Terms the tests cannot separate: this model cannot be identified (a refused candidate).
   if (!fit.status.ok()) throw std::invalid_argument("identify: " + fit.status.reason);
   return fit;
@@ -295,8 +304,13 @@ identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
 int Problem::parameters(const std::vector<joints::Joint>& joints, double scale) const {
   int p = scale != 1.0 ? 1 : 0;
   for (const auto& j : joints)
-    for (bool f : j.fixed)
-      p += f ? 0 : 1;
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      if (j.fixed[t]) continue;
+      const auto params = j.parameters_of(t);
+      p += params.empty() ? 1
+                          : static_cast<int>(std::count_if(params.begin(), params.end(),
+                                                           [](const auto& q) { return !q.fixed; }));
+    }
   return p;
 }
 

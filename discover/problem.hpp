@@ -74,8 +74,12 @@ public:
 
   /// Identifies every non-fixed term from the tests `use`, with the damping scaled. Throws
   /// std::invalid_argument when the tests cannot separate the terms.
+  /// A parametric term (jenkins, iwan, gap) is held at its parameters (its force known; output
+  /// error refines them: refine.hpp). `harmonics`, if
+  /// given, replaces the options' (the equivalent linear joint of the diagnosis: 1).
   identify::FitResult identify(const std::vector<joints::Joint>& joints, const Simulator& sim,
-                               const std::vector<int>& use) const;
+                               const std::vector<int>& use,
+                               const std::vector<int>* harmonics = nullptr) const;
   /// Every test's spectrum for these joints' terms (their basis functions on the measured
   /// deformation, which do not depend on the values), and its warnings: computed once per set
   /// of terms and kept (identify() needs them for every candidate, trial and fold). Safe to call
@@ -85,7 +89,8 @@ public:
     std::vector<std::vector<std::string>> warnings; ///< per test
   };
   const Spectra& spectra(const std::vector<joints::Joint>& joints) const;
-  /// Identified coefficients: the non-fixed terms, and the damping scale if not 1.
+  /// Identified coefficients: the non-fixed terms (a parametric term's non-fixed parameters),
+  /// and the damping scale if not 1.
   int parameters(const std::vector<joints::Joint>& joints, double scale) const;
   /// Simulates every test with these joints, and scores the state. A test whose re-simulation
   /// does not converge (solve(), then from the nearest tests already re-simulated: a stepped

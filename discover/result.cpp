@@ -27,6 +27,11 @@ std::string Candidate::effect() const {
 }
 
 bool Candidate::determined() const {
+  if (term && joints::has_parameters(*term))
+    return std::any_of(parameters.begin(), parameters.end(), [](const auto& p) {
+      return !p.fixed && p.determined && std::isfinite(p.ci_low) && std::isfinite(p.ci_high) &&
+             p.ci_high > p.ci_low;
+    });
   return std::isfinite(ci_low) && std::isfinite(ci_high) && ci_high > ci_low &&
          std::isfinite(std) && std > 0.0;
 }

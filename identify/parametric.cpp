@@ -26,10 +26,7 @@ bool is_exponent(const joints::ParameterInfo& info) {
 }
 
 // One test's equivalent dynamic stiffness of a joint.
-struct Point {
-  double amplitude, omega;
-  Complex Z;
-};
+using Point = EquivalentStiffness;
 
 } // namespace
 
@@ -108,6 +105,170 @@ void check_one_parametric_term(const std::vector<joints::Joint>& joints) {
           "others in 'values' and list them in 'fixed'",
           J.name, fmt::join(open, " and ")));
   }
+}
+
+// Step 2: the parameters of term T of J (its fixed ones held) in their coordinates u that fit
+// N(a) + k + iωc to the points, sorted by amplitude (the joint's own k and c by least squares
+// where open), from a few starts read off the data; empty when no start gives a finite misfit.
+static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
+                                const std::vector<Point>& points, bool k_open, bool c_open,
+                                double& best_cost) {
+  const joints::Term term = J.terms[T];
+  // 2. N(a) + k + iωc fitted to Z(a).
+  const auto& info = joints::term_info(term).parameters;
+  const auto np = static_cast<Eigen::Index>(info.size());
+  std::vector<bool> free(info.size());
+  for (std::size_t p = 0; p < info.size(); ++p)
+    free[p] = !(J.parameters.size() > T && J.parameters[T].size() == info.size() &&
+                J.parameters[T][p].fixed);
+  joints::Joint trial = J;
+  if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
+    trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+  const auto residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) -> bool {
+    for (Eigen::Index p = 0; p < np; ++p) {
+      joints::Parameter& P = trial.parameters[T][static_cast<std::size_t>(p)];
+      P.value = parameter_from_u(info[static_cast<std::size_t>(p)], u(p));
+      P.given = true;
+    }
+    try {
+      joints::check_parameters(trial);
+    } catch (const std::invalid_argument&) {
+      return false;
+    }
+    const auto n = static_cast<Eigen::Index>(points.size());
+    Eigen::VectorXcd e(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Point& P = points[static_cast<std::size_t>(i)];
+      e(i) = P.Z - describing_function(trial, T, P.amplitude);
+    }
+    // The joint's own k and c by least squares (each point weighted by 1/|Z|).
+    double kw = 0.0, w = 0.0, cw = 0.0, wc = 0.0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Point& P = points[static_cast<std::size_t>(i)];
+      const double wi = 1.0 / std::max(std::norm(P.Z), 1e-300);
+      kw += wi * e(i).real(), w += wi;
+      cw += wi * P.omega * e(i).imag(), wc += wi * P.omega * P.omega;
+    }
+    const double k = k_open ? kw / w : 0.0, c = c_open ? cw / wc : 0.0;
+    r.resize(2 * n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Point& P = points[static_cast<std::size_t>(i)];
+      const Complex d = (e(i) - Complex(k, P.omega * c)) / std::max(std::abs(P.Z), 1e-300);
+      r(2 * i) = d.real(), r(2 * i + 1) = d.imag();
+    }
+    return r.allFinite();
+  };
+
+  // Starts read off the data.
+  const Point &lo = points.front(), &hi = points.back();
+  double dissipation = 0.0; // π a² Im Z: the dissipation per cycle, largest
+  for (const Point& P : points)
+    dissipation = std::max(dissipation, std::numbers::pi * P.amplitude * P.amplitude * P.Z.imag());
+  const double lost = lo.Z.real() - hi.Z.real(), gained = -lost;
+  const double k_small = std::max(k_open ? lost : lo.Z.real(), 1e-3 * std::abs(lo.Z));
+  std::vector<std::vector<double>> starts;
+  if (J.parameters.size() > T && J.parameters[T].size() == info.size() &&
+      std::all_of(J.parameters[T].begin(), J.parameters[T].end(),
+                  [](const joints::Parameter& p) { return p.given; })) {
+    std::vector<double> given;
+    for (const joints::Parameter& p : J.parameters[T])
+      given.push_back(p.value);
+    starts.push_back(given);
+  }
+  for (const double scale : {0.3, 1.0, 3.0}) {
+    const double fs = std::max(scale * dissipation / (4.0 * hi.amplitude), 1e-300);
+    if (term == joints::Term::jenkins) starts.push_back({std::max(k_small, 1e-300), fs});
+    if (term == joints::Term::iwan)
+      for (const double chi : {-0.6, -0.2})
+        starts.push_back({3.0 * fs, std::max(k_small, 1e-300), chi, 0.1});
+    if (term == joints::Term::gap)
+      starts.push_back(
+          {scale * lo.amplitude, std::max(gained > 0.0 ? 2.0 * gained : std::abs(hi.Z), 1e-300)});
+  }
+  best_cost = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd best;
+  for (const auto& s : starts) {
+    Eigen::VectorXd u(np), r, rn;
+    for (Eigen::Index p = 0; p < np; ++p) {
+      const std::size_t q = static_cast<std::size_t>(p);
+      const bool keep = !free[q] && J.parameters.size() > T;
+      u(p) = parameter_to_u(info[q], keep ? J.parameters[T][q].value : s[q]);
+    }
+    if (!residual(u, r)) continue;
+    double cost = r.squaredNorm(), mu = 1e-2;
+    for (int it = 0; it < 60; ++it) {
+      Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(r.size(), np);
+      for (Eigen::Index p = 0; p < np; ++p) {
+        if (!free[static_cast<std::size_t>(p)]) continue;
+        const double h = 1e-6 * std::max(1.0, std::abs(u(p)));
+        Eigen::VectorXd up = u;
+        up(p) += h;
+        if (residual(up, rn)) {
+          Jm.col(p) = (rn - r) / h;
+        } else {
+          up(p) = u(p) - h;
+          if (residual(up, rn)) Jm.col(p) = (r - rn) / h;
+        }
+      }
+      const Eigen::MatrixXd A = Jm.transpose() * Jm;
+      const Eigen::VectorXd g = Jm.transpose() * r;
+      bool accepted = false;
+      for (int tries = 0; tries < 10 && !accepted; ++tries) {
+        Eigen::MatrixXd M = A;
+        M.diagonal().array() += mu * (1.0 + A.diagonal().array());
+        const Eigen::VectorXd next = u - M.ldlt().solve(g);
+        if (next.allFinite() && residual(next, rn) && rn.squaredNorm() < cost) {
+          const double gain = (cost - rn.squaredNorm()) / cost;
+          u = next, r = rn, cost = rn.squaredNorm(), mu = std::max(mu / 10.0, 1e-10);
+          accepted = true;
+          if (gain < 1e-12) it = 1000;
+        } else {
+          mu *= 10.0;
+        }
+      }
+      if (!accepted) break;
+    }
+    (void)residual(u, r); // r at u, trial's parameters too
+    if (r.squaredNorm() < best_cost) best_cost = r.squaredNorm(), best = u;
+  }
+  return best;
+}
+
+joints::Joint fit_describing_function(const joints::Joint& J, std::size_t T,
+                                      std::vector<EquivalentStiffness> points, bool k_open,
+                                      bool c_open, std::string& note) {
+  const joints::Term term = J.terms[T];
+  if (points.empty())
+    throw std::invalid_argument("joint '" + J.name + "': no equivalent stiffness to fit its " +
+                                std::string(joints::term_name(term)) + " to");
+  std::sort(points.begin(), points.end(),
+            [](const Point& p, const Point& q) { return p.amplitude < q.amplitude; });
+  double best_cost = 0.0;
+  const Eigen::VectorXd best = best_fit(J, T, points, k_open, c_open, best_cost);
+  if (best.size() == 0)
+    throw std::invalid_argument("joint '" + J.name + "': the describing-function fit of its " +
+                                std::string(joints::term_name(term)) + " found no start");
+  const auto& info = joints::term_info(term).parameters;
+  joints::Joint out = J;
+  if (out.parameters.size() <= T || out.parameters[T].size() != info.size())
+    out.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+  std::string values;
+  for (std::size_t q = 0; q < info.size(); ++q) {
+    joints::Parameter& P = out.parameters[T][q];
+    P.value = parameter_from_u(info[q], best(static_cast<Eigen::Index>(q)));
+    P.given = true;
+    values += fmt::format("{}{}.{} = {:.4g}", values.empty() ? "" : ", ", joints::term_name(term),
+                          info[q].name, P.value);
+  }
+  if (!out.given.empty()) out.given[T] = true;
+  joints::check_parameters(out); // out of its range: std::invalid_argument saying which
+  note = fmt::format("joint '{}': {} started from a describing-function fit of the equivalent "
+                     "stiffness and damping of {} test(s) at deformation amplitudes {:.3g} … "
+                     "{:.3g} (relative misfit {:.2g}): {}",
+                     J.name, joints::term_name(term), points.size(), points.front().amplitude,
+                     points.back().amplitude,
+                     std::sqrt(best_cost / static_cast<double>(2 * points.size())), values);
+  return out;
 }
 
 DescribingFunctionStart describing_function_start(const frf::Substructure& sub,
@@ -206,121 +367,9 @@ DescribingFunctionStart describing_function_start(const frf::Substructure& sub,
     // 2. N(a) + k + iωc fitted to Z(a).
     const auto& info = joints::term_info(term).parameters;
     const auto np = static_cast<Eigen::Index>(info.size());
-    std::vector<bool> free(info.size());
-    for (std::size_t p = 0; p < info.size(); ++p)
-      free[p] = !(J.parameters.size() > T && J.parameters[T].size() == info.size() &&
-                  J.parameters[T][p].fixed);
-    joints::Joint trial = J;
-    if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
-      trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
-    const auto residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) -> bool {
-      for (Eigen::Index p = 0; p < np; ++p) {
-        joints::Parameter& P = trial.parameters[T][static_cast<std::size_t>(p)];
-        P.value = parameter_from_u(info[static_cast<std::size_t>(p)], u(p));
-        P.given = true;
-      }
-      try {
-        joints::check_parameters(trial);
-      } catch (const std::invalid_argument&) {
-        return false;
-      }
-      const auto n = static_cast<Eigen::Index>(points.size());
-      Eigen::VectorXcd e(n);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Point& P = points[static_cast<std::size_t>(i)];
-        e(i) = P.Z - describing_function(trial, T, P.amplitude);
-      }
-      // The joint's own k and c by least squares (each point weighted by 1/|Z|).
-      double kw = 0.0, w = 0.0, cw = 0.0, wc = 0.0;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Point& P = points[static_cast<std::size_t>(i)];
-        const double wi = 1.0 / std::max(std::norm(P.Z), 1e-300);
-        kw += wi * e(i).real(), w += wi;
-        cw += wi * P.omega * e(i).imag(), wc += wi * P.omega * P.omega;
-      }
-      const double k = k_open ? kw / w : 0.0, c = c_open ? cw / wc : 0.0;
-      r.resize(2 * n);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Point& P = points[static_cast<std::size_t>(i)];
-        const Complex d = (e(i) - Complex(k, P.omega * c)) / std::max(std::abs(P.Z), 1e-300);
-        r(2 * i) = d.real(), r(2 * i + 1) = d.imag();
-      }
-      return r.allFinite();
-    };
-
-    // Starts read off the data.
     const Point &lo = points.front(), &hi = points.back();
-    double dissipation = 0.0; // π a² Im Z: the dissipation per cycle, largest
-    for (const Point& P : points)
-      dissipation =
-          std::max(dissipation, std::numbers::pi * P.amplitude * P.amplitude * P.Z.imag());
-    const double lost = lo.Z.real() - hi.Z.real(), gained = -lost;
-    const double k_small = std::max(k_open ? lost : lo.Z.real(), 1e-3 * std::abs(lo.Z));
-    std::vector<std::vector<double>> starts;
-    if (J.parameters.size() > T && J.parameters[T].size() == info.size() &&
-        std::all_of(J.parameters[T].begin(), J.parameters[T].end(),
-                    [](const joints::Parameter& p) { return p.given; })) {
-      std::vector<double> given;
-      for (const joints::Parameter& p : J.parameters[T])
-        given.push_back(p.value);
-      starts.push_back(given);
-    }
-    for (const double scale : {0.3, 1.0, 3.0}) {
-      const double fs = std::max(scale * dissipation / (4.0 * hi.amplitude), 1e-300);
-      if (term == joints::Term::jenkins) starts.push_back({std::max(k_small, 1e-300), fs});
-      if (term == joints::Term::iwan)
-        for (const double chi : {-0.6, -0.2})
-          starts.push_back({3.0 * fs, std::max(k_small, 1e-300), chi, 0.1});
-      if (term == joints::Term::gap)
-        starts.push_back(
-            {scale * lo.amplitude, std::max(gained > 0.0 ? 2.0 * gained : std::abs(hi.Z), 1e-300)});
-    }
     double best_cost = std::numeric_limits<double>::infinity();
-    Eigen::VectorXd best;
-    for (const auto& s : starts) {
-      Eigen::VectorXd u(np), r, rn;
-      for (Eigen::Index p = 0; p < np; ++p) {
-        const std::size_t q = static_cast<std::size_t>(p);
-        const bool keep = !free[q] && J.parameters.size() > T;
-        u(p) = parameter_to_u(info[q], keep ? J.parameters[T][q].value : s[q]);
-      }
-      if (!residual(u, r)) continue;
-      double cost = r.squaredNorm(), mu = 1e-2;
-      for (int it = 0; it < 60; ++it) {
-        Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(r.size(), np);
-        for (Eigen::Index p = 0; p < np; ++p) {
-          if (!free[static_cast<std::size_t>(p)]) continue;
-          const double h = 1e-6 * std::max(1.0, std::abs(u(p)));
-          Eigen::VectorXd up = u;
-          up(p) += h;
-          if (residual(up, rn)) {
-            Jm.col(p) = (rn - r) / h;
-          } else {
-            up(p) = u(p) - h;
-            if (residual(up, rn)) Jm.col(p) = (r - rn) / h;
-          }
-        }
-        const Eigen::MatrixXd A = Jm.transpose() * Jm;
-        const Eigen::VectorXd g = Jm.transpose() * r;
-        bool accepted = false;
-        for (int tries = 0; tries < 10 && !accepted; ++tries) {
-          Eigen::MatrixXd M = A;
-          M.diagonal().array() += mu * (1.0 + A.diagonal().array());
-          const Eigen::VectorXd next = u - M.ldlt().solve(g);
-          if (next.allFinite() && residual(next, rn) && rn.squaredNorm() < cost) {
-            const double gain = (cost - rn.squaredNorm()) / cost;
-            u = next, r = rn, cost = rn.squaredNorm(), mu = std::max(mu / 10.0, 1e-10);
-            accepted = true;
-            if (gain < 1e-12) it = 1000;
-          } else {
-            mu *= 10.0;
-          }
-        }
-        if (!accepted) break;
-      }
-      (void)residual(u, r); // r at u, trial's parameters too
-      if (r.squaredNorm() < best_cost) best_cost = r.squaredNorm(), best = u;
-    }
+    const Eigen::VectorXd best = best_fit(J, T, points, k_open, c_open, best_cost);
     if (best.size() == 0) {
       start.status = fem::Status::failure(
           fem::Status::Code::not_converging,

@@ -37,6 +37,24 @@ double joint_amplitude(const Measurement& m, const joints::Joint& joint);
 double parameter_to_u(const joints::ParameterInfo& info, double p);
 double parameter_from_u(const joints::ParameterInfo& info, double u);
 
+/// One test's equivalent dynamic stiffness of a joint: Z = k_eq + iω c_eq of the linear spring
+/// and damper that reproduce its force's fundamental at the amplitude of its deformation's (m),
+/// ω in rad/s. π a² Im Z is the joint's dissipation per cycle there (J).
+struct EquivalentStiffness {
+  double amplitude = 0.0, omega = 0.0;
+  std::complex<double> Z;
+};
+
+/// The describing-function fit alone (step 2, as describing_function_start() does it): term
+/// `term` of `joint` (its fixed parameters held) fitted to the points, with the joint's own k and
+/// c (`k_open`, `c_open`) taken by least squares. Returns the joint with the term's parameters
+/// set (given, not fixed); `note` gets the line describing_function_start() adds. Throws
+/// std::invalid_argument naming the joint when there are no points, no start fits, or the fit
+/// leaves a parameter's range (the tests may not reach the term's regime).
+joints::Joint fit_describing_function(const joints::Joint& joint, std::size_t term,
+                                      std::vector<EquivalentStiffness> points, bool k_open,
+                                      bool c_open, std::string& note);
+
 /// Output error identifies one parametric term a joint at a time: throws std::invalid_argument
 /// naming the joint and its terms when a joint has two or more whose parameters are not all
 /// fixed.

@@ -684,6 +684,61 @@ TEST_F(CliTest, DiscoverTakesMultisineRecordsAndNamesAHiddenCubicStiffness) {
   EXPECT_TRUE(j["at_noise_level"].get<bool>());
 }
 
+TEST_F(CliTest, DiscoverNamesAHiddenJenkinsSliderFromASteppedSineTable) {
+  // A stepped-sine table of the model with a Jenkins slider at the tip (kt = 5000 N/m, fs = 5 N:
+  // it slips at 1 mm, below every test's amplitude), 1 % noise; discovery from k and c alone.
+  const fs::path truth = dir() / "jenkins.toml", start = dir() / "linear_j.toml";
+  test::write_text(truth, test::replaced(test::cantilever_toml(),
+                                         "terms = [\"k\", \"c\", \"k3\"]\n"
+                                         "values = { k = 4800.0, c = 20.0, k3 = 1.6e8 }\n",
+                                         "terms = [\"k\", \"c\", \"jenkins\"]\n"
+                                         "values = { k = 4800.0, c = 20.0, \"jenkins.kt\" = "
+                                         "5000.0, \"jenkins.fs\" = 5.0 }\n"));
+  test::write_text(start, linear_start_toml());
+  const fs::path data = dir() / "jenkins_data", out = dir() / "jenkins_out";
+  const Outcome sim =
+      jointid({"simulate", truth.string(), "--force", "7:uy", "--freq", "2,2.5,3,3.5,4,4.5,5",
+               "--amplitude", "10,40,80", "--table", "--steps-per-period", "1024", "--noise",
+               "0.01", "-o", data.string()},
+              dir());
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const Outcome run = jointid({"discover", start.string(), (data / "stepped_sine.csv").string(),
+                               "--harmonics", "1", "--no-plot", "-o", out.string()},
+                              dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("jenkins at 'tip'"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("jenkins.fs"), std::string::npos) << run.out;
+  const json j = json::parse(test::read_text(out / "discovery.json"));
+  // The first step names it (the library's tests check that nothing else is added; a table's
+  // noise level is unknown, and what is left at 1e-4 may buy a small term).
+  ASSERT_GE(j["steps"].size(), 1u) << j["steps"].dump();
+  const json& step = j["steps"][0];
+  EXPECT_EQ(step["joint"], "tip");
+  EXPECT_EQ(step["term"], "jenkins");
+  EXPECT_FALSE(step.contains("value")); // its parameters are the result
+  ASSERT_EQ(step["parameters"].size(), 2u);
+  const std::vector<std::pair<std::string, double>> truths{{"kt", 5000.0}, {"fs", 5.0}};
+  for (std::size_t p = 0; p < truths.size(); ++p) {
+    const json& q = step["parameters"][p];
+    EXPECT_EQ(q["name"], truths[p].first);
+    ASSERT_TRUE(q["determined"].get<bool>()) << q.dump();
+    // The interval holds the truth, within 1 % for the harmonic balance's truncation.
+    EXPECT_LE(q["ci95"][0].get<double>(), 1.01 * truths[p].second) << q.dump();
+    EXPECT_GE(q["ci95"][1].get<double>(), 0.99 * truths[p].second) << q.dump();
+  }
+  EXPECT_EQ(step["parameters"][1]["unit"], "N");
+  // The final model carries the parameters too, and the diagnosis says what the data show.
+  const json& tip = j["final_model"]["joints"][0];
+  EXPECT_EQ(tip["terms"][2]["term"], "jenkins");
+  EXPECT_EQ(tip["terms"][2]["parameters"].size(), 2u);
+  ASSERT_EQ(j["diagnosis"]["behaviour"].size(), 1u);
+  EXPECT_EQ(j["diagnosis"]["behaviour"][0]["behaviour"], "macroslip");
+  EXPECT_EQ(j["diagnosis"]["behaviour"][0]["tests"].size(), 21u);
+  const std::string report = test::read_text(out / "report.md");
+  EXPECT_NE(report.find("jenkins at 'tip'"), std::string::npos);
+  EXPECT_NE(report.find("fs = "), std::string::npos);
+}
+
 TEST_F(CliTest, SimulateWritesASteppedSineTableThatIdentifyReads) {
   // Fundamentals of force and drive-point acceleration only, as many labs keep them.
   const fs::path out = dir() / "table";

@@ -205,6 +205,91 @@ INSTANTIATE_TEST_SUITE_P(AtTheTip, HiddenTerm,
                            return std::string(joints::term_name(info.param.term));
                          });
 
+// A term with named parameters hidden at the tip beside k and c: discovery, told only k and c,
+// must name it (nothing else added), give its parameters with intervals that hold the truth
+// where the tests determine them, and say in words what the data show of the joint.
+struct HiddenParametric {
+  Term term;
+  std::vector<double> parameters; ///< in the table's order
+  std::vector<double> levels;
+  bool table;            ///< stepped-sine fundamentals (noise unknown), else records
+  std::string behaviour; ///< what the diagnosis must say of the tip
+};
+
+class HiddenParametricTerm : public ::testing::TestWithParam<HiddenParametric> {};
+
+TEST_P(HiddenParametricTerm, IsNamedWithItsParametersAndTheDiagnosisSaysWhatItDoes) {
+  const HiddenParametric h = GetParam();
+  Data d;
+  joints::Joint truth = joint("tip", 7, {Term::k, Term::c, h.term}, {4800.0, 20.0, 1.0});
+  truth.parameters.resize(3);
+  truth.set_parameters(2, h.parameters);
+  d.truth = {truth};
+  d.levels = h.levels;
+  d.table = h.table;
+  discover::Options o;
+  if (h.table) o.harmonics = {1};
+  const discover::Result r =
+      discover::discover(frf::Substructure(d.model), {linear_start("tip", 7)}, measure(d), o);
+  SCOPED_TRACE(describe(r));
+  ASSERT_EQ(r.steps.size(), 1u);
+  ASSERT_TRUE(r.steps[0].added.term.has_value());
+  EXPECT_EQ(*r.steps[0].added.term, h.term);
+  EXPECT_EQ(r.steps[0].added.joint, "tip");
+  EXPECT_EQ(r.states.back().damping_scale, 1.0);
+  EXPECT_LT(r.gap.back(), 0.1 * r.gap.front());
+  // Its parameters: every determined one's 95 % interval holds the truth, within a margin for
+  // the harmonic balance's truncation of the loop's corners (1 %); some are determined.
+  const auto& params = r.steps[0].added.parameters;
+  ASSERT_EQ(params.size(), h.parameters.size());
+  int determined = 0;
+  for (std::size_t p = 0; p < params.size(); ++p) {
+    if (!params[p].determined) {
+      EXPECT_TRUE(std::isnan(params[p].value)) << params[p].name; // never a value then
+      continue;
+    }
+    ++determined;
+    const double truth_p = h.parameters[p], margin = 0.01 * std::abs(truth_p);
+    EXPECT_LE(params[p].ci_low - margin, truth_p) << params[p].name << " = " << params[p].value;
+    EXPECT_GE(params[p].ci_high + margin, truth_p) << params[p].name << " = " << params[p].value;
+  }
+  EXPECT_GT(determined, 0);
+  if (std::isfinite(std_of(r, "tip", Term::k))) {
+    EXPECT_NEAR(value_of(r, "tip", Term::k), 4800.0, 0.05 * 4800.0);
+  } else { // an iwan in microslip: k apart from kt is not determined, their sum is
+    ASSERT_EQ(h.term, Term::iwan);
+    const auto& tip = r.states.back().joints.front();
+    const double kt = tip.parameter(static_cast<std::size_t>(tip.term_index(Term::iwan)), "kt");
+    EXPECT_NEAR(value_of(r, "tip", Term::k) + kt, 4800.0 + h.parameters[1], 0.02 * 7800.0);
+  }
+  // The diagnosis, from the equivalent stiffness and damping of each test alone.
+  EXPECT_EQ(r.diagnosis.nature, joints::is_hysteretic(h.term) ? "hysteretic" : "conservative");
+  ASSERT_FALSE(r.diagnosis.behaviour.empty());
+  const discover::JointBehaviour& b = r.diagnosis.behaviour.front();
+  EXPECT_EQ(b.joint, "tip");
+  EXPECT_EQ(b.behaviour, h.behaviour) << b.finding << [&] {
+    std::ostringstream o;
+    o << "\nslope " << b.slope << " share " << b.hysteretic_share << "\n";
+    for (std::size_t i = 0; i < b.amplitude.size(); ++i)
+      o << b.frequency_hz[i] << " " << b.amplitude[i] << " D " << b.dissipation[i] << " k "
+        << b.stiffness[i] << "\n";
+    return o.str();
+  }();
+  EXPECT_FALSE(b.model_amplitude.empty());
+}
+
+// Jenkins: slips at 1 mm (fs / kt), below every test's amplitude: Coulomb sliding. Iwan: its
+// largest slip displacement phi_max = 8.5 cm beyond every amplitude: microslip. Gap: contact at
+// ±1 cm, inside the tests' span (1 mm … 5 cm).
+INSTANTIATE_TEST_SUITE_P(
+    AtTheTip, HiddenParametricTerm,
+    ::testing::Values(
+        HiddenParametric{Term::jenkins, {5000.0, 5.0}, {10.0, 40.0, 80.0}, true, "macroslip"},
+        HiddenParametric{
+            Term::iwan, {100.0, 3000.0, -0.5, 0.1}, {10.0, 40.0, 80.0}, false, "microslip"},
+        HiddenParametric{Term::gap, {0.01, 5000.0}, {10.0, 40.0, 80.0}, true, "clearance"}),
+    [](const auto& info) { return std::string(joints::term_name(info.param.term)); });
+
 TEST(Discover, ThroughMeasuredFrfsAsThroughTheModel) {
   // The substructure given by its measured FRF at the tip (sampled from the model every
   // 0.005 Hz up to 80 Hz: the tests at 2–5 Hz lie on the lines), the cubic stiffness hidden.
