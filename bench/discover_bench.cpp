@@ -1,8 +1,10 @@
 // Times model discovery on the paper's cantilever (21 sine tests: 2–5 Hz × 3 levels, made by time
 // integration with 1 % noise) with a hidden cubic stiffness, and with a hidden cubic stiffness
-// and Coulomb friction; discovery on a stepped-sine table of 492 tests (a bolted beam's stand-in,
-// read from its CSV file as `jointid discover` reads it); and one steady-state point by harmonic
-// balance against time integration. Results: docs/benchmarks.md.
+// and Coulomb friction; with a hidden jenkins, iwan or gap (each with the library's terms as
+// candidates, and with the coefficient terms alone: what the parametric candidates cost);
+// discovery on a stepped-sine table of 492 tests (a bolted beam's stand-in, read from its CSV
+// file as `jointid discover` reads it); and one steady-state point by harmonic balance against
+// time integration. Results: docs/benchmarks.md.
 #include "discover/discover.hpp"
 #include "fem/time_integration.hpp"
 #include "identify/sine_tests.hpp"
@@ -14,6 +16,7 @@
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -82,6 +85,38 @@ void BM_DiscoverHiddenCubicStiffnessAndFriction(benchmark::State& state) {
   o.curve_points = static_cast<int>(state.range(0));
   for (auto _ : state)
     benchmark::DoNotOptimize(discover::discover(d.sub, {d.start}, d.k3fc, o));
+}
+
+// A parametric term hidden at the tip beside k and c (the discover tests' values): range(0) 0
+// jenkins (kt 5000 N/m, fs 5 N), 1 iwan (fs 100 N, kt 3000 N/m, chi -0.5, beta 0.1), 2 gap
+// (delta 1 cm, kg 5000 N/m); made once each.
+const std::vector<identify::Measurement>& parametric_tests(int which) {
+  static std::map<int, std::vector<identify::Measurement>> made;
+  auto& m = made[which];
+  if (m.empty()) {
+    const Term term = which == 0 ? Term::jenkins : which == 1 ? Term::iwan : Term::gap;
+    const std::vector<double> parameters = which == 0 ? std::vector<double>{5000.0, 5.0}
+                                           : which == 1
+                                               ? std::vector<double>{100.0, 3000.0, -0.5, 0.1}
+                                               : std::vector<double>{0.01, 5000.0};
+    joints::Joint truth = joint({Term::k, Term::c, term}, {4800.0, 20.0, 1.0});
+    truth.parameters.resize(3);
+    truth.set_parameters(2, parameters);
+    m = tests(data().sub, truth, {10.0, 40.0, 80.0});
+  }
+  return m;
+}
+
+// range(1): 1 every term of the library as a candidate, 0 the coefficient terms alone.
+void BM_DiscoverHiddenParametricTerm(benchmark::State& state) {
+  const Data& d = data();
+  const auto& measured = parametric_tests(static_cast<int>(state.range(0)));
+  discover::Options o;
+  o.curve_points = 0;
+  if (state.range(1) == 0)
+    o.terms.assign(joints::coefficient_terms.begin(), joints::coefficient_terms.end());
+  for (auto _ : state)
+    benchmark::DoNotOptimize(discover::discover(d.sub, {d.start}, measured, o));
 }
 
 // The bolted beam's stepped-sine table (tests/support/bolted_beam.hpp: a hidden softening
@@ -188,6 +223,10 @@ BENCHMARK(BM_DiscoverHiddenCubicStiffness)
 BENCHMARK(BM_DiscoverHiddenCubicStiffnessAndFriction)
     ->Arg(0)
     ->Arg(30)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+BENCHMARK(BM_DiscoverHiddenParametricTerm)
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 BENCHMARK(BM_DiscoverSteppedSineTable)->Arg(30)->Arg(0)->Unit(benchmark::kSecond)->Iterations(1);

@@ -102,5 +102,6 @@ std::unique_ptr<Command> response_command(CLI::App& parent);
 std::unique_ptr<Command> design_command(CLI::App& parent);
 std::unique_ptr<Command> compare_command(CLI::App& parent);
 std::unique_ptr<Command> modal_fit_command(CLI::App& parent);
+std::unique_ptr<Command> backbone_command(CLI::App& parent);
 
 } // namespace jointid::cli

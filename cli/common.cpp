@@ -4,7 +4,9 @@
 
 #include "frf/time_model.hpp"
 #include "identify/fit.hpp"
+#include "identify/parametric.hpp"
 #include "io/files.hpp"
+#include "joints/basis.hpp"
 
 #include <fmt/format.h>
 
@@ -127,16 +129,33 @@ Model::Model(const fs::path& path, Engine engine)
   use_engine(sub, engine);
 }
 
-void check_identifiable(const Model& model) {
+void check_identifiable(const Model& model, Parametric how) {
   const auto& joints = model.file.joints;
+  const auto& lines = model.file.joint_lines;
   for (std::size_t i = 0; i < joints.size(); ++i) {
+    const int line = i < lines.size() && lines.size() == joints.size() ? lines[i] : 0;
+    const std::string where =
+        line > 0 ? fmt::format("{}:{}: ", model.name(), line) : model.name() + ": ";
+    const joints::Joint& j = joints[i];
     try {
-      identify::check_identifiable({joints[i]});
+      if (how == Parametric::output_error) {
+        identify::check_one_parametric_term({j});
+        continue;
+      }
+      if (how == Parametric::needs_output_error)
+        for (std::size_t t = 0; t < j.terms.size(); ++t)
+          if (joints::has_parameters(j.terms[t]) && !j.fixed[t]) {
+            const std::string name(joints::term_name(j.terms[t]));
+            throw std::invalid_argument(fmt::format(
+                "joint '{}': term '{}' is not fixed: its parameters ({}) enter the joint's force "
+                "non-linearly and need --output-error (a describing-function start, then output "
+                "error); or, to identify the joint's other terms with this one known, give all "
+                "of them in 'values' and list \"{}\" in 'fixed'",
+                j.name, name, joints::parameter_names(j.terms[t]), name));
+          }
+      identify::check_identifiable({j});
     } catch (const std::invalid_argument& e) {
-      const auto& lines = model.file.joint_lines;
-      const int line = i < lines.size() && lines.size() == joints.size() ? lines[i] : 0;
-      throw io::Error(line > 0 ? fmt::format("{}:{}: {}", model.name(), line, e.what())
-                               : fmt::format("{}: {}", model.name(), e.what()));
+      throw io::Error(where + e.what());
     }
   }
 }

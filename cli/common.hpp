@@ -74,10 +74,17 @@ struct Model {
   frf::Substructure sub;
 };
 
-/// identify (and its output error) and design identify the coefficients of the terms k … fc: a
-/// joint whose parametric term (jenkins, iwan, gap) is not fixed is refused, io::Error naming
-/// the model file, the joint's line and the term's parameters.
-void check_identifiable(const Model& model);
+/// How a command takes a joint's parametric term (jenkins, iwan, gap) whose parameters are not
+/// all fixed.
+enum class Parametric {
+  fixed_only,         ///< refused (the equation error takes it only as a known force)
+  needs_output_error, ///< refused, saying that `identify --output-error` identifies it
+  output_error,       ///< identified by output error: one such term a joint
+};
+
+/// The joints' terms as the command identifies them; io::Error naming the model file, the
+/// joint's line, the term and its parameters otherwise.
+void check_identifiable(const Model& model, Parametric how = Parametric::fixed_only);
 
 /// Runs `compute()`; a std::invalid_argument from the library (the model's data or the
 /// options refused) becomes io::Error after the model file's name, its reason intact.

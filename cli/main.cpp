@@ -77,9 +77,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "jointid " JOINTID_VERSION);
   app.require_subcommand(1);
   std::vector<std::unique_ptr<cli::Command>> commands;
-  for (auto* add : {cli::modes_command, cli::frf_command, cli::simulate_command,
-                    cli::identify_command, cli::discover_command, cli::response_command,
-                    cli::design_command, cli::compare_command, cli::modal_fit_command})
+  for (auto* add :
+       {cli::modes_command, cli::frf_command, cli::simulate_command, cli::identify_command,
+        cli::discover_command, cli::response_command, cli::design_command, cli::compare_command,
+        cli::modal_fit_command, cli::backbone_command})
     commands.push_back(add(app));
 
   try {

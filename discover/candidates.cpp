@@ -1,7 +1,9 @@
 #include "discover/candidates.hpp"
 
+#include "discover/diagnosis.hpp"
 #include "discover/selection.hpp"
 #include "fem/minimise.hpp"
+#include "identify/parametric.hpp"
 
 #include <fmt/format.h>
 
@@ -67,6 +69,63 @@ Outcome consider_term(const Problem& problem, const State& state, const Simulato
     State s = problem.evaluate(joints, sim);
     s.fit = fit;
     judge(c, s);
+    return {std::move(c), std::move(s)};
+  } catch (const std::invalid_argument& e) {
+    return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
+  }
+}
+
+Outcome consider_parametric(const Problem& problem, const State& state, const Simulator& sim,
+                            const std::string& joint, joints::Term term) {
+  Candidate c;
+  c.joint = joint;
+  c.term = term;
+  std::vector<joints::Joint> joints = state.joints;
+  std::size_t jj = 0;
+  while (joints[jj].name != joint)
+    ++jj;
+  joints::Joint& J = joints[jj];
+  const std::size_t T = J.terms.size();
+  J.terms.push_back(term);
+  J.values.push_back(1.0);
+  J.fixed.push_back(false);
+  if (!J.given.empty()) J.given.push_back(false);
+  J.parameters.resize(T + 1);
+  const auto& info = joints::term_info(term).parameters;
+  J.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+  for (joints::Parameter& p : J.parameters[T])
+    p.given = false; // no start of its own: the describing-function fit's
+  try {
+    // 1. Each test's equivalent stiffness of the joint, less the joint's other terms (but k and
+    // c, which the fit takes with it) at the state's values.
+    std::vector<identify::EquivalentStiffness> points =
+        equivalent_stiffness(problem, state, sim, jj);
+    const joints::Joint& now = state.joints[jj];
+    const auto other = [&now](std::size_t t) {
+      return !((now.terms[t] == joints::Term::k || now.terms[t] == joints::Term::c) &&
+               !now.fixed[t]);
+    };
+    for (auto& p : points)
+      p.Z -= joint_describing_function(now, p.amplitude, p.omega, other);
+    const int k = now.term_index(joints::Term::k), cc = now.term_index(joints::Term::c);
+    const bool k_open = k >= 0 && !now.fixed[static_cast<std::size_t>(k)];
+    const bool c_open = cc >= 0 && !now.fixed[static_cast<std::size_t>(cc)];
+    // 2. Its parameters from the describing function fitted to them.
+    std::string note;
+    J = identify::fit_describing_function(J, T, std::move(points), k_open, c_open, note);
+    // 3. The coefficient terms by equation error with its force known, then every non-fixed
+    // term and parameter by output error.
+    const identify::FitResult fit = problem.identify(joints, sim, problem.all_tests());
+    joints = fit.identified(joints);
+    State s = problem.evaluate(joints, sim);
+    s.fit = fit;
+    judge(c, s);
+    // Its parameters from the start have no intervals: only output error (finalists) gives them.
+    for (auto& p : c.parameters) {
+      p.fixed = p.determined = false;
+      p.std = p.ci_low = p.ci_high = std::numeric_limits<double>::quiet_NaN();
+    }
+    if (c.rejected.empty()) c.rejected = interval_problem(c);
     return {std::move(c), std::move(s)};
   } catch (const std::invalid_argument& e) {
     return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
@@ -190,18 +249,28 @@ std::vector<std::function<Outcome()>> candidate_jobs(const Problem& problem, con
   std::vector<std::function<Outcome()>> jobs;
   if (!values_fitted) jobs.push_back([=] { return consider_refit(*p, *s, *sim); });
   for (const auto& j : state.joints)
-    for (joints::Term t : problem.options().terms)
+    for (joints::Term t : problem.options().terms) {
       // An even force has no fundamental for a sinusoidal deformation: from the fundamentals
       // alone (tables) it cannot be identified (Preconditions::harmonics).
-      if (j.term_index(t) < 0 && (can.harmonics || !joints::term_info(t).even))
+      if (j.term_index(t) >= 0 || (!can.harmonics && joints::term_info(t).even)) continue;
+      if (!joints::has_parameters(t)) {
         jobs.push_back([=, name = j.name] { return consider_term(*p, *s, *sim, name, t); });
+        continue;
+      }
+      // One parametric term identified at a time per joint (identify/parametric.hpp).
+      bool open = false;
+      for (std::size_t u = 0; u < j.terms.size(); ++u)
+        open = open || (joints::has_parameters(j.terms[u]) && !j.fixed[u]);
+      if (!open)
+        jobs.push_back([=, name = j.name] { return consider_parametric(*p, *s, *sim, name, t); });
+    }
   if (can.damping_scale) jobs.push_back([=] { return consider_damping(*p, *s); });
   // What the library cannot add: a term of the model whose coefficient changes between tests
   // (with four tests or more: fewer leave too little to tell a trend from a fit).
   if (can.per_test_values)
     for (const auto& j : state.joints)
       for (std::size_t t = 0; t < j.terms.size(); ++t)
-        if (!j.fixed[t])
+        if (!j.fixed[t] && !joints::has_parameters(j.terms[t])) // (a coefficient per test)
           jobs.push_back([=, name = j.name, term = j.terms[t]] {
             return consider_variation(*p, *s, *sim, name, term);
           });

@@ -24,6 +24,13 @@ Outcome consider_refit(const Problem& problem, const State& state, const Simulat
 /// `term` added at `joint`, every non-fixed term identified again by equation error.
 Outcome consider_term(const Problem& problem, const State& state, const Simulator& sim,
                       const std::string& joint, joints::Term term);
+/// The parametric `term` (jenkins, iwan, gap) added at `joint`: its parameters started from a
+/// describing-function fit to each test's equivalent stiffness of the joint (less its other
+/// terms), the coefficient terms by equation error with its force known. Its parameters get
+/// intervals only from output error: the best parametric candidate of a step is among the
+/// finalists (selection.hpp), the others stay undetermined.
+Outcome consider_parametric(const Problem& problem, const State& state, const Simulator& sim,
+                            const std::string& joint, joints::Term term);
 /// The joint's `term` identified from each test alone (every other term held at the state's
 /// value), and every test simulated at its own value: does the coefficient change between
 /// tests, beyond the noise, and with what? Admissible when the values disagree

@@ -119,6 +119,9 @@ std::pair<std::vector<int>, std::vector<double>> cluster(const std::vector<doubl
 std::vector<ResponseCurve> curves(const Problem& problem, const State& state) {
   std::vector<ResponseCurve> out;
   if (problem.options().curve_points < 2) return out;
+  // A periodic broadband test is at no one frequency: there is no sine sweep through it.
+  for (const auto& m : problem.tests())
+    if (m.kind == identify::RecordKind::periodic) return out;
   Sweeps s;
   for (const auto& m : problem.tests())
     s.frequency.push_back(m.frequency_hz), s.level.push_back(identify::force_level(m));

@@ -17,7 +17,7 @@ std::pair<std::vector<int>, std::vector<double>> cluster(const std::vector<doubl
 /// DOF of the group's first test, by continuation from point to point; swept up, and down where
 /// that differs by more than 1 % (another branch). Options::curve_points each, or a point
 /// between every two tests of the group where it has more (at most four times as many). None
-/// when Options::curve_points < 2.
+/// when Options::curve_points < 2, or when a test is periodic (it is at no one frequency).
 std::vector<ResponseCurve> curves(const Problem& problem, const State& state);
 
 } // namespace jointid::discover::detail

@@ -5,6 +5,11 @@
 /// harmonics point to an asymmetric joint force; in sentences.
 #include "discover/gap.hpp"
 #include "discover/preconditions.hpp"
+#include "discover/problem.hpp"
+#include "identify/parametric.hpp"
+
+#include <complex>
+#include <functional>
 
 #include <string>
 #include <vector>
@@ -38,5 +43,32 @@ bool changes_with_level(double linear_criterion, double nonlinear_criterion, int
 /// (in standard deviations of its noise, or relatively when the noise is unknown), in a
 /// sentence saying whether the noise explains it. Empty when no pair qualifies.
 std::vector<std::string> level_evidence(const std::vector<identify::Measurement>& tests);
+
+/// Each test's equivalent stiffness of joint `joint` of the state (JointBehaviour): the joint as
+/// k + c identified from that test alone at harmonic 1, the other joints held at the state's
+/// values. Tests that do not determine it alone are skipped; `sources` (if given) gets the
+/// tests used.
+std::vector<identify::EquivalentStiffness>
+equivalent_stiffness(const Problem& problem, const State& state, const Simulator& sim,
+                     std::size_t joint, std::vector<int>* used = nullptr);
+
+/// The describing function N(a) = G₁/a of the joint's terms that `include` keeps (all when
+/// empty), under y = a cos ωt: its equivalent stiffness k_eq + iω c_eq at that amplitude.
+/// A parametric term without its parameters is left out.
+std::complex<double>
+joint_describing_function(const joints::Joint& joint, double amplitude, double omega,
+                          const std::function<bool(std::size_t)>& include = {});
+
+/// The dissipation per cycle π a² Im N(a) of the joint's force, J.
+double joint_dissipation(const joints::Joint& joint, double amplitude, double omega);
+
+/// What the points show (JointBehaviour's fits and words), `tests` their sources.
+JointBehaviour behaviour(const std::string& joint,
+                         const std::vector<identify::EquivalentStiffness>& points,
+                         const std::vector<std::string>& tests);
+
+/// The model lines of a behaviour: D of the start's and the final model's joint over the
+/// measured amplitudes (and a little beyond), at the tests' median frequency.
+void model_lines(JointBehaviour& behaviour, const joints::Joint& start, const joints::Joint& last);
 
 } // namespace jointid::discover::detail

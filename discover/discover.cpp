@@ -229,6 +229,14 @@ private:
       out.diagnosis =
           diagnose(problem_.compared(), problem_.tests(), state, additions,
                    choice.outside ? &ranking[*choice.outside] : nullptr, problem_.preconditions());
+      // What the tests show of each joint's force against its amplitude: slip or clearance.
+      for (std::size_t j = 0; j < state.joints.size(); ++j) {
+        std::vector<int> used;
+        const auto points = equivalent_stiffness(problem_, state, current, j, &used);
+        JointBehaviour b = behaviour(state.joints[j].name, points, problem_.sources(used));
+        if (!b.finding.empty()) out.diagnosis.findings.push_back(b.finding);
+        out.diagnosis.behaviour.push_back(std::move(b));
+      }
     }
     Step s;
     for (std::size_t i : order)
@@ -256,6 +264,8 @@ private:
     warn_left_out(out, state,
                   "the model after step " + std::to_string(out.steps.size() + 1) + " (+ " +
                       s.added.name() + ")");
+    for (const std::string& said : state.fit.identifiability)
+      out.warnings.push_back(fmt::format("step {}: {}", out.steps.size() + 1, said));
     if (!s.added.determined())
       out.warnings.push_back(fmt::format("the 95 % interval of {} added in step {} could not be "
                                          "determined: its value is not a result",
@@ -326,6 +336,10 @@ private:
       out.comparisons.push_back(comparisons(problem_.tests(), compared.harmonics, s));
       out.curves.push_back(curves(problem_, s));
     }
+    for (JointBehaviour& b : out.diagnosis.behaviour)
+      for (std::size_t j = 0; j < state.joints.size(); ++j)
+        if (state.joints[j].name == b.joint && j < out.states.front().joints.size())
+          model_lines(b, out.states.front().joints[j], state.joints[j]);
     out.at_noise_level = at_noise_level(compared, out.states.back());
     out.chi2_per_value = out.states.back().chi2 / misfit(compared, state.X, state.failed).values;
     if (compared.noise_known) out.chi2_by_harmonic = chi2_by_harmonic(compared, state.X);
@@ -347,22 +361,6 @@ private:
 
 Result discover(const frf::Substructure& substructure, const std::vector<joints::Joint>& start,
                 const std::vector<identify::Measurement>& tests, const Options& options) {
-  for (const joints::Term t : options.terms)
-    if (joints::has_parameters(t))
-      throw std::invalid_argument("discover: term '" + std::string(joints::term_name(t)) +
-                                  "' is not a candidate: the terms with named parameters (" +
-                                  "jenkins, iwan, gap) are simulated, and may be held fixed in "
-                                  "the model, but are not yet discovered");
-  // A periodic broadband test would need a harmonic balance over every line of its period (or a
-  // time integration per candidate): not supported, said with the test's name.
-  for (const auto& m : tests)
-    if (m.kind == identify::RecordKind::periodic)
-      throw std::invalid_argument(
-          m.source + ": a periodic broadband test (lines every " +
-          fmt::format("{:.6g}", m.frequency_hz) +
-          " Hz): discover re-simulates each test by the harmonic balance of one excitation "
-          "frequency, which this test is not; give discover sine tests, stepped-sine tables or "
-          "sweeps (jointid identify takes periodic records)");
   // Tests left out (too few steady periods) are passed over, with their reason.
   std::vector<std::string> left_out;
   const std::vector<identify::Measurement> kept = identify::usable(tests, left_out);

@@ -10,6 +10,16 @@
 ///
 ///     gap = sqrt( Σ |X_meas − X_sim|² / Σ |X_meas|² )       (sums over tests, channels, k)
 ///
+/// A periodic broadband test (a multisine; identify/periodic.hpp) is compared at its lines
+/// (Measurement::lines: the excited lines in the band and those where the joints put response
+/// out of the noise), its noise per line from the scatter of its periods. It is re-simulated by
+/// the harmonic balance at its line spacing 1/T, driven by the measured force at the lines that
+/// drive it (its excited lines, and any other out of the force's noise), to its highest line or
+/// max(K, 10) times its highest driven line where that is higher (K the largest harmonic
+/// compared: the joints' harmonics and combinations); the simulation's error from twice that.
+/// Its "harmonics" judged on their own (the stop rule's χ² per harmonic) are two groups: the
+/// excited lines, and the others.
+///
 /// The noise level is what a perfect model would leave: the same formula with the variance of
 /// each measured harmonic (identify::measure estimates it from the record itself) plus that of
 /// the measured force's noise propagated through the model; it is unknown for stepped-sine
@@ -53,6 +63,7 @@
 #include "joints/joint.hpp"
 
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,10 +75,11 @@ struct Options {
   std::vector<int> harmonics{1, 2, 3};
   /// The re-simulations' harmonic balance.
   frf::HarmonicBalanceOptions balance{.harmonics = 15};
-  /// Terms tried at every joint (those a joint already has are skipped): the coefficient terms
-  /// k … fc; the parametric ones (jenkins, iwan, gap) are not candidates yet (refused).
-  std::vector<joints::Term> terms{joints::coefficient_terms.begin(),
-                                  joints::coefficient_terms.end()};
+  /// Terms tried at every joint (those a joint already has are skipped): every term of the
+  /// library. A parametric one (jenkins, iwan, gap) is started by a describing-function fit to
+  /// each test's equivalent stiffness of the joint and refined by output error at once (its
+  /// parameters enter non-linearly: no equation-error screen); one per joint at a time.
+  std::vector<joints::Term> terms{joints::all_terms.begin(), joints::all_terms.end()};
   /// Also try a scale factor on the substructure's modal damping (a linear model error).
   bool substructure_damping = true;
   int max_steps = 6;
@@ -76,7 +88,9 @@ struct Options {
   double min_explained = 0.05;
   /// Cross-validation leaves one test out up to 30 tests, and uses this many folds above.
   int folds = 10;
-  /// Candidates refined by output error at each step (the best by the equation-error screen).
+  /// Candidates refined by output error at each step (the best by the equation-error screen),
+  /// and besides them the best parametric one where its describing-function start ranks among
+  /// the best finalists + 1.
   int finalists = 3;
   /// Points of each state's response curves for the report (0: none).
   int curve_points = 30;
@@ -114,11 +128,15 @@ struct Candidate {
   std::string name() const;   ///< "k3 at 'tip'", "substructure damping", "refit"
   std::string effect() const; ///< "cubic stiffness", "substructure damping", …
   bool linear() const;        ///< k, c, a refit or the damping scale
-  double value = 0.0;         ///< identified coefficient (SI), or the damping scale
+  double value = 0.0;         ///< identified coefficient (SI), or the damping scale; a
+                              ///< parametric term: 1 (its parameters are the result)
+  /// A parametric term (jenkins, iwan, gap): its parameters as identified, with their 95 %
+  /// intervals; an undetermined one (the tests do not separate it) has no value (NaN).
+  std::vector<identify::ParameterEstimate> parameters;
   double std = 0.0;
   double ci_low = 0.0, ci_high = 0.0;
   /// The 95 % interval is a result: finite, of non-zero width (false: "undetermined", never a
-  /// number ± 0).
+  /// number ± 0). A parametric term: some parameter is determined.
   bool determined() const;
   double gap = 0.0;       ///< after adding it
   double criterion = 0.0; ///< information criterion after adding it
@@ -159,11 +177,14 @@ struct Step {
   std::string finding;            ///< one sentence
 };
 
-/// The fundamental of one test at one channel, measured and simulated.
+/// The fundamental of one test at one channel, measured and simulated; a periodic test has one
+/// per excited line (its FRF over them: frequency_hz and force_phasor the line's; force the
+/// test's level, identify::force_level), and as "harmonics" the lines where only the joints put
+/// response, over the excited lines.
 struct Comparison {
   std::string test, channel;
   double frequency_hz = 0.0, force = 0.0;
-  std::complex<double> force_phasor;        ///< F_1 of its (first) force channel, N or N·m
+  std::complex<double> force_phasor;        ///< F_1 (or the line's) of its first force, N or N·m
   std::complex<double> measured, simulated; ///< X_1, m or rad
   double amplitude_error = 0.0;             ///< |X_sim| / |X_meas| − 1
   double phase_error_deg = 0.0;             ///< arg(X_sim / X_meas)
@@ -187,6 +208,39 @@ struct ResponseCurve {
   std::vector<bool> converged;                       ///< per point
 };
 
+/// What the tests show of one joint's force against the amplitude of its deformation, each test
+/// alone: the joint replaced by the linear spring and damper k_eq + iω c_eq that give its force's
+/// fundamental there (equation error at harmonic 1, the other joints held at the starting
+/// model's values). Its dissipation per cycle is D = π a² ω c_eq. On log axes, D grows with a
+/// power of the amplitude: 2 for viscous damping, 1 for Coulomb sliding (macroslip: D = 4 f a),
+/// 3 + χ (−1 < χ ≤ 0) for an Iwan joint in microslip; a clearance leaves D alone and stiffens the
+/// joint from the amplitude where contact is made.
+struct JointBehaviour {
+  std::string joint;
+  std::vector<std::string> tests;
+  std::vector<double> amplitude;    ///< |Y₁| of the deformation, m (rad)
+  std::vector<double> frequency_hz; ///< of the test
+  std::vector<double> dissipation;  ///< D per cycle, J
+  std::vector<double> stiffness;    ///< k_eq, N/m (N m/rad)
+  /// D fitted as π c ω a² + A a^s (c, A ≥ 0, s from a scan): the power s of the part that is not
+  /// viscous and that part's largest share of D over the tests (NaN: not fitted, too few tests
+  /// or amplitudes within 20 % of each other).
+  double slope = std::numeric_limits<double>::quiet_NaN();
+  double hysteretic_share = std::numeric_limits<double>::quiet_NaN();
+  /// k_eq at the largest amplitude relative to the smallest, − 1.
+  double stiffness_change = std::numeric_limits<double>::quiet_NaN();
+  /// A clearance's amplitude: where k_eq starts to rise (NaN: no clearance seen).
+  double contact_amplitude = std::numeric_limits<double>::quiet_NaN();
+  /// "microslip", "macroslip", "microslip to macroslip", "clearance", or empty (none of these).
+  std::string behaviour;
+  std::string finding; ///< in one sentence
+  /// Model lines: D per cycle (J) and k_eq of the starting and the final model's joint force at
+  /// `model_amplitude`, at `model_frequency_hz` (the tests' median).
+  std::vector<double> model_amplitude, start_dissipation, final_dissipation;
+  std::vector<double> start_stiffness, final_stiffness;
+  double model_frequency_hz = 0.0;
+};
+
 struct Diagnosis {
   /// Does the disagreement change with force level? Empty when nothing significant is found,
   /// or when the tests are all at one force level (they cannot tell).
@@ -196,13 +250,15 @@ struct Diagnosis {
   std::string joint;               ///< where it sits (joint name, or "substructure")
   std::string channel;             ///< the channel with the largest relative error
   double channel_error = 0.0;      ///< its relative error, ‖e‖/‖X_meas‖ over the tests
-  std::string nature;              ///< "conservative", "dissipative", or empty
+  std::string nature;              ///< "conservative", "dissipative", "hysteretic", or empty
   double conservative_explains = 0.0, dissipative_explains = 0.0;
   bool even_harmonics = false; ///< an unexplained 2nd harmonic, 5 × above the noise
   double even_content = 0.0;   ///< largest |X_meas − X_sim| at k = 2 over |X_1|
   /// The even harmonics point to an asymmetric joint force: k2 explains half the gap or more,
   /// or they appear in most tests (not in a few, as a symmetric system's lost symmetry would).
   bool asymmetric = false;
+  /// Per joint whose DOFs the tests measure: its dissipation and stiffness against amplitude.
+  std::vector<JointBehaviour> behaviour;
   std::vector<std::string> findings; ///< the diagnosis as sentences
 };
 

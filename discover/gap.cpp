@@ -17,12 +17,26 @@ Compared compared_values(const std::vector<identify::Measurement>& tests, int ha
   c.harmonics = harmonics;
   for (std::size_t i = 0; i < tests.size(); ++i) {
     const auto& m = tests[i];
+    const bool periodic = m.kind == identify::RecordKind::periodic;
     for (std::size_t j = 0; j < m.response_at.size(); ++j)
+      for (int k : periodic ? m.lines : std::vector<int>()) {
+        const bool excited = std::binary_search(m.excited_lines.begin(), m.excited_lines.end(), k);
+        Entry e{static_cast<int>(i), static_cast<int>(j), excited ? 1 : std::min(2, harmonics),
+                m.X(k, static_cast<Eigen::Index>(j)),
+                m.X_variance(k, static_cast<Eigen::Index>(j))};
+        e.row = k;
+        e.line = true;
+        c.entries.push_back(e);
+        c.values += 2;
+        c.measured2 += std::norm(e.measured);
+        if (!(e.variance > 0.0)) c.noise_known = false;
+      }
+    for (std::size_t j = 0; j < m.response_at.size() && !periodic; ++j)
       for (int k = 0; k <= harmonics; ++k) {
         if (!m.has_harmonic(k) || (k == 0 && !m.has_mean[j])) continue;
         c.entries.push_back({static_cast<int>(i), static_cast<int>(j), k,
                              m.X(k, static_cast<Eigen::Index>(j)),
-                             m.X_variance(k, static_cast<Eigen::Index>(j))});
+                             m.X_variance(k, static_cast<Eigen::Index>(j)), 0.0, 0.0, k});
         c.values += k == 0 ? 1 : 2;
         c.measured2 += std::norm(c.entries.back().measured);
         if (!(c.entries.back().variance > 0.0)) c.noise_known = false;
@@ -38,7 +52,7 @@ Misfit misfit(const Compared& compared, const std::vector<Eigen::MatrixXcd>& X,
   Misfit m;
   for (const auto& e : compared.entries) {
     if (std::binary_search(left_out.begin(), left_out.end(), e.test)) continue;
-    const double d = std::norm(e.measured - X[e.test](e.harmonic, e.response));
+    const double d = std::norm(e.measured - X[e.test](e.row, e.response));
     m.squared += d;
     m.chi2 += compared.noise_known ? e.dof() * d / e.total() : 0.0;
     m.values += e.dof();
@@ -83,8 +97,7 @@ std::vector<double> chi2_by_harmonic(const Compared& compared,
   const int K = compared.harmonics;
   std::vector<double> chi2(K + 1, 0.0), n(K + 1, 0.0);
   for (const auto& e : compared.entries) {
-    chi2[e.harmonic] +=
-        e.dof() * std::norm(e.measured - X[e.test](e.harmonic, e.response)) / e.total();
+    chi2[e.harmonic] += e.dof() * std::norm(e.measured - X[e.test](e.row, e.response)) / e.total();
     n[e.harmonic] += e.dof();
   }
   for (int k = 0; k <= K; ++k)

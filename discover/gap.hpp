@@ -12,13 +12,18 @@
 
 namespace jointid::discover::detail {
 
-/// A value compared: test i, response j, harmonic k (a displacement, m or rad).
+/// A value compared: test i, response j, harmonic k (a displacement, m or rad). A periodic
+/// test's value is one of its lines (Measurement::lines): `row` is the line, `harmonic` the
+/// group it is judged in — 1 for an excited line, 2 (1 when only the fundamental is compared)
+/// for a line where only the joints put response (harmonics and combinations).
 struct Entry {
   int test = 0, response = 0, harmonic = 0;
   std::complex<double> measured;
   double variance = 0.0;   ///< E|δX|² of the measurement noise, NaN when unknown
   double simulation = 0.0; ///< E|δX|² of the simulation's own error (harmonic truncation)
   double force = 0.0;      ///< E|δX_sim|² from the noise in the measured force that drives it
+  int row = 0;             ///< the row of the simulated harmonics: k, or a periodic test's line
+  bool line = false;       ///< a periodic test's line (else a harmonic of a sine test)
   /// The variance of the difference measured − simulated, and its real degrees of freedom.
   double total() const { return variance + simulation + force; }
   int dof() const { return harmonic == 0 ? 1 : 2; }
@@ -36,7 +41,8 @@ struct Compared {
 };
 
 /// The values of harmonics 0 … K at every response of every test: harmonic 0 only where the
-/// mean displacement was measured, a table's harmonic 1 only. The noise level is that of the
+/// mean displacement was measured, a table's harmonic 1 only; a periodic test's lines
+/// (Measurement::lines, its mean not compared). The noise level is that of the
 /// responses' own noise (estimate_simulation_error adds the force's). Throws
 /// std::invalid_argument when every response is zero.
 Compared compared_values(const std::vector<identify::Measurement>& tests, int harmonics);

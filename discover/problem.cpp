@@ -1,6 +1,7 @@
 #include "discover/problem.hpp"
 
 #include "discover/selection.hpp"
+#include "identify/parametric.hpp"
 
 #include <fmt/format.h>
 
@@ -14,6 +15,32 @@ namespace jointid::discover::detail {
 namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+bool is_periodic(const identify::Measurement& m) {
+  return m.kind == identify::RecordKind::periodic;
+}
+
+bool excited(const identify::Measurement& m, int k) {
+  return std::binary_search(m.excited_lines.begin(), m.excited_lines.end(), k);
+}
+
+// Line (harmonic) k of force c drives the re-simulation: a sine test's fundamental, a periodic
+// test's excited lines, and any other out of the force's noise (beyond 5 standard deviations:
+// driven through a resonance, noise alone would give the model responses the structure never
+// had).
+bool drives(const identify::Measurement& m, Eigen::Index k, Eigen::Index c) {
+  if (is_periodic(m) ? excited(m, static_cast<int>(k)) : k == 1) return true;
+  return !(m.F_variance.size() > 0 && std::norm(m.F(k, c)) <= 25.0 * m.F_variance(k, c));
+}
+
+// A periodic test's highest line that drives it.
+int highest_driven(const identify::Measurement& m) {
+  int top = m.excited_lines.back();
+  for (Eigen::Index k = top + 1; k < m.F.rows(); ++k)
+    for (Eigen::Index c = 0; c < m.F.cols(); ++c)
+      if (m.F(k, c) != 0.0 && drives(m, k, c)) top = static_cast<int>(k);
+  return top;
+}
 
 void add_unique(std::vector<int>& list, int value) {
   if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
@@ -62,9 +89,23 @@ int Problem::equation(const identify::Measurement& m, const std::string& what,
 // re-simulations need.
 void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
   synthesis_dofs_ = joints::joint_dof_set(start, dofs_);
-  double f_max = 0.0;
+  double f_max = 0.0, top = 0.0; // the sine tests' highest frequency; the periodic tests' band
   for (const auto& m : tests_) {
-    if (m.harmonics < K_ && !m.fundamental_only)
+    if (is_periodic(m)) {
+      // The lines compared, and the joints' harmonics and combinations of the excited lines up
+      // to the K-th, at least the tenth: their harmonic balance at 1/T reaches that far. (A
+      // cubic stiffness driven hard spreads its response far past three times the highest
+      // excited line: on the cantilever's 90 N multisine test with k3, truncated at 3 times it
+      // has no solution, at 5 times it is 17 % off the solution at 10 times.)
+      const int reach = std::max(m.lines.back(), std::max(K_, 10) * highest_driven(m));
+      balance_harmonics_.push_back(reach);
+      rows_.push_back(m.harmonics);
+      top = std::max(top, frf::synthesis_band_hz(m.frequency_hz, 2 * reach)); // refined: twice
+    } else {
+      balance_harmonics_.push_back(-1); // the options' (set below)
+      rows_.push_back(K_);
+    }
+    if (m.harmonics < K_ && !m.fundamental_only && !is_periodic(m))
       throw std::invalid_argument(m.source + ": measured to harmonic " +
                                   std::to_string(m.harmonics) + ", but " + std::to_string(K_) +
                                   " are compared");
@@ -81,10 +122,12 @@ void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
       add_unique(synthesis_dofs_, e);
     force_eq_.push_back(std::move(forces));
     response_eq_.push_back(std::move(responses));
-    f_max = std::max(f_max, m.frequency_hz);
+    if (!is_periodic(m)) f_max = std::max(f_max, m.frequency_hz);
   }
   fit_to_measured_band(f_max);
-  f_max_ = frf::synthesis_band_hz(f_max, 2 * o_.balance.harmonics); // refined: twice K
+  for (int& k : balance_harmonics_)
+    if (k < 0) k = o_.balance.harmonics;
+  f_max_ = std::max(top, frf::synthesis_band_hz(f_max, 2 * o_.balance.harmonics)); // refined: 2K
 }
 
 // Measured FRFs end at their band: the re-simulations keep to the harmonics whose doubles (the
@@ -92,6 +135,19 @@ void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
 void Problem::fit_to_measured_band(double f_max) {
   const double top = sub_.band_top_hz(synthesis_dofs_);
   if (!std::isfinite(top)) return;
+  // A periodic test's harmonic balance needs its lines, and the joints' response up to
+  // max(K, 10) times its highest driven line, twice over for the refined simulation.
+  for (std::size_t i = 0; i < tests_.size(); ++i)
+    if (is_periodic(tests_[i]) &&
+        2.0 * balance_harmonics_[i] * tests_[i].frequency_hz > top * (1.0 + 1e-12))
+      throw std::invalid_argument(fmt::format(
+          "{}: the measured FRFs reach {} Hz; this periodic test's re-simulation needs {} Hz "
+          "(twice line {}: the joints' response up to {} times its highest driven line, "
+          "doubled to estimate the simulation's own error). Measure the FRFs to that, or use "
+          "fewer of its lines (--band)",
+          tests_[i].source, top, 2.0 * balance_harmonics_[i] * tests_[i].frequency_hz,
+          balance_harmonics_[i], std::max(K_, 10)));
+  if (f_max <= 0.0) return; // periodic tests only
   const int reach = static_cast<int>(std::floor(top / f_max * (1.0 + 1e-12)));
   const int usable = std::min(o_.balance.harmonics, reach / 2);
   if (usable < K_)
@@ -110,30 +166,30 @@ void Problem::fit_to_measured_band(double f_max) {
 }
 
 void Problem::set_up_drive_and_start(const std::vector<joints::Joint>& start) {
-  // The force that drives each re-simulation: the measured harmonics, except those that are
-  // noise (a force harmonic within 5 standard deviations of 0 is taken as 0): driven through
-  // a resonance, noise alone would give the model responses the structure never had.
+  // The force that drives each re-simulation: the measured harmonics (or lines) that drive it
+  // (drives()), the others taken as 0.
   for (const auto& m : tests_) {
     Eigen::MatrixXcd F = m.F;
     for (Eigen::Index k = 0; k < F.rows(); ++k)
       for (Eigen::Index c = 0; c < F.cols(); ++c)
-        if (k != 1 && m.F_variance.size() > 0 && std::norm(F(k, c)) <= 25.0 * m.F_variance(k, c))
-          F(k, c) = 0.0;
+        if (!drives(m, k, c)) F(k, c) = 0.0;
     drive_.push_back(std::move(F));
   }
   // The measured joint deformations: the harmonic balance starts from them, so that it
   // finds the periodic solution on the measured branch (hardening joints have several).
   const std::vector<int> set2 = joints::joint_dof_set(start, dofs_);
   const Eigen::MatrixXd B = joints::joint_coordinates_on(start, dofs_, set2);
-  for (const auto& m : tests_) {
-    Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(o_.balance.harmonics + 1, B.cols());
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    const auto& m = tests_[i];
+    const int K = balance_harmonics_[i];
+    Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K + 1, B.cols());
     for (std::size_t d = 0; d < set2.size(); ++d) {
       const int r = m.response_index(dofs_.node_dof(set2[d]));
       if (r < 0)
         throw std::invalid_argument(m.source + ": no response channel at joint DOF " +
                                     fem::to_string(dofs_.node_dof(set2[d])) +
                                     " (discovery needs x, v or a at every joint DOF)");
-      for (int k = 0; k <= std::min(m.harmonics, o_.balance.harmonics); ++k) {
+      for (int k = 0; k <= std::min(m.harmonics, K); ++k) {
         if (!m.has_harmonic(k) || (k == 0 && !m.has_mean[r])) continue;
         Y.row(k) += m.X(k, r) * B.row(static_cast<Eigen::Index>(d)).cast<std::complex<double>>();
       }
@@ -176,10 +232,11 @@ std::unique_ptr<Simulator> Problem::make_simulator(double scale, bool refined) c
   auto s = std::make_unique<Simulator>(
       Simulator{scale, harmonics, scale == 1.0 ? *base_ : base_->with_damping_scale(scale), {}});
   frf::HarmonicBalanceOptions options = o_.balance;
-  options.harmonics = harmonics;
-  for (std::size_t i = 0; i < tests_.size(); ++i)
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    options.harmonics = balance_harmonics_[i] * (refined ? 2 : 1);
     s->balance.emplace_back(s->synthesis, layout_, dofs_, force_eq_[i], response_eq_[i],
                             tests_[i].frequency_hz, options);
+  }
   return s;
 }
 
@@ -195,8 +252,12 @@ const Problem::Spectra& Problem::spectra(const std::vector<joints::Joint>& joint
   std::string key;
   for (const auto& j : joints) {
     key += j.name + ':';
-    for (const joints::Term t : j.terms)
-      key += std::string(joints::term_name(t)) + ',';
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      key += std::string(joints::term_name(j.terms[t])) + ',';
+      // A parametric term's force (fixed) is in the spectrum: its parameters are in the key.
+      for (const joints::Parameter& p : j.parameters_of(t))
+        key += fmt::format("{:a},", p.value);
+    }
     key += ';';
   }
   const std::lock_guard<std::mutex> lock(spectra_mutex_);
@@ -213,8 +274,12 @@ const Problem::Spectra& Problem::spectra(const std::vector<joints::Joint>& joint
 }
 
 identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
-                                      const Simulator& sim, const std::vector<int>& use) const {
-  const Spectra& all = spectra(joints);
+                                      const Simulator& sim, const std::vector<int>& use,
+                                      const std::vector<int>* harmonics) const {
+  // The parametric terms with their parameters as they are: their forces known (the
+  // equation error identifies coefficients; their parameters are refined by output error).
+  const std::vector<joints::Joint> held = identify::with_parametric_fixed(joints);
+  const Spectra& all = spectra(held);
   std::vector<std::string> warnings;
   for (int i : use)
     warnings.insert(warnings.end(), all.warnings[i].begin(), all.warnings[i].end());
@@ -229,8 +294,8 @@ identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
     return sim.synthesis.receptance(w, rows, cols);
   };
   identify::FitOptions fo;
-  fo.harmonics = o_.harmonics;
-  identify::FitResult fit = identify::fit(H, dofs_, joints, spectra, fo, std::move(warnings));
+  fo.harmonics = harmonics ? *harmonics : o_.harmonics;
+  identify::FitResult fit = identify::fit(H, dofs_, held, spectra, fo, std::move(warnings));
   // Terms the tests cannot separate: this model cannot be identified (a refused candidate).
   if (!fit.status.ok()) throw std::invalid_argument("identify: " + fit.status.reason);
   return fit;
@@ -239,8 +304,13 @@ identify::FitResult Problem::identify(const std::vector<joints::Joint>& joints,
 int Problem::parameters(const std::vector<joints::Joint>& joints, double scale) const {
   int p = scale != 1.0 ? 1 : 0;
   for (const auto& j : joints)
-    for (bool f : j.fixed)
-      p += f ? 0 : 1;
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      if (j.fixed[t]) continue;
+      const auto params = j.parameters_of(t);
+      p += params.empty() ? 1
+                          : static_cast<int>(std::count_if(params.begin(), params.end(),
+                                                           [](const auto& q) { return !q.fixed; }));
+    }
   return p;
 }
 
@@ -259,8 +329,8 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
                  (per_test.empty() ? 0 : static_cast<int>(per_test.size()) - 1);
   s.X.resize(tests_.size()); // NaN where not tried
   for (std::size_t i = 0; i < tests_.size(); ++i)
-    s.X[i] =
-        Eigen::MatrixXcd::Constant(K_ + 1, static_cast<Eigen::Index>(response_eq_[i].size()), nan);
+    s.X[i] = Eigen::MatrixXcd::Constant(rows_[i] + 1,
+                                        static_cast<Eigen::Index>(response_eq_[i].size()), nan);
   s.Y.assign(tests_.size(), Eigen::MatrixXcd());
   const int limit = max_left_out(static_cast<int>(tests_.size()));
   std::vector<int> solved;
@@ -280,7 +350,7 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
           break;
         }
       }
-    s.X[i] = r.X.topRows(K_ + 1);
+    s.X[i] = r.X.topRows(rows_[i] + 1);
     s.Y[i] = r.Y;
     if (r.status.ok() && r.X.allFinite()) {
       solved.push_back(t);
@@ -300,11 +370,12 @@ frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,
   if (o_.checkpoint) o_.checkpoint();
   if (!friction_problem(joints).empty()) { // fc < 0: no steady state to speak of
     frf::HarmonicBalanceResult none;
-    none.X = Eigen::MatrixXcd::Constant(sim.harmonics + 1, response_eq_[i].size(), nan);
+    none.X = Eigen::MatrixXcd::Constant(sim.balance[i].options().harmonics + 1,
+                                        response_eq_[i].size(), nan);
     return none;
   }
   frf::HarmonicBalanceResult r;
-  if (warm && warm->rows() == sim.harmonics + 1) {
+  if (warm && warm->rows() == sim.balance[i].options().harmonics + 1) {
     r = sim.balance[i].solve(joints, drive_[i], warm);
     if (r.status.ok()) return r;
   }

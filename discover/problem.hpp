@@ -17,10 +17,12 @@
 namespace jointid::discover::detail {
 
 /// The substructure's receptance (its damping scaled) and the harmonic-balance problems of
-/// every test built on it.
+/// every test built on it (a sine test's at its frequency with the options' harmonics, a
+/// periodic test's at 1/T up to Problem::balance_harmonics; each twice as many when refined).
 struct Simulator {
   double scale = 1.0;
-  int harmonics = 0;
+  int harmonics = 0; ///< the sine tests'
+
   frf::ModalSynthesis synthesis;
   std::vector<frf::HarmonicBalance> balance;
 };
@@ -45,6 +47,13 @@ public:
   /// Test i's force and response equations.
   const std::vector<int>& force_equations(std::size_t i) const { return force_eq_[i]; }
   const std::vector<int>& response_equations(std::size_t i) const { return response_eq_[i]; }
+  /// Test i's harmonic balance: harmonics 0 … this (not refined): the options' for a sine test;
+  /// for a periodic test its highest line compared, or max(K, 10) times its highest driven line
+  /// where that is higher (K the largest harmonic compared: the joints' harmonics and
+  /// combinations, which a strongly driven cubic joint spreads far beyond the third).
+  int balance_harmonics(std::size_t i) const { return balance_harmonics_[i]; }
+  /// Test i's simulated harmonics kept in a State: 0 … K (a periodic test: to its highest line).
+  int rows(std::size_t i) const { return rows_[i]; }
   /// Test i's measured joint deformations: (harmonic-balance harmonics + 1) × joints.
   const Eigen::MatrixXcd& measured_deformation(std::size_t i) const { return measured_start_[i]; }
   /// What the set-up had to say (e.g. fewer harmonics in the band of measured FRFs).
@@ -65,8 +74,12 @@ public:
 
   /// Identifies every non-fixed term from the tests `use`, with the damping scaled. Throws
   /// std::invalid_argument when the tests cannot separate the terms.
+  /// A parametric term (jenkins, iwan, gap) is held at its parameters (its force known; output
+  /// error refines them: refine.hpp). `harmonics`, if
+  /// given, replaces the options' (the equivalent linear joint of the diagnosis: 1).
   identify::FitResult identify(const std::vector<joints::Joint>& joints, const Simulator& sim,
-                               const std::vector<int>& use) const;
+                               const std::vector<int>& use,
+                               const std::vector<int>* harmonics = nullptr) const;
   /// Every test's spectrum for these joints' terms (their basis functions on the measured
   /// deformation, which do not depend on the values), and its warnings: computed once per set
   /// of terms and kept (identify() needs them for every candidate, trial and fold). Safe to call
@@ -76,7 +89,8 @@ public:
     std::vector<std::vector<std::string>> warnings; ///< per test
   };
   const Spectra& spectra(const std::vector<joints::Joint>& joints) const;
-  /// Identified coefficients: the non-fixed terms, and the damping scale if not 1.
+  /// Identified coefficients: the non-fixed terms (a parametric term's non-fixed parameters),
+  /// and the damping scale if not 1.
   int parameters(const std::vector<joints::Joint>& joints, double scale) const;
   /// Simulates every test with these joints, and scores the state. A test whose re-simulation
   /// does not converge (solve(), then from the nearest tests already re-simulated: a stepped
@@ -125,6 +139,7 @@ private:
   std::vector<joints::Joint> layout_;
   std::vector<int> synthesis_dofs_;
   std::vector<std::vector<int>> force_eq_, response_eq_;
+  std::vector<int> balance_harmonics_, rows_; // per test
   double f_max_ = 0.0;
   std::vector<std::string> notes_;
   std::unique_ptr<frf::ModalSynthesis> base_;

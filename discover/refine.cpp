@@ -1,13 +1,17 @@
 #include "discover/refine.hpp"
 
 #include "discover/selection.hpp"
+#include "identify/parametric.hpp"
 #include "identify/statistics.hpp"
+
+#include <fmt/format.h>
 
 #include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace jointid::discover::detail {
@@ -17,6 +21,20 @@ namespace {
 using Complex = std::complex<double>;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
+// Every named parameter in its range: a step far out in a parameter's coordinate saturates it
+// (an exponent at −1, a logarithm's exponential at +∞), which no simulation takes.
+bool in_range(const std::vector<joints::Joint>& joints) {
+  for (const joints::Joint& j : joints)
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      const auto list = j.parameters_of(t);
+      const auto& info = joints::term_info(j.terms[t]).parameters;
+      for (std::size_t p = 0; p < list.size() && p < info.size(); ++p)
+        if (!joints::in_range(info[p], list[p].value) || !(std::abs(list[p].value) < 1e100))
+          return false;
+    }
+  return true;
+}
+
 // The Levenberg–Marquardt search of one refinement: the parameters (every non-fixed term), the
 // weighted residual of a state, and the Jacobian by finite differences.
 class OutputError {
@@ -24,8 +42,15 @@ public:
   OutputError(const Problem& problem, const Simulator& sim, const State& start)
       : problem_(problem), compared_(problem.compared()), sim_(sim) {
     for (std::size_t j = 0; j < start.joints.size(); ++j)
-      for (std::size_t t = 0; t < start.joints[j].terms.size(); ++t)
-        if (!start.joints[j].fixed[t]) params_.push_back({j, t});
+      for (std::size_t t = 0; t < start.joints[j].terms.size(); ++t) {
+        if (start.joints[j].fixed[t]) continue;
+        // A parametric term: each non-fixed parameter in its natural coordinate
+        // (identify/parametric.hpp), which keeps it in its range.
+        const auto list = start.joints[j].parameters_of(t);
+        if (list.empty()) params_.push_back({j, t, -1});
+        for (std::size_t q = 0; q < list.size(); ++q)
+          if (!list[q].fixed) params_.push_back({j, t, static_cast<int>(q)});
+      }
     for (const auto& e : compared_.entries)
       weight_.push_back(compared_.noise_known ? 1.0 / std::sqrt(e.total() / e.dof()) : 1.0);
   }
@@ -60,6 +85,11 @@ public:
     std::vector<bool> dissipative(p);
     for (Eigen::Index q = 0; q < p; ++q) {
       const joints::Term term = joints_[params_[q].joint].terms[params_[q].term];
+      if (params_[q].parameter >= 0) { // a parameter, in its coordinate u
+        b_(q) = coordinate(joints_, params_[q]);
+        step_(q) = 1e-5 * std::max(1.0, std::abs(b_(q)));
+        continue;
+      }
       dissipative[q] = joints::term_info(term).nature == joints::Nature::dissipative;
       b_(q) = joints_[params_[q].joint].values[params_[q].term];
       // A finite-difference step of the parameter's own scale: its value, or (at 0, e.g. a
@@ -91,7 +121,7 @@ public:
         for (Eigen::Index q = 0; q < p; ++q) // projected onto non-negative damping and friction
           if (dissipative[q]) nb(q) = std::max(nb(q), 0.0);
         const std::vector<joints::Joint> nj = joints_with(nb);
-        if (!nb.allFinite() || !physical_problem(nj).empty()) continue;
+        if (!nb.allFinite() || !physical_problem(nj).empty() || !in_range(nj)) continue;
         State sn = problem_.evaluate(nj, sim_, &current_);
         if (!covers(sn)) continue;
         const Eigen::VectorXd rn = residual(sn);
@@ -117,9 +147,16 @@ public:
     const bool formed = jacobian() && dof > 0;
     double s2 = formed ? cost_ / dof : nan;
     if (compared_.noise_known) s2 = std::max(s2, 1.0);
-    const Eigen::MatrixXd C = formed ? covariance(J_, s2) : Eigen::MatrixXd::Constant(p, p, nan);
+    std::vector<bool> undetermined(static_cast<std::size_t>(p), false);
+    std::vector<std::string> said;
+    const int nulls = microslip(undetermined, said);
+    const Eigen::MatrixXd C = !formed ? Eigen::MatrixXd::Constant(p, p, nan)
+                              : nulls > 0
+                                  ? covariance_without(J_, s2, nulls)
+                                  : covariance_of_determined(J_, s2, droppable(), undetermined);
     const double tq = formed ? identify::student_t_quantile(0.975, dof) : nan;
     identify::FitResult fit = begin_fit;
+    fit.identifiability = said;
     std::size_t q = 0;
     fit.joints.clear();
     for (const auto& joint : current_.joints) {
@@ -129,9 +166,44 @@ public:
         te.term = joint.terms[t];
         te.value = joint.values[t];
         te.fixed = joint.fixed[t];
+        te.parameters = identify::parameters_of(joint, t);
+        if (!te.parameters.empty()) { // its parameters, their intervals through u
+          te.std = 0.0, te.ci_low = te.ci_high = te.value;
+          if (te.fixed) {
+            je.terms.push_back(te);
+            continue;
+          }
+          for (identify::ParameterEstimate& pe : te.parameters) {
+            if (pe.fixed) continue;
+            const auto qi = static_cast<Eigen::Index>(q++);
+            const Param& P = params_[static_cast<std::size_t>(qi)];
+            const joints::ParameterInfo& pi = info(current_.joints, P);
+            const double u = b_(qi),
+                         su = std::isfinite(C(qi, qi)) ? std::sqrt(std::max(C(qi, qi), 0.0)) : nan;
+            const double h = 1e-6 * std::max(1.0, std::abs(u));
+            const double slope =
+                (identify::parameter_from_u(pi, u + h) - identify::parameter_from_u(pi, u - h)) /
+                (2.0 * h);
+            pe.std = std::abs(slope) * su;
+            const double a = identify::parameter_from_u(pi, u - tq * su),
+                         b = identify::parameter_from_u(pi, u + tq * su);
+            pe.ci_low = std::min(a, b), pe.ci_high = std::max(a, b);
+            pe.determined = !undetermined[static_cast<std::size_t>(qi)] && std::isfinite(pe.std) &&
+                            pe.ci_high > pe.ci_low;
+            // Never a value where the tests do not determine it (the model keeps one to
+            // simulate with).
+            if (undetermined[static_cast<std::size_t>(qi)])
+              pe.value = pe.std = pe.ci_low = pe.ci_high = nan;
+          }
+          je.terms.push_back(te);
+          continue;
+        }
         if (!te.fixed) {
           const auto qi = static_cast<Eigen::Index>(q++);
-          te.std = std::isfinite(C(qi, qi)) ? std::sqrt(std::max(C(qi, qi), 0.0)) : nan;
+          te.std = std::isfinite(C(qi, qi)) && !undetermined[static_cast<std::size_t>(qi)]
+                       ? std::sqrt(std::max(C(qi, qi), 0.0))
+                       : nan;
+          te.determined = std::isfinite(te.std);
         }
         te.ci_low = te.value - tq * te.std;
         te.ci_high = te.value + tq * te.std;
@@ -156,7 +228,76 @@ public:
 private:
   struct Param {
     std::size_t joint, term;
+    int parameter; ///< of a parametric term; -1: the coefficient
   };
+
+  // An iwan that stayed in microslip in every test (its largest deformation, bounded by Σ_k |Y_k|,
+  // below its largest slip displacement phi_max): its force there depends only on k + kt, chi
+  // and the density's scale R (joints/hysteresis.hpp), so fs apart from beta, and kt apart
+  // from k (when k is identified too), are not determined. Marks them in `undetermined`, says
+  // so in `said`, and returns the number of directions the tests do not see.
+  int microslip(std::vector<bool>& undetermined, std::vector<std::string>& said) const {
+    int nulls = 0;
+    for (std::size_t j = 0; j < current_.joints.size(); ++j) {
+      const joints::Joint& J = current_.joints[j];
+      const int t = J.term_index(joints::Term::iwan);
+      if (t < 0 || J.fixed[static_cast<std::size_t>(t)]) continue;
+      const auto ti = static_cast<std::size_t>(t);
+      const double phi_max = joints::iwan_density(J.parameter(ti, "fs"), J.parameter(ti, "kt"),
+                                                  J.parameter(ti, "chi"), J.parameter(ti, "beta"))
+                                 .phi_max;
+      double peak = 0.0;
+      for (const Eigen::MatrixXcd& Y : current_.Y)
+        if (Y.cols() > static_cast<Eigen::Index>(j))
+          peak = std::max(peak, Y.col(static_cast<Eigen::Index>(j)).cwiseAbs().sum());
+      if (!(peak < phi_max)) continue;
+      std::vector<std::string> names;
+      bool k_open = false;
+      for (std::size_t q = 0; q < params_.size(); ++q) {
+        const Param& P = params_[q];
+        if (P.joint != j) continue;
+        if (P.parameter < 0 && J.terms[P.term] == joints::Term::k) k_open = true;
+      }
+      for (std::size_t q = 0; q < params_.size(); ++q) {
+        const Param& P = params_[q];
+        if (P.joint != j) continue;
+        const std::string name = P.parameter < 0 ? std::string(joints::term_name(J.terms[P.term]))
+                                                 : std::string(info(current_.joints, P).name);
+        const bool lost = P.parameter < 0 ? J.terms[P.term] == joints::Term::k
+                          : P.term == ti
+                              ? (name == "fs" || name == "beta" || (k_open && name == "kt"))
+                              : false;
+        if (lost) undetermined[q] = true, names.push_back(name);
+      }
+      nulls += 1 + (k_open ? 1 : 0);
+      said.push_back(fmt::format(
+          "joint '{}': its iwan stayed in microslip in every test (largest deformation {:.3g}, "
+          "below its largest slip displacement phi_max ≈ {:.3g}), where its force depends only "
+          "on {}chi and the slip density's scale: {}iwan.fs apart from iwan.beta are "
+          "undetermined (no value is given for them); a test whose deformation reaches beyond "
+          "phi_max (macroslip) would determine them",
+          J.name, peak, phi_max, k_open ? "k + kt, " : "kt, ",
+          k_open ? "k apart from iwan.kt, and " : ""));
+    }
+    return nulls;
+  }
+
+  // The parametric terms' parameters: those that may be undetermined without failing the fit.
+  std::vector<bool> droppable() const {
+    std::vector<bool> out;
+    for (const Param& P : params_)
+      out.push_back(P.parameter >= 0);
+    return out;
+  }
+
+  static const joints::ParameterInfo& info(const std::vector<joints::Joint>& j, const Param& p) {
+    return joints::term_info(j[p.joint].terms[p.term])
+        .parameters[static_cast<std::size_t>(p.parameter)];
+  }
+  static double coordinate(const std::vector<joints::Joint>& j, const Param& p) {
+    return identify::parameter_to_u(
+        info(j, p), j[p.joint].parameters[p.term][static_cast<std::size_t>(p.parameter)].value);
+  }
 
   Eigen::VectorXd residual(const State& st) const {
     Eigen::VectorXd r(values_);
@@ -164,7 +305,7 @@ private:
     for (std::size_t i = 0; i < compared_.entries.size(); ++i) {
       const auto& e = compared_.entries[i];
       if (std::binary_search(left_out_.begin(), left_out_.end(), e.test)) continue;
-      const Complex err = e.measured - st.X[e.test](e.harmonic, e.response);
+      const Complex err = e.measured - st.X[e.test](e.row, e.response);
       r(n++) = weight_[i] * err.real();
       if (e.harmonic != 0) r(n++) = weight_[i] * err.imag();
     }
@@ -173,8 +314,14 @@ private:
 
   std::vector<joints::Joint> joints_with(const Eigen::VectorXd& b) const {
     std::vector<joints::Joint> j = joints_;
-    for (Eigen::Index q = 0; q < size(); ++q)
-      j[params_[q].joint].values[params_[q].term] = b(q);
+    for (Eigen::Index q = 0; q < size(); ++q) {
+      const Param& P = params_[q];
+      if (P.parameter < 0)
+        j[P.joint].values[P.term] = b(q);
+      else
+        j[P.joint].parameters[P.term][static_cast<std::size_t>(P.parameter)].value =
+            identify::parameter_from_u(info(j, P), b(q));
+    }
     return j;
   }
 
@@ -186,7 +333,7 @@ private:
         Eigen::VectorXd bq = b_;
         bq(q) += h;
         const std::vector<joints::Joint> jq = joints_with(bq);
-        if (!physical_problem(jq).empty()) continue;
+        if (!physical_problem(jq).empty() || !in_range(jq)) continue;
         const State sq = problem_.evaluate(jq, sim_, &current_);
         if (!covers(sq)) continue;
         J_.col(q) = (residual(sq) - r_) / h;
@@ -237,7 +384,77 @@ Eigen::MatrixXd covariance(const Eigen::MatrixXd& J, double s2) {
   return s2 * scale.asDiagonal() * (W * W.transpose()) * scale.asDiagonal();
 }
 
+static State refine_from(const Problem& problem, const State& start, const Simulator& sim);
+
+Eigen::MatrixXd covariance_without(const Eigen::MatrixXd& J, double s2, int nulls) {
+  const Eigen::Index p = J.cols();
+  Eigen::MatrixXd C = Eigen::MatrixXd::Constant(p, p, nan);
+  if (!J.allFinite() || !std::isfinite(s2) || nulls >= p) return C;
+  Eigen::VectorXd scale(p);
+  for (Eigen::Index q = 0; q < p; ++q) {
+    const double norm = J.col(q).norm();
+    if (!(norm > 0.0)) return C;
+    scale(q) = 1.0 / norm;
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J * scale.asDiagonal(), Eigen::ComputeThinV);
+  const Eigen::Index r = p - nulls;
+  const Eigen::VectorXd& sv = svd.singularValues();
+  if (!(sv(r - 1) > 1e-6 * sv(0))) return C;
+  const Eigen::MatrixXd W = svd.matrixV().leftCols(r) * sv.head(r).cwiseInverse().asDiagonal();
+  return s2 * scale.asDiagonal() * (W * W.transpose()) * scale.asDiagonal();
+}
+
+Eigen::MatrixXd covariance_of_determined(const Eigen::MatrixXd& J, double s2,
+                                         const std::vector<bool>& droppable,
+                                         std::vector<bool>& undetermined) {
+  const Eigen::Index p = J.cols();
+  undetermined.assign(static_cast<std::size_t>(p), false);
+  Eigen::MatrixXd C = covariance(J, s2);
+  if (p == 0 || std::isfinite(C(0, 0)) || !J.allFinite()) return C;
+  std::vector<Eigen::Index> active(static_cast<std::size_t>(p));
+  for (Eigen::Index q = 0; q < p; ++q)
+    active[static_cast<std::size_t>(q)] = q;
+  while (active.size() > 1) {
+    // The direction the tests do not resolve: the smallest singular value's right vector of
+    // the column-scaled Jacobian; the parameter that leans on it most is left undetermined.
+    const auto n = static_cast<Eigen::Index>(active.size());
+    Eigen::MatrixXd Js(J.rows(), n);
+    for (Eigen::Index c = 0; c < n; ++c) {
+      const auto col = J.col(active[static_cast<std::size_t>(c)]);
+      Js.col(c) = col / std::max(col.norm(), 1e-300);
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
+    const Eigen::VectorXd v = svd.matrixV().col(n - 1).cwiseAbs();
+    Eigen::Index worst = -1;
+    for (Eigen::Index c = 0; c < n; ++c)
+      if (droppable[static_cast<std::size_t>(active[static_cast<std::size_t>(c)])] &&
+          (worst < 0 || v(c) > v(worst)))
+        worst = c;
+    if (worst < 0) return C; // only coefficients left: undetermined as they are
+    undetermined[static_cast<std::size_t>(active[static_cast<std::size_t>(worst)])] = true;
+    active.erase(active.begin() + worst);
+    Eigen::MatrixXd Ja(J.rows(), static_cast<Eigen::Index>(active.size()));
+    for (std::size_t c = 0; c < active.size(); ++c)
+      Ja.col(static_cast<Eigen::Index>(c)) = J.col(active[c]);
+    const Eigen::MatrixXd Ca = covariance(Ja, s2);
+    if (!std::isfinite(Ca(0, 0))) continue;
+    for (std::size_t a = 0; a < active.size(); ++a)
+      for (std::size_t b = 0; b < active.size(); ++b)
+        C(active[a], active[b]) = Ca(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+    return C;
+  }
+  return C;
+}
+
 State refine(const Problem& problem, const State& start, const Simulator& sim) {
+  try {
+    return refine_from(problem, start, sim);
+  } catch (const std::invalid_argument&) {
+    return start; // a model the simulators refuse (out of range): the start stands
+  }
+}
+
+State refine_from(const Problem& problem, const State& start, const Simulator& sim) {
   OutputError search(problem, sim, start);
   if (search.size() == 0) return start;
   const State begin = search.begin(start);

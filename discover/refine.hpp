@@ -22,4 +22,19 @@ State refine(const Problem& problem, const State& start, const Simulator& sim);
 /// apart (the parameters act alike beyond what a Jacobian by finite differences resolves).
 Eigen::MatrixXd covariance(const Eigen::MatrixXd& J, double s2);
 
+/// The covariance of what the tests determine when `nulls` directions of the parameters are not
+/// seen at all (an iwan in microslip): the pseudo-inverse with the `nulls` smallest singular
+/// values of the column-scaled J left out. Right for every combination the tests determine
+/// (orthogonal to those directions); the parameters along them are undetermined.
+Eigen::MatrixXd covariance_without(const Eigen::MatrixXd& J, double s2, int nulls);
+
+/// The same where the tests leave some parameters of a parametric term undetermined (an iwan in
+/// microslip: fs apart from beta): while the covariance is undetermined, the `droppable`
+/// parameter that leans most on the direction the Jacobian does not resolve is marked in
+/// `undetermined` and held; the others' covariance is then that with it held (NaN in its row and
+/// column). NaN throughout when no droppable parameter is left.
+Eigen::MatrixXd covariance_of_determined(const Eigen::MatrixXd& J, double s2,
+                                         const std::vector<bool>& droppable,
+                                         std::vector<bool>& undetermined);
+
 } // namespace jointid::discover::detail

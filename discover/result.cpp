@@ -27,6 +27,11 @@ std::string Candidate::effect() const {
 }
 
 bool Candidate::determined() const {
+  if (term && joints::has_parameters(*term))
+    return std::any_of(parameters.begin(), parameters.end(), [](const auto& p) {
+      return !p.fixed && p.determined && std::isfinite(p.ci_low) && std::isfinite(p.ci_high) &&
+             p.ci_high > p.ci_low;
+    });
   return std::isfinite(ci_low) && std::isfinite(ci_high) && ci_high > ci_low &&
          std::isfinite(std) && std > 0.0;
 }
@@ -42,26 +47,42 @@ std::vector<Comparison> comparisons(const std::vector<identify::Measurement>& te
   std::vector<Comparison> out;
   for (std::size_t i = 0; i < tests.size(); ++i) {
     const auto& m = tests[i];
+    const bool periodic = m.kind == identify::RecordKind::periodic;
+    // A sine test's fundamental; every excited line of a periodic test (its FRF over them).
+    const std::vector<int> lines = periodic ? m.excited_lines : std::vector<int>{1};
     for (std::size_t j = 0; j < m.response_at.size(); ++j) {
       const auto jj = static_cast<Eigen::Index>(j);
-      Comparison c;
-      c.test = m.source;
-      c.channel = channel_name(m, j);
-      c.frequency_hz = m.frequency_hz;
-      c.force = identify::force_level(m);
-      c.force_phasor = m.F.cols() > 0 ? m.F(1, 0) : std::complex<double>();
-      c.measured = m.X(1, jj);
-      c.simulated = s.X[i](1, jj);
-      c.amplitude_error = std::abs(c.simulated) / std::max(std::abs(c.measured), 1e-300) - 1.0;
-      c.phase_error_deg = std::arg(c.simulated / c.measured) * 180.0 / std::numbers::pi;
-      double hm = 0.0, hs = 0.0;
-      if (!m.fundamental_only)
-        for (int k = 2; k <= K; ++k)
-          hm += std::norm(m.X(k, jj)), hs += std::norm(s.X[i](k, jj));
-      c.harmonics_measured = std::sqrt(hm) / std::max(std::abs(c.measured), 1e-300);
-      c.harmonics_simulated = std::sqrt(hs) / std::max(std::abs(c.measured), 1e-300);
-      c.converged = !std::binary_search(s.failed.begin(), s.failed.end(), static_cast<int>(i));
-      out.push_back(c);
+      // Harmonics 2 … K over the fundamental; a periodic test's lines where only the joints put
+      // response over its excited lines.
+      double hm = 0.0, hs = 0.0, reference = 0.0;
+      if (periodic) {
+        for (int k : m.lines)
+          if (std::binary_search(m.excited_lines.begin(), m.excited_lines.end(), k))
+            reference += std::norm(m.X(k, jj));
+          else
+            hm += std::norm(m.X(k, jj)), hs += std::norm(s.X[i](k, jj));
+      } else {
+        reference = std::norm(m.X(1, jj));
+        if (!m.fundamental_only)
+          for (int k = 2; k <= K; ++k)
+            hm += std::norm(m.X(k, jj)), hs += std::norm(s.X[i](k, jj));
+      }
+      for (int k : lines) {
+        Comparison c;
+        c.test = m.source;
+        c.channel = channel_name(m, j);
+        c.frequency_hz = k * m.frequency_hz;
+        c.force = identify::force_level(m);
+        c.force_phasor = m.F.cols() > 0 ? m.F(k, 0) : std::complex<double>();
+        c.measured = m.X(k, jj);
+        c.simulated = s.X[i](k, jj);
+        c.amplitude_error = std::abs(c.simulated) / std::max(std::abs(c.measured), 1e-300) - 1.0;
+        c.phase_error_deg = std::arg(c.simulated / c.measured) * 180.0 / std::numbers::pi;
+        c.harmonics_measured = std::sqrt(hm / std::max(reference, 1e-300));
+        c.harmonics_simulated = std::sqrt(hs / std::max(reference, 1e-300));
+        c.converged = !std::binary_search(s.failed.begin(), s.failed.end(), static_cast<int>(i));
+        out.push_back(c);
+      }
     }
   }
   return out;

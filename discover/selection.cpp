@@ -112,6 +112,7 @@ void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::s
     if (je.name == joint)
       for (const auto& te : je.terms)
         if (te.term == term) {
+          candidate.parameters = te.parameters;
           candidate.value = te.value;
           candidate.std = te.std;
           candidate.ci_low = te.ci_low;
@@ -129,6 +130,13 @@ void judge(Candidate& candidate, const State& state) {
 }
 
 std::string interval_problem(const Candidate& candidate) {
+  // A parametric term: its parameters are in their ranges by construction (identify/
+  // parametric.hpp); what the tests leave undetermined is said, not held against it, as long
+  // as they determine some of it (the criterion and cross-validation judge whether it matters).
+  if (candidate.term && joints::has_parameters(*candidate.term)) {
+    if (candidate.determined()) return {};
+    return "not determined: the tests determine none of its parameters (no 95 % interval)";
+  }
   const double none = candidate.term ? 0.0 : 1.0;
   if (!std::isfinite(candidate.ci_low) || !std::isfinite(candidate.ci_high))
     return "not determined: its 95 % interval could not be estimated";
@@ -218,10 +226,21 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
     return ranking[a].criterion < ranking[b].criterion;
   });
   std::vector<std::size_t> out;
-  for (std::size_t i : by)
-    if (std::isfinite(ranking[i].criterion) && !ranking[i].varies &&
-        out.size() < static_cast<std::size_t>(count))
+  bool parametric_seen = false;
+  int coefficient = 0, place = 0; // place: among the candidates that may be refined
+  for (std::size_t i : by) {
+    if (!std::isfinite(ranking[i].criterion) || ranking[i].varies) continue;
+    if (ranking[i].term && joints::has_parameters(*ranking[i].term)) {
+      // The best one, besides the count, where it ranks among the best count + 1 (its start
+      // screens it: further down, coefficient terms explain the data better).
+      if (!parametric_seen && place <= count) out.push_back(i);
+      parametric_seen = true;
+    } else if (coefficient < count) {
       out.push_back(i);
+      ++coefficient;
+    }
+    ++place;
+  }
   return out;
 }
 
@@ -274,7 +293,7 @@ CrossValidation cross_validated(Problem& problem, const std::vector<joints::Join
         const frf::HarmonicBalanceResult r = problem.solve(sim, i, fitted);
         for (const auto& e : compared.entries) // a failed prediction counts as predicting nothing
           if (e.test == i) {
-            part.squared += r.status.ok() ? std::norm(e.measured - r.X(e.harmonic, e.response))
+            part.squared += r.status.ok() ? std::norm(e.measured - r.X(e.row, e.response))
                                           : std::norm(e.measured);
             part.measured2 += std::norm(e.measured);
           }

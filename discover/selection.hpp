@@ -102,7 +102,10 @@ Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& o
               const std::function<CrossValidation(std::size_t)>& cv_of);
 
 /// The candidates refined by output error: the best `count` by the criterion among those with a
-/// finite criterion, converged, and not varying per test.
+/// finite criterion, converged, not varying per test and not parametric; and besides them the
+/// best parametric one (jenkins, iwan, gap) when it ranks among the best `count` + 1 of all
+/// those (its start, a describing-function fit, screens it; output error gives its parameters
+/// and their intervals).
 std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int count);
 
 // Cross-validation.

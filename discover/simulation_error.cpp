@@ -7,7 +7,9 @@
 //    integration with exact stick–slip;
 //  - the noise of the measured force that drives the simulation, propagated through the model:
 //    the fundamental of each force perturbed by its standard deviation, in phase and in
-//    quadrature, E|δX|² = (|ΔX_re|² + |ΔX_im|²) / 2.
+//    quadrature, E|δX|² = (|ΔX_re|² + |ΔX_im|²) / 2; a periodic test's excited lines all at once,
+//    each by its own standard deviation (a line's response comes from its own force, the others'
+//    reaching it only through the joints' non-linearity: a second-order effect of the noise).
 #include "discover/problem.hpp"
 
 #include "fem/parallel.hpp"
@@ -41,19 +43,21 @@ void Problem::propagate_force_noise(const State& s, const Simulator& sim) {
   for (std::size_t i = 0; i < tests_.size(); ++i) {
     if (o_.checkpoint) o_.checkpoint();
     const auto& m = tests_[i];
+    const bool periodic = m.kind == identify::RecordKind::periodic;
+    const std::vector<int> lines = periodic ? m.excited_lines : std::vector<int>{1};
     for (Eigen::Index c = 0; c < drive_[i].cols(); ++c) {
-      const double v = m.F_variance.size() > 0 ? m.F_variance(1, c) : nan;
+      const double v = m.F_variance.size() > 0 ? m.F_variance(lines.front(), c) : nan;
       if (!(v > 0.0) || !compared_.noise_known) continue;
       for (Complex unit : {Complex(1.0, 0.0), Complex(0.0, 1.0)}) {
         Eigen::MatrixXcd F = drive_[i];
-        F(1, c) += std::sqrt(v) * unit;
+        for (int k : lines)
+          F(k, c) += std::sqrt(m.F_variance(k, c)) * unit;
         const frf::HarmonicBalanceResult r =
             sim.balance[i].solve(s.joints, F, s.Y[i].size() > 0 ? &s.Y[i] : nullptr);
         if (!r.status.ok()) continue;
         for (auto& e : compared_.entries)
           if (e.test == static_cast<int>(i))
-            e.force +=
-                0.5 * std::norm(r.X(e.harmonic, e.response) - s.X[i](e.harmonic, e.response));
+            e.force += 0.5 * std::norm(r.X(e.row, e.response) - s.X[i](e.row, e.response));
       }
     }
   }
@@ -85,7 +89,8 @@ double Problem::estimate_simulation_error(State& s) {
     if (same_branch) {
       reference = exact[i];
     } else {
-      Eigen::MatrixXcd start = Eigen::MatrixXcd::Zero(fine.harmonics + 1, layout_.size());
+      Eigen::MatrixXcd start = Eigen::MatrixXcd::Zero(fine.balance[i].options().harmonics + 1,
+                                                      static_cast<Eigen::Index>(layout_.size()));
       start.topRows(measured_start_[i].rows()) = measured_start_[i];
       frf::HarmonicBalanceResult r = fine.balance[i].solve(s.joints, drive_[i], &start);
       if (!r.status.ok()) r = fine.balance[i].solve(s.joints, drive_[i]);
@@ -94,9 +99,10 @@ double Problem::estimate_simulation_error(State& s) {
     }
     for (auto& e : compared_.entries)
       if (e.test == static_cast<int>(i)) {
-        e.simulation = reference.size() > 0 ? factor * std::norm(reference(e.harmonic, e.response) -
-                                                                 s.X[i](e.harmonic, e.response))
-                                            : 0.0;
+        e.simulation =
+            reference.size() > 0
+                ? factor * std::norm(reference(e.row, e.response) - s.X[i](e.row, e.response))
+                : 0.0;
         E += e.simulation;
       }
   }
@@ -130,7 +136,7 @@ std::vector<Eigen::MatrixXcd> Problem::time_integrated(const State& s) const {
       if (o_.checkpoint) o_.checkpoint();
       const auto& m = tests_[i];
       // One force, a pure sine: what the integrator's load can be.
-      if (force_eq_[i].size() != 1) return {};
+      if (force_eq_[i].size() != 1 || m.kind == identify::RecordKind::periodic) return {};
       for (Eigen::Index k = 0; k < drive_[i].rows(); ++k)
         if (k != 1 && std::abs(drive_[i](k, 0)) > 0.0) return {};
       const Complex F1 = drive_[i](1, 0);

@@ -318,22 +318,8 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
     for (const int k : P.harmonics) {
       D.setIdentity();
       for (int j = 0; j < nj; ++j) {
-        Complex lin = 0.0;
-        for (std::size_t t = 0; t < joints[j].terms.size(); ++t) {
-          const joints::TermInfo& info = joints::term_info(joints[j].terms[t]);
-          if (info.parameters.size() > 0) { // the stiffness at small amplitude
-            const joints::Term term = joints[j].terms[t];
-            if (term == joints::Term::jenkins || term == joints::Term::iwan)
-              lin += joints[j].parameter(t, "kt");
-            else if (term == joints::Term::gap && joints[j].parameter(t, "delta") == 0.0)
-              lin += joints[j].parameter(t, "kg");
-            continue;
-          }
-          if (info.degree != 1) continue;
-          lin += info.nature == joints::Nature::conservative
-                     ? Complex(joints[j].values[t])
-                     : Complex(0.0, k * P.omega) * joints[j].values[t];
-        }
+        const detail::LinearJoint linear = detail::linear_joint(joints[j]);
+        const Complex lin(linear.stiffness, k * P.omega * linear.damping);
         D.col(j) += P.Hyy[k].col(j) * lin;
       }
       lu.compute(D);

@@ -44,6 +44,29 @@ inline void joint_force(const joints::Joint& j, double y, double v, double width
   }
 }
 
+// A joint at small amplitude: its linear stiffness (k, a hysteretic term's kt, a gap's kg
+// when it has no clearance) and its linear viscous damping (c); the other terms vanish there.
+// The harmonic balance's linear start and the backbone's linear mode.
+struct LinearJoint {
+  double stiffness = 0.0, damping = 0.0;
+};
+inline LinearJoint linear_joint(const joints::Joint& j) {
+  LinearJoint out;
+  for (std::size_t t = 0; t < j.terms.size(); ++t) {
+    const joints::TermInfo& info = joints::term_info(j.terms[t]);
+    if (info.parameters.size() > 0) {
+      if (j.terms[t] == joints::Term::jenkins || j.terms[t] == joints::Term::iwan)
+        out.stiffness += j.parameter(t, "kt");
+      else if (j.terms[t] == joints::Term::gap && j.parameter(t, "delta") == 0.0)
+        out.stiffness += j.parameter(t, "kg");
+      continue;
+    }
+    if (info.degree != 1) continue;
+    (info.nature == joints::Nature::conservative ? out.stiffness : out.damping) += j.values[t];
+  }
+  return out;
+}
+
 // A joint's memoryless force g and its derivatives at the n time samples y, ẏ, added to the
 // columns of g (n × 3: g, ∂g/∂y, ∂g/∂ẏ): its coefficient terms and gaps; the hysteretic terms
 // are the equations' (Equations::sliders). Coulomb friction is left out when it is handled

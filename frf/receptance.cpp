@@ -174,6 +174,18 @@ ModalSynthesis ModalSynthesis::with_damping_scale(double factor) const {
   return scaled;
 }
 
+ModalSynthesis ModalSynthesis::with_self_excitation(double xi) const {
+  require_ok();
+  if (!measured_.empty())
+    throw std::logic_error("receptance: measured FRFs have no modal damping to shift");
+  if (!std::isfinite(xi))
+    throw std::invalid_argument("modal synthesis: the self-excitation must be finite, got " +
+                                std::to_string(xi));
+  ModalSynthesis shifted = *this;
+  shifted.modal_damping_.array() -= xi;
+  return shifted;
+}
+
 Eigen::MatrixXd ModalSynthesis::shapes(std::span<const int> equations) const {
   require_ok();
   Eigen::MatrixXd out(equations.size(), phi_.cols());

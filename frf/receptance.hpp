@@ -77,6 +77,12 @@ public:
   /// std::invalid_argument): "the substructure's damping is off by a factor".
   /// Measured FRFs have no modal damping to scale: std::logic_error (check measured()).
   ModalSynthesis with_damping_scale(double factor) const;
+  /// A copy with ξ (1/s) taken from every mode's damping, 2ζ_rω_r − ξ: the structure with the
+  /// self-excitation −ξ M ẋ of the extended periodic motion concept (frf/backbone.hpp; ΦᵀMΦ = I,
+  /// so in modal coordinates it is −ξ q̇). The residual flexibility (quasi-static) is kept.
+  /// Measured FRFs have no modal damping: std::logic_error (check measured()); a ξ not finite:
+  /// std::invalid_argument.
+  ModalSynthesis with_self_excitation(double xi) const;
   /// The (first) measured FRFs behind the synthesis, or nullptr when it comes from modes only.
   const MeasuredReceptance* measured() const {
     return measured_.empty() ? nullptr : measured_.front().frf.get();

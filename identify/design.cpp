@@ -2,6 +2,7 @@
 
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
+#include "joints/hysteresis.hpp"
 
 #include <fmt/format.h>
 
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace jointid::identify {
@@ -362,6 +364,84 @@ Design choose_tests(const std::vector<CandidateTest>& candidates,
           joints::term_name(x.term), x.joint, n, 100.0 * d.std(u) / std::abs(x.prior), x.prior));
   }
   return d;
+}
+
+std::vector<ParametricLevel> parametric_levels(const std::vector<joints::Joint>& joints,
+                                               const std::vector<CandidateTest>& candidates) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<ParametricLevel> out;
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    const joints::Joint& J = joints[j];
+    for (std::size_t t = 0; t < J.terms.size(); ++t) {
+      if (!joints::has_parameters(J.terms[t]) || J.fixed[t]) continue;
+      joints::check_parameters(J); // every parameter needs its value (a prior guess)
+      ParametricLevel level;
+      level.joint = J.name;
+      level.term = J.terms[t];
+      const std::string name(joints::term_name(J.terms[t]));
+      const int k_index = J.term_index(joints::Term::k);
+      const bool k_open = k_index >= 0 && !J.fixed[static_cast<std::size_t>(k_index)];
+      std::string below, above; // what the tests determine below and from the threshold
+      if (J.terms[t] == joints::Term::jenkins) {
+        level.regime = "slip";
+        level.threshold = J.parameter(t, "fs") / J.parameter(t, "kt");
+        below = fmt::format("the jenkins is a spring of stiffness jenkins.kt, {}jenkins.fs is "
+                            "undetermined",
+                            k_open ? "determined only as k + jenkins.kt; " : "");
+        above = "jenkins.kt and jenkins.fs";
+      } else if (J.terms[t] == joints::Term::iwan) {
+        level.regime = "macroslip";
+        level.threshold = joints::iwan_density(J.parameter(t, "fs"), J.parameter(t, "kt"),
+                                               J.parameter(t, "chi"), J.parameter(t, "beta"))
+                              .phi_max;
+        below = fmt::format("its force depends only on k + iwan.kt, iwan.chi and the slip "
+                            "density's scale: {}iwan.fs apart from iwan.beta are undetermined",
+                            k_open ? "k apart from iwan.kt, and " : "");
+        above =
+            fmt::format("iwan.fs apart from iwan.beta{}", k_open ? ", k apart from iwan.kt" : "");
+      } else {
+        level.regime = "contact";
+        level.threshold = J.parameter(t, "delta");
+        below = "the gap gives no force: gap.delta and gap.kg are undetermined";
+        above = "gap.delta and gap.kg";
+      }
+      // Per frequency: the smallest force that reaches the threshold, else the largest usable.
+      std::map<double, std::pair<double, const CandidateTest*>> reach, largest;
+      for (const CandidateTest& c : candidates) {
+        if (!c.usable || j >= c.joint_amplitude.size()) continue;
+        const double f = c.plan.frequency_hz, F = c.plan.amplitude;
+        if (c.joint_amplitude[j] >= level.threshold && (!reach.contains(f) || F < reach[f].first))
+          reach[f] = {F, &c};
+        if (!largest.contains(f) || F > largest[f].first) largest[f] = {F, &c};
+      }
+      std::string levels;
+      for (const auto& [f, big] : largest) {
+        level.frequency_hz.push_back(f);
+        if (reach.contains(f)) {
+          level.lowest_force.push_back(reach[f].first);
+          level.guess_force.push_back(nan);
+          levels += fmt::format("{}at {:g} Hz from {:g} N", levels.empty() ? "" : "; ", f,
+                                reach[f].first);
+        } else {
+          const double a = big.second->joint_amplitude[j];
+          const double guess = a > 0.0 ? big.first * level.threshold / a : nan;
+          level.lowest_force.push_back(nan);
+          level.guess_force.push_back(guess);
+          levels +=
+              fmt::format("{}at {:g} Hz none of the candidates (the largest, {:g} N, "
+                          "reaches {:.3g} of it; about {:.3g} N by linear scaling)",
+                          levels.empty() ? "" : "; ", f, big.first, a / level.threshold, guess);
+        }
+      }
+      level.sentence = fmt::format(
+          "joint '{}': its {} reaches {} where its deformation exceeds {:.4g} (by the model's "
+          "values): {}. Below that {}; tests that reach it determine {}",
+          J.name, name, level.regime, level.threshold,
+          levels.empty() ? std::string("no candidate could be predicted") : levels, below, above);
+      out.push_back(std::move(level));
+    }
+  }
+  return out;
 }
 
 } // namespace jointid::identify

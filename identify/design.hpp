@@ -104,6 +104,30 @@ struct Design {
   std::vector<std::string> warnings;
 };
 
+/// What a joint's parametric term (jenkins, iwan, gap) with parameters not fixed needs of the
+/// tests: its parameters are determined apart only by tests whose deformation reaches a regime
+/// (the term's force below it depends on fewer combinations of them), and the design says, by
+/// the model's values, which candidate force levels reach it.
+struct ParametricLevel {
+  std::string joint;
+  joints::Term term = joints::Term::jenkins;
+  std::string regime;     ///< "slip" (jenkins), "macroslip" (iwan), "contact" (gap)
+  double threshold = 0.0; ///< the deformation that reaches it: fs/kt, φ_max, δ (m or rad)
+  /// Per candidate frequency (ascending): the smallest candidate force whose predicted
+  /// deformation (its fundamental's amplitude) reaches the threshold; NaN where none does.
+  std::vector<double> frequency_hz, lowest_force;
+  /// Where none does: the force scaled linearly from the largest usable candidate's deformation
+  /// to the threshold (a rough guess, beyond the candidates); NaN where one does.
+  std::vector<double> guess_force;
+  std::string sentence; ///< all of it in words: what the tests there determine
+};
+
+/// One ParametricLevel per joint term with parameters not all fixed, from the candidates (as
+/// predict_candidates() made them with those terms held at the joints' values). Throws
+/// std::invalid_argument for a parameter without a value (the prediction needs every one).
+std::vector<ParametricLevel> parametric_levels(const std::vector<joints::Joint>& joints,
+                                               const std::vector<CandidateTest>& candidates);
+
 /// The D-optimal set of `n` distinct usable candidates (list a candidate twice to allow it to
 /// be repeated). Throws std::invalid_argument when n is not positive or exceeds the usable
 /// candidates; warns, naming the term, when the best set leaves an unknown undetermined

@@ -100,10 +100,11 @@ void check_identifiable(const std::vector<joints::Joint>& joints) {
       throw std::invalid_argument(
           "joint '" + j.name + "': the parameters of term '" + name + "' (" +
           joints::parameter_names(j.terms[t]) +
-          ") enter its force non-linearly; they are identified by output error, which is "
-          "coming — to identify the joint's other terms with this one known, give all of its "
-          "parameters in 'values' and list \"" +
-          name + "\" in 'fixed'");
+          ") enter its force non-linearly: the equation error takes the term only as a known "
+          "force (all of its parameters in 'values' and \"" +
+          name +
+          "\" in 'fixed'); output error identifies them, started from a describing-function "
+          "fit (identify::output_error)");
     }
 }
 

@@ -145,10 +145,11 @@ struct TestSpectrum {
 /// The joints' DOFs (set 2), in the order used by TestSpectrum::X2.
 using joints::joint_dof_set;
 
-/// The equation-error route (and the output error, the design built on it) identifies the
-/// coefficients of the terms k … fc. A parametric term (jenkins, iwan, gap) enters its force
-/// non-linearly: it is used only with all of its parameters fixed (a known force). Throws
-/// std::invalid_argument naming the joint, the term and its parameters otherwise.
+/// The equation-error route (and the design built on it) identifies the coefficients of the
+/// terms k … fc. A parametric term (jenkins, iwan, gap) enters its force non-linearly: it is
+/// used only with all of its parameters fixed (a known force); output error
+/// (identify/output_error.hpp) identifies its parameters. Throws std::invalid_argument naming
+/// the joint, the term and its parameters otherwise.
 void check_identifiable(const std::vector<joints::Joint>& joints);
 /// The parameters of term t of joint j for a TermEstimate (empty for a coefficient term).
 std::vector<ParameterEstimate> parameters_of(const joints::Joint& joint, std::size_t term);

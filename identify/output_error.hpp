@@ -51,8 +51,13 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
                        const std::vector<Measurement>& tests, const FitResult& start,
                        const OutputErrorOptions& options = {});
 
-/// The whole pipeline: fit() (equation error, its options), then output_error() on the
-/// substructure's synthesis over the joints', forces' and responses' DOFs.
+/// The whole pipeline: a parametric term's non-fixed parameters (jenkins, iwan, gap; one such
+/// term a joint) started by describing_function_start(), whose failure is the result's status
+/// (naming the joint and the term); fit() (equation error, its options) with those forces
+/// known; then output_error() on the substructure's synthesis over the joints', forces' and
+/// responses' DOFs. A parameter the tests do not determine (an iwan kept in microslip) has no
+/// value, `determined` false, and FitResult::identifiability says which combinations the tests
+/// determine, with their intervals.
 FitResult output_error(const frf::Substructure& substructure,
                        const std::vector<joints::Joint>& joints,
                        const std::vector<Measurement>& tests, const FitOptions& fit_options,

@@ -26,10 +26,7 @@ bool is_exponent(const joints::ParameterInfo& info) {
 }
 
 // One test's equivalent dynamic stiffness of a joint.
-struct Point {
-  double amplitude, omega;
-  Complex Z;
-};
+using Point = EquivalentStiffness;
 
 } // namespace
 
@@ -95,23 +92,200 @@ std::vector<joints::Joint> with_parametric_fixed(std::vector<joints::Joint> join
   return joints;
 }
 
-std::vector<joints::Joint> describing_function_start(const frf::Substructure& sub,
-                                                     const std::vector<joints::Joint>& joints,
-                                                     const std::vector<Measurement>& tests,
-                                                     const FitOptions& fit_options,
-                                                     std::vector<std::string>& notes) {
-  std::vector<joints::Joint> out = joints;
+void check_one_parametric_term(const std::vector<joints::Joint>& joints) {
+  for (const joints::Joint& J : joints) {
+    std::vector<std::string> open;
+    for (std::size_t t = 0; t < J.terms.size(); ++t)
+      if (joints::has_parameters(J.terms[t]) && !J.fixed[t])
+        open.emplace_back(joints::term_name(J.terms[t]));
+    if (open.size() > 1)
+      throw std::invalid_argument(fmt::format(
+          "joint '{}': its terms {} both have parameters that are not fixed; output error "
+          "identifies one parametric term of a joint at a time: give all the parameters of the "
+          "others in 'values' and list them in 'fixed'",
+          J.name, fmt::join(open, " and ")));
+  }
+}
+
+// Step 2: the parameters of term T of J (its fixed ones held) in their coordinates u that fit
+// N(a) + k + iωc to the points, sorted by amplitude (the joint's own k and c by least squares
+// where open), from a few starts read off the data; empty when no start gives a finite misfit.
+static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
+                                const std::vector<Point>& points, bool k_open, bool c_open,
+                                double& best_cost) {
+  const joints::Term term = J.terms[T];
+  // 2. N(a) + k + iωc fitted to Z(a).
+  const auto& info = joints::term_info(term).parameters;
+  const auto np = static_cast<Eigen::Index>(info.size());
+  std::vector<bool> free(info.size());
+  for (std::size_t p = 0; p < info.size(); ++p)
+    free[p] = !(J.parameters.size() > T && J.parameters[T].size() == info.size() &&
+                J.parameters[T][p].fixed);
+  joints::Joint trial = J;
+  if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
+    trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+  const auto residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) -> bool {
+    for (Eigen::Index p = 0; p < np; ++p) {
+      joints::Parameter& P = trial.parameters[T][static_cast<std::size_t>(p)];
+      P.value = parameter_from_u(info[static_cast<std::size_t>(p)], u(p));
+      P.given = true;
+    }
+    try {
+      joints::check_parameters(trial);
+    } catch (const std::invalid_argument&) {
+      return false;
+    }
+    const auto n = static_cast<Eigen::Index>(points.size());
+    Eigen::VectorXcd e(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Point& P = points[static_cast<std::size_t>(i)];
+      e(i) = P.Z - describing_function(trial, T, P.amplitude);
+    }
+    // The joint's own k and c by least squares (each point weighted by 1/|Z|).
+    double kw = 0.0, w = 0.0, cw = 0.0, wc = 0.0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Point& P = points[static_cast<std::size_t>(i)];
+      const double wi = 1.0 / std::max(std::norm(P.Z), 1e-300);
+      kw += wi * e(i).real(), w += wi;
+      cw += wi * P.omega * e(i).imag(), wc += wi * P.omega * P.omega;
+    }
+    const double k = k_open ? kw / w : 0.0, c = c_open ? cw / wc : 0.0;
+    r.resize(2 * n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Point& P = points[static_cast<std::size_t>(i)];
+      const Complex d = (e(i) - Complex(k, P.omega * c)) / std::max(std::abs(P.Z), 1e-300);
+      r(2 * i) = d.real(), r(2 * i + 1) = d.imag();
+    }
+    return r.allFinite();
+  };
+
+  // Starts read off the data.
+  const Point &lo = points.front(), &hi = points.back();
+  double dissipation = 0.0; // π a² Im Z: the dissipation per cycle, largest
+  for (const Point& P : points)
+    dissipation = std::max(dissipation, std::numbers::pi * P.amplitude * P.amplitude * P.Z.imag());
+  const double lost = lo.Z.real() - hi.Z.real(), gained = -lost;
+  const double k_small = std::max(k_open ? lost : lo.Z.real(), 1e-3 * std::abs(lo.Z));
+  std::vector<std::vector<double>> starts;
+  if (J.parameters.size() > T && J.parameters[T].size() == info.size() &&
+      std::all_of(J.parameters[T].begin(), J.parameters[T].end(),
+                  [](const joints::Parameter& p) { return p.given; })) {
+    std::vector<double> given;
+    for (const joints::Parameter& p : J.parameters[T])
+      given.push_back(p.value);
+    starts.push_back(given);
+  }
+  for (const double scale : {0.3, 1.0, 3.0}) {
+    const double fs = std::max(scale * dissipation / (4.0 * hi.amplitude), 1e-300);
+    if (term == joints::Term::jenkins) starts.push_back({std::max(k_small, 1e-300), fs});
+    if (term == joints::Term::iwan)
+      for (const double chi : {-0.6, -0.2})
+        starts.push_back({3.0 * fs, std::max(k_small, 1e-300), chi, 0.1});
+    if (term == joints::Term::gap)
+      starts.push_back(
+          {scale * lo.amplitude, std::max(gained > 0.0 ? 2.0 * gained : std::abs(hi.Z), 1e-300)});
+  }
+  best_cost = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd best;
+  for (const auto& s : starts) {
+    Eigen::VectorXd u(np), r, rn;
+    for (Eigen::Index p = 0; p < np; ++p) {
+      const std::size_t q = static_cast<std::size_t>(p);
+      const bool keep = !free[q] && J.parameters.size() > T;
+      u(p) = parameter_to_u(info[q], keep ? J.parameters[T][q].value : s[q]);
+    }
+    if (!residual(u, r)) continue;
+    double cost = r.squaredNorm(), mu = 1e-2;
+    for (int it = 0; it < 60; ++it) {
+      Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(r.size(), np);
+      for (Eigen::Index p = 0; p < np; ++p) {
+        if (!free[static_cast<std::size_t>(p)]) continue;
+        const double h = 1e-6 * std::max(1.0, std::abs(u(p)));
+        Eigen::VectorXd up = u;
+        up(p) += h;
+        if (residual(up, rn)) {
+          Jm.col(p) = (rn - r) / h;
+        } else {
+          up(p) = u(p) - h;
+          if (residual(up, rn)) Jm.col(p) = (r - rn) / h;
+        }
+      }
+      const Eigen::MatrixXd A = Jm.transpose() * Jm;
+      const Eigen::VectorXd g = Jm.transpose() * r;
+      bool accepted = false;
+      for (int tries = 0; tries < 10 && !accepted; ++tries) {
+        Eigen::MatrixXd M = A;
+        M.diagonal().array() += mu * (1.0 + A.diagonal().array());
+        const Eigen::VectorXd next = u - M.ldlt().solve(g);
+        if (next.allFinite() && residual(next, rn) && rn.squaredNorm() < cost) {
+          const double gain = (cost - rn.squaredNorm()) / cost;
+          u = next, r = rn, cost = rn.squaredNorm(), mu = std::max(mu / 10.0, 1e-10);
+          accepted = true;
+          if (gain < 1e-12) it = 1000;
+        } else {
+          mu *= 10.0;
+        }
+      }
+      if (!accepted) break;
+    }
+    (void)residual(u, r); // r at u, trial's parameters too
+    if (r.squaredNorm() < best_cost) best_cost = r.squaredNorm(), best = u;
+  }
+  return best;
+}
+
+joints::Joint fit_describing_function(const joints::Joint& J, std::size_t T,
+                                      std::vector<EquivalentStiffness> points, bool k_open,
+                                      bool c_open, std::string& note) {
+  const joints::Term term = J.terms[T];
+  if (points.empty())
+    throw std::invalid_argument("joint '" + J.name + "': no equivalent stiffness to fit its " +
+                                std::string(joints::term_name(term)) + " to");
+  std::sort(points.begin(), points.end(),
+            [](const Point& p, const Point& q) { return p.amplitude < q.amplitude; });
+  double best_cost = 0.0;
+  const Eigen::VectorXd best = best_fit(J, T, points, k_open, c_open, best_cost);
+  if (best.size() == 0)
+    throw std::invalid_argument("joint '" + J.name + "': the describing-function fit of its " +
+                                std::string(joints::term_name(term)) + " found no start");
+  const auto& info = joints::term_info(term).parameters;
+  joints::Joint out = J;
+  if (out.parameters.size() <= T || out.parameters[T].size() != info.size())
+    out.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+  std::string values;
+  for (std::size_t q = 0; q < info.size(); ++q) {
+    joints::Parameter& P = out.parameters[T][q];
+    P.value = parameter_from_u(info[q], best(static_cast<Eigen::Index>(q)));
+    P.given = true;
+    values += fmt::format("{}{}.{} = {:.4g}", values.empty() ? "" : ", ", joints::term_name(term),
+                          info[q].name, P.value);
+  }
+  if (!out.given.empty()) out.given[T] = true;
+  joints::check_parameters(out); // out of its range: std::invalid_argument saying which
+  note = fmt::format("joint '{}': {} started from a describing-function fit of the equivalent "
+                     "stiffness and damping of {} test(s) at deformation amplitudes {:.3g} … "
+                     "{:.3g} (relative misfit {:.2g}): {}",
+                     J.name, joints::term_name(term), points.size(), points.front().amplitude,
+                     points.back().amplitude,
+                     std::sqrt(best_cost / static_cast<double>(2 * points.size())), values);
+  return out;
+}
+
+DescribingFunctionStart describing_function_start(const frf::Substructure& sub,
+                                                  const std::vector<joints::Joint>& joints,
+                                                  const std::vector<Measurement>& tests,
+                                                  const FitOptions& fit_options) {
+  check_one_parametric_term(joints);
+  DescribingFunctionStart start;
+  start.joints = joints;
+  std::vector<joints::Joint>& out = start.joints;
+  std::vector<std::string>& notes = start.notes;
   for (std::size_t jj = 0; jj < joints.size(); ++jj) {
     const joints::Joint& J = joints[jj];
     std::vector<std::size_t> open;
     for (std::size_t t = 0; t < J.terms.size(); ++t)
       if (joints::has_parameters(J.terms[t]) && !J.fixed[t]) open.push_back(t);
     if (open.empty()) continue;
-    if (open.size() > 1)
-      throw std::invalid_argument("joint '" + J.name +
-                                  "': one parametric term at a time is identified (" +
-                                  std::to_string(open.size()) +
-                                  " are not fixed); give the others' parameters and fix them");
     const std::size_t T = open[0];
     const joints::Term term = J.terms[T];
 
@@ -147,149 +321,64 @@ std::vector<joints::Joint> describing_function_start(const frf::Substructure& su
     std::vector<joints::Joint> model = with_parametric_fixed(joints);
     model[jj] = linear;
     std::vector<Point> points;
+    int measured = 0;     // tests that measure the joint's deformation
+    fem::Status refused;  // the first per-test fit's status that was not ok
+    std::string left_out; // the first per-test fit refused as input, why
     for (const Measurement& m : tests) {
       const double a = joint_amplitude(m, J);
       if (!(a > 0.0)) continue;
+      ++measured;
       try {
         const FitResult r = fit(sub, model, {m}, fit_options);
-        if (!r.status.ok()) continue;
+        if (!r.status.ok()) {
+          if (refused.ok()) refused = r.status.within(m.source + ": ");
+          continue;
+        }
         const double omega = 2.0 * std::numbers::pi * m.frequency_hz;
         const double k = r.joints[jj].terms[0].value, c = r.joints[jj].terms[1].value;
         points.push_back({a, omega, Complex(k - k_fixed, omega * (c - c_fixed))});
-      } catch (const std::invalid_argument&) {
-        continue; // this test alone does not determine k and c: left out of the start
+      } catch (const std::invalid_argument& e) {
+        // this test alone does not determine k and c: left out of the start
+        if (left_out.empty()) left_out = e.what();
       }
     }
-    if (points.empty())
-      throw std::invalid_argument("joint '" + J.name +
-                                  "': no test alone gives its equivalent "
-                                  "stiffness and damping (the start of the " +
-                                  std::string(joints::term_name(term)) +
-                                  "'s output error): measure the joint's DOFs");
+    const std::string what = fmt::format("joint '{}': the describing-function fit of its {} (the "
+                                         "start of its output error)",
+                                         J.name, joints::term_name(term));
+    if (measured == 0)
+      throw std::invalid_argument(what + " has no test that measures the joint's deformation: "
+                                         "record the response at the joint's DOFs");
+    if (points.empty()) {
+      start.status =
+          !refused.ok()
+              ? refused.within(what + ": no test alone gives its equivalent stiffness and "
+                                      "damping: ")
+              : fem::Status::failure(fem::Status::Code::not_separable,
+                                     what +
+                                         ": no test alone gives its equivalent stiffness "
+                                         "and damping (" +
+                                         left_out + ")");
+      start.joints = joints;
+      return start;
+    }
     std::sort(points.begin(), points.end(),
               [](const Point& p, const Point& q) { return p.amplitude < q.amplitude; });
 
     // 2. N(a) + k + iωc fitted to Z(a).
     const auto& info = joints::term_info(term).parameters;
     const auto np = static_cast<Eigen::Index>(info.size());
-    std::vector<bool> free(info.size());
-    for (std::size_t p = 0; p < info.size(); ++p)
-      free[p] = !(J.parameters.size() > T && J.parameters[T].size() == info.size() &&
-                  J.parameters[T][p].fixed);
-    joints::Joint trial = J;
-    if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
-      trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
-    const auto residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) -> bool {
-      for (Eigen::Index p = 0; p < np; ++p) {
-        joints::Parameter& P = trial.parameters[T][static_cast<std::size_t>(p)];
-        P.value = parameter_from_u(info[static_cast<std::size_t>(p)], u(p));
-        P.given = true;
-      }
-      try {
-        joints::check_parameters(trial);
-      } catch (const std::invalid_argument&) {
-        return false;
-      }
-      const auto n = static_cast<Eigen::Index>(points.size());
-      Eigen::VectorXcd e(n);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Point& P = points[static_cast<std::size_t>(i)];
-        e(i) = P.Z - describing_function(trial, T, P.amplitude);
-      }
-      // The joint's own k and c by least squares (each point weighted by 1/|Z|).
-      double kw = 0.0, w = 0.0, cw = 0.0, wc = 0.0;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Point& P = points[static_cast<std::size_t>(i)];
-        const double wi = 1.0 / std::max(std::norm(P.Z), 1e-300);
-        kw += wi * e(i).real(), w += wi;
-        cw += wi * P.omega * e(i).imag(), wc += wi * P.omega * P.omega;
-      }
-      const double k = k_open ? kw / w : 0.0, c = c_open ? cw / wc : 0.0;
-      r.resize(2 * n);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Point& P = points[static_cast<std::size_t>(i)];
-        const Complex d = (e(i) - Complex(k, P.omega * c)) / std::max(std::abs(P.Z), 1e-300);
-        r(2 * i) = d.real(), r(2 * i + 1) = d.imag();
-      }
-      return r.allFinite();
-    };
-
-    // Starts read off the data.
     const Point &lo = points.front(), &hi = points.back();
-    double dissipation = 0.0; // π a² Im Z: the dissipation per cycle, largest
-    for (const Point& P : points)
-      dissipation =
-          std::max(dissipation, std::numbers::pi * P.amplitude * P.amplitude * P.Z.imag());
-    const double lost = lo.Z.real() - hi.Z.real(), gained = -lost;
-    const double k_small = std::max(k_open ? lost : lo.Z.real(), 1e-3 * std::abs(lo.Z));
-    std::vector<std::vector<double>> starts;
-    if (J.parameters.size() > T && J.parameters[T].size() == info.size() &&
-        std::all_of(J.parameters[T].begin(), J.parameters[T].end(),
-                    [](const joints::Parameter& p) { return p.given; })) {
-      std::vector<double> given;
-      for (const joints::Parameter& p : J.parameters[T])
-        given.push_back(p.value);
-      starts.push_back(given);
-    }
-    for (const double scale : {0.3, 1.0, 3.0}) {
-      const double fs = std::max(scale * dissipation / (4.0 * hi.amplitude), 1e-300);
-      if (term == joints::Term::jenkins) starts.push_back({std::max(k_small, 1e-300), fs});
-      if (term == joints::Term::iwan)
-        for (const double chi : {-0.6, -0.2})
-          starts.push_back({3.0 * fs, std::max(k_small, 1e-300), chi, 0.1});
-      if (term == joints::Term::gap)
-        starts.push_back(
-            {scale * lo.amplitude, std::max(gained > 0.0 ? 2.0 * gained : std::abs(hi.Z), 1e-300)});
-    }
     double best_cost = std::numeric_limits<double>::infinity();
-    Eigen::VectorXd best;
-    for (const auto& s : starts) {
-      Eigen::VectorXd u(np), r, rn;
-      for (Eigen::Index p = 0; p < np; ++p) {
-        const std::size_t q = static_cast<std::size_t>(p);
-        const bool keep = !free[q] && J.parameters.size() > T;
-        u(p) = parameter_to_u(info[q], keep ? J.parameters[T][q].value : s[q]);
-      }
-      if (!residual(u, r)) continue;
-      double cost = r.squaredNorm(), mu = 1e-2;
-      for (int it = 0; it < 60; ++it) {
-        Eigen::MatrixXd Jm = Eigen::MatrixXd::Zero(r.size(), np);
-        for (Eigen::Index p = 0; p < np; ++p) {
-          if (!free[static_cast<std::size_t>(p)]) continue;
-          const double h = 1e-6 * std::max(1.0, std::abs(u(p)));
-          Eigen::VectorXd up = u;
-          up(p) += h;
-          if (residual(up, rn)) {
-            Jm.col(p) = (rn - r) / h;
-          } else {
-            up(p) = u(p) - h;
-            if (residual(up, rn)) Jm.col(p) = (r - rn) / h;
-          }
-        }
-        const Eigen::MatrixXd A = Jm.transpose() * Jm;
-        const Eigen::VectorXd g = Jm.transpose() * r;
-        bool accepted = false;
-        for (int tries = 0; tries < 10 && !accepted; ++tries) {
-          Eigen::MatrixXd M = A;
-          M.diagonal().array() += mu * (1.0 + A.diagonal().array());
-          const Eigen::VectorXd next = u - M.ldlt().solve(g);
-          if (next.allFinite() && residual(next, rn) && rn.squaredNorm() < cost) {
-            const double gain = (cost - rn.squaredNorm()) / cost;
-            u = next, r = rn, cost = rn.squaredNorm(), mu = std::max(mu / 10.0, 1e-10);
-            accepted = true;
-            if (gain < 1e-12) it = 1000;
-          } else {
-            mu *= 10.0;
-          }
-        }
-        if (!accepted) break;
-      }
-      (void)residual(u, r); // r at u, trial's parameters too
-      if (r.squaredNorm() < best_cost) best_cost = r.squaredNorm(), best = u;
+    const Eigen::VectorXd best = best_fit(J, T, points, k_open, c_open, best_cost);
+    if (best.size() == 0) {
+      start.status = fem::Status::failure(
+          fem::Status::Code::not_converging,
+          fmt::format("{}: no start gave a finite misfit over the {} test(s) at deformation "
+                      "amplitudes {:.3g} … {:.3g}",
+                      what, points.size(), lo.amplitude, hi.amplitude));
+      start.joints = joints;
+      return start;
     }
-    if (best.size() == 0)
-      throw std::invalid_argument("joint '" + J.name + "': the describing-function fit of its " +
-                                  std::string(joints::term_name(term)) + " found no start");
     if (out[jj].parameters.size() <= T || out[jj].parameters[T].size() != info.size())
       out[jj].set_parameters(T, std::vector<double>(info.size(), 0.0), false);
     std::string values;
@@ -302,6 +391,27 @@ std::vector<joints::Joint> describing_function_start(const frf::Substructure& su
                             info[q].name, P.value);
     }
     if (!out[jj].given.empty()) out[jj].given[T] = true;
+    try { // the fit may run a parameter out of its range (fs → 0: the term vanishes)
+      joints::check_parameters(out[jj]);
+    } catch (const std::invalid_argument& e) {
+      const double change = (hi.Z.real() - lo.Z.real()) / std::max(std::abs(lo.Z), 1e-300);
+      start.status = fem::Status::failure(
+          fem::Status::Code::not_converging,
+          fmt::format("{}: the fit left the parameters' range ({}; {}): over the tests' "
+                      "deformation amplitudes {:.3g} … {:.3g} the joint's equivalent stiffness "
+                      "changes by {:.2g} % — the tests may not reach its {} (deformation beyond "
+                      "{}): add tests at larger forces, or give the term's parameters and fix "
+                      "them",
+                      what, e.what(), values, lo.amplitude, hi.amplitude, 100.0 * change,
+                      term == joints::Term::gap       ? "contact"
+                      : term == joints::Term::jenkins ? "slip"
+                                                      : "macroslip",
+                      term == joints::Term::gap       ? "delta"
+                      : term == joints::Term::jenkins ? "fs/kt"
+                                                      : "phi_max"));
+      start.joints = joints;
+      return start;
+    }
     notes.push_back(fmt::format(
         "joint '{}': {} started from a describing-function fit of the equivalent stiffness and "
         "damping of {} test(s) at deformation amplitudes {:.3g} … {:.3g} (relative misfit "
@@ -309,7 +419,7 @@ std::vector<joints::Joint> describing_function_start(const frf::Substructure& su
         J.name, joints::term_name(term), points.size(), lo.amplitude, hi.amplitude,
         std::sqrt(best_cost / static_cast<double>(2 * points.size())), values));
   }
-  return out;
+  return start;
 }
 
 } // namespace jointid::identify

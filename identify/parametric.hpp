@@ -13,6 +13,7 @@
 ///     lost between the smallest and largest amplitude, the dissipation's size).
 /// Amplitude-independent information only enters through Z(a): the start is as good as the
 /// amplitudes the tests span.
+#include "fem/status.hpp"
 #include "frf/substructure.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
@@ -36,15 +37,48 @@ double joint_amplitude(const Measurement& m, const joints::Joint& joint);
 double parameter_to_u(const joints::ParameterInfo& info, double p);
 double parameter_from_u(const joints::ParameterInfo& info, double u);
 
-/// The joints with every non-fixed parameter of a parametric term set (given, not fixed) to its
-/// describing-function estimate; `notes` gets one line per term (the amplitudes used, the
-/// relative misfit). At most one non-fixed parametric term per joint. Throws
-/// std::invalid_argument naming the joint when no test gives its equivalent stiffness.
-std::vector<joints::Joint> describing_function_start(const frf::Substructure& substructure,
-                                                     const std::vector<joints::Joint>& joints,
-                                                     const std::vector<Measurement>& tests,
-                                                     const FitOptions& fit_options,
-                                                     std::vector<std::string>& notes);
+/// One test's equivalent dynamic stiffness of a joint: Z = k_eq + iω c_eq of the linear spring
+/// and damper that reproduce its force's fundamental at the amplitude of its deformation's (m),
+/// ω in rad/s. π a² Im Z is the joint's dissipation per cycle there (J).
+struct EquivalentStiffness {
+  double amplitude = 0.0, omega = 0.0;
+  std::complex<double> Z;
+};
+
+/// The describing-function fit alone (step 2, as describing_function_start() does it): term
+/// `term` of `joint` (its fixed parameters held) fitted to the points, with the joint's own k and
+/// c (`k_open`, `c_open`) taken by least squares. Returns the joint with the term's parameters
+/// set (given, not fixed); `note` gets the line describing_function_start() adds. Throws
+/// std::invalid_argument naming the joint when there are no points, no start fits, or the fit
+/// leaves a parameter's range (the tests may not reach the term's regime).
+joints::Joint fit_describing_function(const joints::Joint& joint, std::size_t term,
+                                      std::vector<EquivalentStiffness> points, bool k_open,
+                                      bool c_open, std::string& note);
+
+/// Output error identifies one parametric term a joint at a time: throws std::invalid_argument
+/// naming the joint and its terms when a joint has two or more whose parameters are not all
+/// fixed.
+void check_one_parametric_term(const std::vector<joints::Joint>& joints);
+
+/// The describing-function start of the parametric terms (its numerical outcome a status).
+struct DescribingFunctionStart {
+  /// ok, or why a joint's fit found no start (the reason names the joint and the term; the
+  /// per-test fits' own status passed up within it). `joints` are then as given.
+  fem::Status status;
+  /// The joints with every non-fixed parameter of a parametric term set (given, not fixed) to
+  /// its describing-function estimate.
+  std::vector<joints::Joint> joints;
+  /// One line per term: the amplitudes used, the relative misfit, the values.
+  std::vector<std::string> notes;
+};
+
+/// The start of every non-fixed parametric term (at most one a joint: check_one_parametric_term).
+/// Throws std::invalid_argument naming the joint when no test measures its deformation (bad
+/// input: the joint's DOFs need a response channel).
+DescribingFunctionStart describing_function_start(const frf::Substructure& substructure,
+                                                  const std::vector<joints::Joint>& joints,
+                                                  const std::vector<Measurement>& tests,
+                                                  const FitOptions& fit_options);
 
 /// The joints with every parametric term marked fixed (its parameters as they are): the
 /// equation-error fit then identifies the coefficient terms with these forces known.

@@ -34,7 +34,8 @@ std::string identify_result_json(const identify::FitResult& result,
           one["ci95"] = Json::array({number(p.ci_low), number(p.ci_high)});
           one["fixed"] = p.fixed;
           one["determined"] = p.determined;
-          parameters[p.name] = std::move(one);
+          // keyed as in the model file's values: "<term>.<parameter>"
+          parameters[std::string(joints::term_name(t.term)) + "." + p.name] = std::move(one);
         }
         term["parameters"] = std::move(parameters);
         term["fixed"] = t.fixed;
@@ -122,7 +123,8 @@ std::string modes_json(const fem::Modes& modes, int count,
 std::string design_json(const identify::Design& design,
                         const std::vector<identify::CandidateTest>& candidates,
                         const std::vector<identify::DesignUnknown>& unknowns,
-                        const identify::DesignOptions& options) {
+                        const identify::DesignOptions& options,
+                        const std::vector<identify::ParametricLevel>& levels) {
   Json out;
   out["noise"] = options.noise;
   out["periods"] = options.periods;
@@ -170,6 +172,25 @@ std::string design_json(const identify::Design& design,
     all.push_back(std::move(j));
   }
   out["candidates"] = std::move(all);
+  if (!levels.empty()) {
+    Json parametric = Json::array();
+    for (const auto& l : levels) {
+      Json per = Json::array();
+      for (std::size_t f = 0; f < l.frequency_hz.size(); ++f)
+        per.push_back({{"freq_hz", l.frequency_hz[f]},
+                       {"lowest_force", number(l.lowest_force[f])},
+                       {"guess_force", number(l.guess_force[f])}});
+      Json j;
+      j["joint"] = l.joint;
+      j["term"] = std::string(joints::term_name(l.term));
+      j["regime"] = l.regime;
+      j["threshold"] = number(l.threshold);
+      j["levels"] = std::move(per);
+      j["sentence"] = l.sentence;
+      parametric.push_back(std::move(j));
+    }
+    out["parametric"] = std::move(parametric);
+  }
   out["warnings"] = design.warnings;
   return text(out);
 }

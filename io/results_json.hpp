@@ -36,11 +36,14 @@ std::string modes_json(const fem::Modes& modes, int count = -1,
 /// [{"freq_hz", "amplitude", "record"}], "log_det", "exchanges", "candidates": [{"freq_hz",
 /// "amplitude", "usable", "misfit", "reason", "joint_amplitude": [...], "chosen"}],
 /// "warnings"}. `std` and `bias` are what fit() is predicted to show for the chosen tests
-/// (null: undetermined).
+/// (null: undetermined). With `levels`: "parametric": [{"joint", "term", "regime",
+/// "threshold", "levels": [{"freq_hz", "lowest_force" (null: no candidate reaches it),
+/// "guess_force"}], "sentence"}].
 std::string design_json(const identify::Design& design,
                         const std::vector<identify::CandidateTest>& candidates,
                         const std::vector<identify::DesignUnknown>& unknowns,
-                        const identify::DesignOptions& options);
+                        const identify::DesignOptions& options,
+                        const std::vector<identify::ParametricLevel>& levels = {});
 
 /// Writes JSON text atomically (see write_file_atomically).
 void write_json(const std::filesystem::path& path, const std::string& json);

@@ -7,6 +7,7 @@
 #include <complex>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <utility>
 
 namespace jointid::report {
@@ -335,6 +336,52 @@ Figure sine_figure(const discover::Result& r, std::size_t step) {
 }
 
 } // namespace
+
+Figure joint_behaviour_figure(const discover::JointBehaviour& b) {
+  Figure figure{1200, 500, 2, {}};
+  if (b.amplitude.empty()) return figure;
+  const std::string unit_note = fmt::format(" (lines at {:.3g} Hz)", b.model_frequency_hz);
+  Chart D;
+  D.title = fmt::format("Joint '{}': dissipation per cycle{}", b.joint,
+                        b.behaviour.empty() ? std::string() : " — " + b.behaviour);
+  D.x_label = "deformation amplitude |Y1| (m)";
+  D.y_label = "dissipation per cycle (J)";
+  D.log_x = D.log_y = true;
+  Chart K;
+  K.title = fmt::format("Joint '{}': equivalent stiffness", b.joint);
+  K.x_label = "deformation amplitude |Y1| (m)";
+  K.y_label = "k_eq (N/m)";
+  K.log_x = true;
+  Series dots{"measured, each test alone", {}, {}, Series::Style::points, palette_color(0), 6.0};
+  Series kdots = dots;
+  for (std::size_t i = 0; i < b.amplitude.size(); ++i) {
+    if (b.dissipation[i] > 0.0)
+      dots.x.push_back(b.amplitude[i]), dots.y.push_back(b.dissipation[i]);
+    kdots.x.push_back(b.amplitude[i]), kdots.y.push_back(b.stiffness[i]);
+  }
+  if (!dots.x.empty()) D.series.push_back(dots);
+  K.series.push_back(kdots);
+  const auto line = [&](const std::string& label, const std::vector<double>& y, std::size_t colour,
+                        Series::Style style, bool positive) {
+    Series s{label + unit_note, {}, {}, style, palette_color(colour), 2.0};
+    for (std::size_t i = 0; i < b.model_amplitude.size() && i < y.size(); ++i)
+      if (std::isfinite(y[i]) && (!positive || y[i] > 0.0))
+        s.x.push_back(b.model_amplitude[i]), s.y.push_back(y[i]);
+    return s;
+  };
+  for (auto [chart, start, last, positive] :
+       {std::tuple{&D, &b.start_dissipation, &b.final_dissipation, true},
+        std::tuple{&K, &b.start_stiffness, &b.final_stiffness, false}}) {
+    const Series s0 = line("starting model", *start, 1, Series::Style::dashed, positive);
+    const Series s1 = line("final model", *last, 2, Series::Style::line, positive);
+    if (s0.x.size() > 1) chart->series.push_back(s0);
+    if (s1.x.size() > 1) chart->series.push_back(s1);
+  }
+  if (!D.series.empty()) figure.charts.push_back(D);
+  figure.charts.push_back(K);
+  figure.columns = static_cast<int>(figure.charts.size());
+  return figure;
+}
 
 std::string model_text(const discover::State& s) {
   std::string text;

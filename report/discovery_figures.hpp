@@ -28,6 +28,14 @@ bool stepped_sine_sweeps(const std::vector<discover::Comparison>& tests);
 /// channels.
 Figure discovery_response_figure(const discover::Result& result, std::size_t step);
 
+/// What the tests show of a joint against the amplitude of its deformation (discover::
+/// JointBehaviour): left, the dissipation per cycle on log axes — each test's as dots, the
+/// starting and the final model's as lines (slope 2: viscous, 1: Coulomb sliding, 3 + chi:
+/// microslip); right, the equivalent stiffness over the amplitude (a clearance rises from an
+/// amplitude on). Dots with D ≤ 0 (noise about none) are left off the log axis. Empty (no charts)
+/// when the behaviour has no points.
+Figure joint_behaviour_figure(const discover::JointBehaviour& behaviour);
+
 /// The model of a discovery state in words: "'tip': k + c + k3; substructure damping ×1.2".
 std::string model_text(const discover::State& s);
 

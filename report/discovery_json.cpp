@@ -14,6 +14,65 @@ using io::json::Json;
 using io::json::number;
 using io::json::text;
 
+// A parametric term's parameters: name, unit, value and 95 % interval (null where the tests do
+// not determine it: never a value then).
+Json parameters_json(const std::vector<identify::ParameterEstimate>& list, joints::Term term) {
+  Json out = Json::array();
+  const auto& info = joints::term_info(term).parameters;
+  for (std::size_t p = 0; p < list.size(); ++p) {
+    const auto& e = list[p];
+    const bool determined = !e.fixed && e.determined && std::isfinite(e.value) &&
+                            std::isfinite(e.ci_low) && std::isfinite(e.ci_high) &&
+                            e.ci_high > e.ci_low;
+    Json j;
+    j["name"] = e.name;
+    j["unit"] = p < info.size() ? std::string(info[p].unit) : std::string();
+    j["value"] = e.fixed || determined ? number(e.value) : Json(nullptr);
+    j["std"] = determined ? number(e.std) : Json(nullptr);
+    j["ci95"] = determined ? Json::array({number(e.ci_low), number(e.ci_high)})
+                           : Json::array({nullptr, nullptr});
+    j["fixed"] = e.fixed;
+    j["determined"] = e.fixed || determined;
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+Json behaviour_json(const discover::JointBehaviour& b) {
+  Json j;
+  j["joint"] = b.joint;
+  j["behaviour"] = b.behaviour.empty() ? Json(nullptr) : Json(b.behaviour);
+  j["finding"] = b.finding;
+  Json points = Json::array();
+  for (std::size_t i = 0; i < b.amplitude.size(); ++i)
+    points.push_back({{"test", b.tests.size() > i ? b.tests[i] : std::string()},
+                      {"frequency_hz", number(b.frequency_hz[i])},
+                      {"amplitude", number(b.amplitude[i])},
+                      {"dissipation_per_cycle", number(b.dissipation[i])},
+                      {"stiffness", number(b.stiffness[i])}});
+  j["tests"] = std::move(points);
+  const auto or_null = [](double v) { return std::isfinite(v) ? number(v) : Json(nullptr); };
+  j["slope"] = or_null(b.slope);
+  j["hysteretic_share"] = or_null(b.hysteretic_share);
+  j["stiffness_change"] = or_null(b.stiffness_change);
+  j["contact_amplitude"] = or_null(b.contact_amplitude);
+  j["model_frequency_hz"] = number(b.model_frequency_hz);
+  const auto list = [](const std::vector<double>& v) {
+    Json out = Json::array();
+    for (double x : v)
+      out.push_back(number(x));
+    return out;
+  };
+  Json lines;
+  lines["amplitude"] = list(b.model_amplitude);
+  lines["start_dissipation"] = list(b.start_dissipation);
+  lines["final_dissipation"] = list(b.final_dissipation);
+  lines["start_stiffness"] = list(b.start_stiffness);
+  lines["final_stiffness"] = list(b.final_stiffness);
+  j["model"] = std::move(lines);
+  return j;
+}
+
 Json candidate_json(const discover::Candidate& c) {
   Json j;
   j["joint"] = c.joint;
@@ -28,6 +87,12 @@ Json candidate_json(const discover::Candidate& c) {
   j["ci95"] = determined ? Json::array({number(c.ci_low), number(c.ci_high)})
                          : Json::array({nullptr, nullptr});
   j["determined"] = determined;
+  if (!c.parameters.empty() && c.term) { // a parametric term: its parameters are the result
+    j.erase("value");
+    j.erase("std");
+    j.erase("ci95");
+    j["parameters"] = parameters_json(c.parameters, *c.term);
+  }
   j["gap"] = number(c.gap);
   j["explained"] = number(c.explained);
   j["criterion"] = number(c.criterion);
@@ -68,6 +133,20 @@ Json joints_json(const std::vector<joints::Joint>& joints, const identify::FitRe
       term["effect"] = std::string(joints::term_effect(joint.terms[t]));
       term["unit"] = std::string(joints::term_unit(joint.terms[t]));
       term["value"] = number(joint.values[t]);
+      if (joints::has_parameters(joint.terms[t])) { // its parameters, as identified
+        std::vector<identify::ParameterEstimate> list = identify::parameters_of(joint, t);
+        if (fit)
+          for (const auto& je : fit->joints)
+            if (je.name == joint.name)
+              for (const auto& te : je.terms)
+                if (te.term == joint.terms[t] && te.parameters.size() == list.size())
+                  list = te.parameters;
+        term.erase("value");
+        term["parameters"] = parameters_json(list, joint.terms[t]);
+        term["fixed"] = static_cast<bool>(joint.fixed[t]);
+        terms.push_back(std::move(term));
+        continue;
+      }
       if (fit)
         for (const auto& je : fit->joints)
           if (je.name == joint.name)
@@ -180,6 +259,10 @@ std::string discovery_json(const discover::Result& r) {
   diag["even_harmonics"] = d.even_harmonics;
   diag["even_content"] = number(d.even_content);
   diag["asymmetric"] = d.asymmetric;
+  Json behaviour = Json::array();
+  for (const auto& b : d.behaviour)
+    behaviour.push_back(behaviour_json(b));
+  diag["behaviour"] = std::move(behaviour);
   diag["findings"] = d.findings;
   out["diagnosis"] = std::move(diag);
   Json model;

@@ -46,6 +46,24 @@ std::string listed(const std::vector<std::string>& items) {
   return text;
 }
 
+// A parametric term's parameters with their units and intervals: "kt = 5000 N/m [4990, 5010],
+// fs = 5 N [4.9, 5.1]"; "undetermined" where the tests do not determine one.
+std::string parameters_text(const std::vector<identify::ParameterEstimate>& list,
+                            joints::Term term) {
+  std::string out;
+  const auto& info = joints::term_info(term).parameters;
+  for (std::size_t p = 0; p < list.size(); ++p) {
+    const auto& e = list[p];
+    const std::string unit =
+        p < info.size() && info[p].unit != "1" ? fmt::format(" {}", info[p].unit) : std::string();
+    out += fmt::format("{}{} = {}", out.empty() ? "" : ", ", e.name,
+                       e.fixed        ? g4(e.value) + unit + " (fixed)"
+                       : e.determined ? g4(e.value) + unit + " " + interval(e.ci_low, e.ci_high)
+                                      : std::string("undetermined"));
+  }
+  return out;
+}
+
 std::string short_name(const discover::Candidate& c) {
   if (c.refit) return "refit";
   if (!c.term) return "damping scale";
@@ -115,6 +133,18 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   md += "## Diagnosis\n\n";
   for (std::size_t i = 0; i + 1 < r.diagnosis.findings.size(); ++i)
     md += "- " + r.diagnosis.findings[i] + "\n";
+  // What the tests show of each joint against its amplitude: slip, or a clearance.
+  for (const auto& b : r.diagnosis.behaviour) {
+    const Figure f = joint_behaviour_figure(b);
+    if (f.charts.empty()) continue;
+    md += fmt::format("\n### Joint '{}' against its amplitude\n\n", b.joint);
+    md += "Each test alone: the joint replaced by the spring and damper that give its force's "
+          "fundamental (equation error at harmonic 1), its dissipation per cycle π a² ω c_eq "
+          "and stiffness k_eq at the amplitude a of its deformation. On log axes the dissipation "
+          "grows as a² for viscous damping, a for Coulomb sliding (macroslip), a^(3 + chi) for "
+          "microslip; a clearance stiffens the joint from an amplitude on.\n\n";
+    md += plot(fmt::format("joint_{}_amplitude.png", b.joint), f);
+  }
   md += "\n## Starting model\n\n";
   for (const auto& n : r.start_notes)
     md += n + "\n\n";
@@ -128,11 +158,14 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
           "|\n|---|---|---|---|---|---|---|---|\n";
     for (std::size_t i = 0; i < r.steps.size(); ++i) {
       const auto& s = r.steps[i];
-      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", i + 1, s.added.name(),
-                        s.added.effect(), g4(s.added.value),
-                        s.added.determined() ? interval(s.added.ci_low, s.added.ci_high)
-                                             : std::string("undetermined"),
-                        g4(s.gap_before), g4(s.gap_after), pct(s.added.explained));
+      const bool parametric = !s.added.parameters.empty();
+      md += fmt::format(
+          "| {} | {} | {} | {} | {} | {} | {} | {} |\n", i + 1, s.added.name(), s.added.effect(),
+          parametric ? parameters_text(s.added.parameters, *s.added.term) : g4(s.added.value),
+          parametric             ? std::string("(with each parameter)")
+          : s.added.determined() ? interval(s.added.ci_low, s.added.ci_high)
+                                 : std::string("undetermined"),
+          g4(s.gap_before), g4(s.gap_after), pct(s.added.explained));
     }
     md += "\n";
   }
@@ -282,6 +315,18 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   for (const auto& j : last.joints)
     for (std::size_t t = 0; t < j.terms.size(); ++t) {
       std::string ci = j.fixed[t] ? "fixed" : "—";
+      if (joints::has_parameters(j.terms[t])) { // its parameters, as identified
+        std::vector<identify::ParameterEstimate> list = identify::parameters_of(j, t);
+        for (const auto& je : last.fit.joints)
+          if (je.name == j.name)
+            for (const auto& te : je.terms)
+              if (te.term == j.terms[t] && te.parameters.size() == list.size())
+                list = te.parameters;
+        md += fmt::format("| {} | {} | {} | {} | — | {} |\n", j.name, joints::term_name(j.terms[t]),
+                          joints::term_effect(j.terms[t]), parameters_text(list, j.terms[t]),
+                          j.fixed[t] ? "fixed" : "(with each parameter)");
+        continue;
+      }
       for (const auto& je : last.fit.joints)
         if (je.name == j.name)
           for (const auto& te : je.terms)

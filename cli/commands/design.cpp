@@ -4,6 +4,7 @@
 #include "identify/design.hpp"
 #include "cli/command.hpp"
 #include "cli/common.hpp"
+#include "identify/parametric.hpp"
 #include "io/files.hpp"
 #include "io/results_json.hpp"
 #include "joints/basis.hpp"
@@ -113,6 +114,11 @@ public:
                     "Leave out candidates whose equations, at the model's values, miss by more "
                     "than this many noise standard deviations (e.g. where a friction joint sticks)")
         ->capture_default_str();
+    app()
+        .add_option("--excitation", excitation_,
+                    "Kind of candidate test: sine (multisine candidates are not designed yet: "
+                    "refused, saying why)")
+        ->capture_default_str();
     add_output_dir();
     add_engine();
   }
@@ -128,10 +134,22 @@ private:
   std::vector<std::string> frequencies_; ///< Hz: values or ranges F0:STEP:F1
   std::vector<std::string> amplitudes_;  ///< N or N·m (peak): values or ranges A0:STEP:A1
   int count_ = 10;                       ///< tests to choose
+  std::string excitation_ = "sine";      ///< the candidates' kind (only sine is designed)
   identify::DesignOptions options_;      ///< the library's defaults
 };
 
 void Design::check_options() const {
+  // Periodic broadband candidates would need each multisine's prediction at all its lines and
+  // the information of its lines (noise per line from the period scatter): not there yet.
+  if (excitation_ == "multisine" || excitation_ == "periodic")
+    throw io::Error(
+        "--excitation multisine: design chooses sine tests only; multisine candidates (a band "
+        "and RMS levels) are not designed yet: their prediction would be a harmonic balance at "
+        "every line of the period and their information that of every line, which design does "
+        "not compute. Design sine tests, or run multisine tests at a few levels and let "
+        "identify's intervals say what they determine");
+  if (excitation_ != "sine")
+    throw io::Error(fmt::format("--excitation: expected sine, got \"{}\"", excitation_));
   check_harmonics(options_.harmonics, 0);
   if (count_ < 1) throw io::Error(fmt::format("-n: expected at least 1 test, got {}", count_));
   if (!(options_.noise > 0.0 && options_.noise < 1.0))
@@ -166,11 +184,25 @@ void Design::run() {
   const Model model(model_, engine());
   if (model.file.joints.empty())
     throw io::Error(model.name() + ": no [[joints]]: nothing to design tests for");
-  check_identifiable(model);
-  const std::vector<identify::DesignUnknown> unknowns =
-      identify::design_unknowns(model.file.joints);
+  // A parametric term not fixed (one a joint, identified by output error) is held at its
+  // values for the D-optimal choice of the coefficient terms' tests; the levels that reach its
+  // regime are said apart.
+  check_identifiable(model, Parametric::output_error);
+  const std::vector<joints::Joint> held = identify::with_parametric_fixed(model.file.joints);
+  const std::vector<identify::DesignUnknown> unknowns = identify::design_unknowns(held);
+  const bool parametric_open =
+      std::any_of(model.file.joints.begin(), model.file.joints.end(), [](const joints::Joint& j) {
+        for (std::size_t t = 0; t < j.terms.size(); ++t)
+          if (joints::has_parameters(j.terms[t]) && !j.fixed[t]) return true;
+        return false;
+      });
   if (unknowns.empty())
-    throw io::Error(model.name() + ": every joint term is fixed; nothing to identify");
+    throw io::Error(model.name() + ": every joint term " +
+                    (!parametric_open ? "is fixed; nothing to identify"
+                                      : "but the parametric ones (jenkins, iwan, gap) "
+                                        "is fixed: the D-optimal design chooses tests "
+                                        "for the terms k … fc; give the joint k or c "
+                                        "unknown beside it"));
   for (const auto& u : unknowns)
     if (u.prior == 0.0)
       warn(fmt::format("{}: joint '{}', term {}: its value (the prior guess) is 0; the prediction "
@@ -184,15 +216,14 @@ void Design::run() {
     for (double a : amps)
       plans.push_back({f, a});
   identify::DesignOptions options = options_;
-  const std::vector<identify::CandidateTest> candidates =
-      with_progress(fmt::format("jointid design: predicting {} candidates", plans.size()),
-                    [&](const auto& progress) {
-                      options.progress = progress.callback();
-                      return for_model(model, [&] {
-                        return identify::predict_candidates(model.sub, model.file.joints, force_at,
-                                                            plans, options);
-                      });
-                    });
+  const std::vector<identify::CandidateTest> candidates = with_progress(
+      fmt::format("jointid design: predicting {} candidates", plans.size()),
+      [&](const auto& progress) {
+        options.progress = progress.callback();
+        return for_model(model, [&] {
+          return identify::predict_candidates(model.sub, held, force_at, plans, options);
+        });
+      });
   const auto usable = std::count_if(candidates.begin(), candidates.end(),
                                     [](const identify::CandidateTest& c) { return c.usable; });
   if (usable < count_)
@@ -202,12 +233,14 @@ void Design::run() {
                                 count_, usable, candidates.size()));
   const identify::Design chosen =
       for_model(model, [&] { return identify::choose_tests(candidates, unknowns, count_); });
+  const std::vector<identify::ParametricLevel> levels =
+      for_model(model, [&] { return identify::parametric_levels(model.file.joints, candidates); });
   if (!output_rank()) return;
 
   // 4. Write and report.
   make_output_dir(output_dir_);
   const fs::path json = output_dir_ / "design.json";
-  io::write_json(json, io::design_json(chosen, candidates, unknowns, options));
+  io::write_json(json, io::design_json(chosen, candidates, unknowns, options, levels));
   fmt::print("wrote {}\n", json.string());
   if (const auto skipped = static_cast<std::ptrdiff_t>(candidates.size()) - usable; skipped > 0)
     warn(fmt::format("{} of {} candidates left out: no periodic solution at the model's values, "
@@ -215,6 +248,8 @@ void Design::run() {
                      "where a friction joint sticks (design.json gives each reason)",
                      skipped, candidates.size()));
   print(chosen, candidates, unknowns);
+  for (const auto& level : levels)
+    fmt::print("parametric term: {}\n", level.sentence);
 }
 
 void Design::print(const identify::Design& chosen,

@@ -32,7 +32,13 @@ public:
         .add_option("TESTS", records_, "Measurement records or stepped-sine tables (CSV)")
         ->required();
     add_output_dir();
-    add_harmonics(options_.harmonics, "Harmonics used in the fits; 0 to the largest are compared");
+    add_harmonics(options_.harmonics,
+                  "Harmonics used in the fits; 0 to the largest are compared (a periodic test: "
+                  "its lines where a response stands out of the noise, up to the largest of "
+                  "these times the highest excited line)");
+    app().add_option("--band", band_,
+                     "F0:F1 in Hz: a periodic test's excited lines used (default: all); its other "
+                     "lines from F0 up");
     add_balance_harmonics(options_.balance.harmonics,
                           "Harmonics 0 … K of the harmonic-balance re-simulations");
     app().add_option("--max-steps", options_.max_steps, "Most terms added")->capture_default_str();
@@ -41,7 +47,8 @@ public:
       names.emplace_back(joints::term_name(t));
     app()
         .add_option("--terms", terms_,
-                    "Candidate terms tried at every joint (default: k, c, k2, k3, c2, c3, fc)")
+                    "Candidate terms tried at every joint (default: every term, k, c, k2, k3, "
+                    "c2, c3, fc, jenkins, iwan, gap)")
         ->check(choices(names))
         ->delimiter(',')
         ->allow_extra_args(false);
@@ -60,6 +67,7 @@ private:
   std::vector<fs::path> records_;
   discover::Options options_; ///< the library's defaults
   std::vector<std::string> terms_;
+  std::string band_; ///< F0:F1, Hz; empty: every line
 };
 
 void Discover::run() {
@@ -73,21 +81,12 @@ void Discover::run() {
   discover::Options options = options_;
   if (!terms_.empty()) {
     options.terms.clear();
-    for (const auto& t : terms_) {
+    for (const auto& t : terms_)
       options.terms.push_back(joints::parse_term(t)); // checked by --terms' choices
-      if (joints::has_parameters(options.terms.back()))
-        throw io::Error(fmt::format(
-            "--terms: '{}' is not a discovery candidate yet: jenkins, iwan and gap are "
-            "simulated, and may be held fixed in the model's joints, but their discovery is "
-            "coming; the candidates are {}",
-            t, [] {
-              std::string names;
-              for (const joints::Term c : joints::coefficient_terms)
-                names += (names.empty() ? "" : ", ") + std::string(joints::term_name(c));
-              return names;
-            }()));
-    }
   }
+  identify::MeasureOptions measure{.harmonics = K};
+  if (!band_.empty())
+    std::tie(measure.band_from_hz, measure.band_to_hz) = parse_band("--band", band_);
   check_output_dir(output_dir_);
 
   // 2. The inputs.
@@ -98,7 +97,7 @@ void Discover::run() {
   const std::vector<identify::SineTest> tests = io::read_tests(records_);
   for (const char* name : {"discovery.json", "report.md"})
     io::check_not_an_input(output_dir_ / name);
-  const std::vector<identify::Measurement> measured = identify::measure(tests, {.harmonics = K});
+  const std::vector<identify::Measurement> measured = identify::measure(tests, measure);
 
   // 3. Discover.
   const discover::Result result =
@@ -131,8 +130,15 @@ void Discover::print(const discover::Result& result) const {
              "gap before", "gap after");
   for (std::size_t i = 0; i < result.steps.size(); ++i) {
     const auto& s = result.steps[i];
-    fmt::print("{:<5} {:<28} {:<26} {:>12.5g} {:>11.4g} {:>11.4g}\n", i + 1, s.added.name(),
-               s.added.effect(), s.added.value, s.gap_before, s.gap_after);
+    fmt::print("{:<5} {:<28} {:<26} {:>12} {:>11.4g} {:>11.4g}\n", i + 1, s.added.name(),
+               s.added.effect(),
+               s.added.parameters.empty() ? fmt::format("{:.5g}", s.added.value) : "(below)",
+               s.gap_before, s.gap_after);
+    for (const auto& p : s.added.parameters) // a parametric term: its parameters below it
+      fmt::print("      {:<33} {}\n",
+                 fmt::format("{}.{}", joints::term_name(*s.added.term), p.name),
+                 p.determined ? fmt::format("{:.5g} [{:.5g}, {:.5g}]", p.value, p.ci_low, p.ci_high)
+                              : std::string("undetermined"));
   }
   fmt::print("\n{}\nStopped: {}.\n", result.diagnosis.findings.back(), result.stop_reason);
 }

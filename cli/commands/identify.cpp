@@ -48,7 +48,8 @@ public:
     app().add_flag("--output-error", output_error_,
                    "Refine by output error (maximum likelihood: the harmonic balance of the model "
                    "fitted to the measured harmonics, each weighted by its noise); needs records "
-                   "of two or more periods");
+                   "of two or more periods. Identifies a non-fixed jenkins, iwan or gap term "
+                   "(one a joint), started from a describing-function fit");
     add_balance_harmonics(refined_.balance.harmonics,
                           "Harmonics 0 … K of the output error's harmonic balance");
     add_engine();
@@ -92,7 +93,8 @@ void Identify::run() {
   // 2. The inputs.
   const Model model(model_, engine());
   if (model.file.joints.empty()) throw io::Error(model.name() + ": no [[joints]] to identify");
-  check_identifiable(model);
+  check_identifiable(model,
+                     output_error_ ? Parametric::output_error : Parametric::needs_output_error);
   const std::vector<identify::SineTest> tests = io::read_tests(records_);
   io::check_not_an_input(output_);
   for (const fs::path& png : {fit_png_, params_png_})
@@ -132,6 +134,11 @@ void Identify::print(const identify::FitResult& result) const {
                      p.fixed        ? std::string("(fixed)")
                      : p.determined ? fmt::format("[{:.7g}, {:.7g}]", p.ci_low, p.ci_high)
                                     : std::string("(see below)"));
+        continue;
+      }
+      if (std::isnan(t.value)) { // not determined apart from another term: no value
+        fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", j.name, joints::term_name(t.term),
+                   joints::term_effect(t.term), "undetermined", "", "(see below)");
         continue;
       }
       fmt::print("{:<12} {:<5} {:<26} {:>14.7g} {:>11.3g}  {}\n", j.name, joints::term_name(t.term),

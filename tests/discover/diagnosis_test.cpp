@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -194,6 +195,77 @@ TEST(Diagnosis, LevelEvidenceWithoutNoiseGivesNoVerdict) {
   // Levels less than 1.5× apart, or frequencies 0.5 % apart, are not compared.
   measured[1].F(1, 0) = 14.0;
   EXPECT_TRUE(level_evidence(measured).empty());
+}
+
+// What a joint does against its amplitude, from each test's equivalent stiffness: points made
+// from the describing function of a known joint (k = 4800 N/m, c = 20 N s/m and the term),
+// amplitudes spread geometrically as a sweep's are, frequencies 2 … 5 Hz.
+discover::JointBehaviour behaviour_of(Term term, const std::vector<double>& parameters, double a0,
+                                      double a1, double k3 = 0.0) {
+  joints::Joint j{"tip",          7, 0, fem::Dof::uy, {Term::k, Term::c}, {4800.0, 20.0},
+                  {false, false}, {}};
+  if (k3 != 0.0) {
+    j.terms.push_back(Term::k3), j.values.push_back(k3), j.fixed.push_back(false);
+  } else if (!parameters.empty()) {
+    j.terms.push_back(term), j.values.push_back(1.0), j.fixed.push_back(false);
+    j.parameters.resize(3);
+    j.set_parameters(2, parameters);
+  }
+  std::vector<identify::EquivalentStiffness> points;
+  std::vector<std::string> names;
+  const int n = 21;
+  for (int i = 0; i < n; ++i) {
+    // Amplitude and frequency shuffled against each other (i·8 mod 21), as in a sweep at levels.
+    const double a = a0 * std::pow(a1 / a0, ((i * 8) % n) / (n - 1.0));
+    const double w = 2.0 * std::numbers::pi * (2.0 + 3.0 * i / (n - 1.0));
+    points.push_back({a, w, joint_describing_function(j, a, w)});
+    names.push_back(std::to_string(i));
+  }
+  return behaviour("tip", points, names);
+}
+
+TEST(JointBehaviour, AJenkinsSlidingIsMacroslip) {
+  // kt 5000 N/m, fs 5 N: it slides beyond 1 mm; D = 4 fs (a − fs/kt) grows as a: power 1.
+  const auto b = behaviour_of(Term::jenkins, {5000.0, 5.0}, 0.003, 0.06);
+  EXPECT_EQ(b.behaviour, "macroslip") << b.finding;
+  EXPECT_NEAR(b.slope, 1.0, 0.2) << b.finding;
+  // The stuck spring is lost as it slides: a Jenkins element's k_eq = kt/π (β − sin 2β / 2),
+  // cos β = 1 − 2 fs/(kt a), beside k: 4800 + 1459.1 at 3 mm, 4800 + 18.0 at 6 cm.
+  const auto jenkins_k = [](double a) {
+    const double beta = std::acos(1.0 - 2.0 * 5.0 / (5000.0 * a));
+    return 4800.0 + 5000.0 / std::numbers::pi * (beta - std::sin(2.0 * beta) / 2.0);
+  };
+  EXPECT_NEAR(b.stiffness_change, jenkins_k(0.06) / jenkins_k(0.003) - 1.0, 1e-3);
+  EXPECT_NE(b.finding.find("macroslip"), std::string::npos);
+}
+
+TEST(JointBehaviour, AnIwanInMicroslipGrowsAsThreePlusChi) {
+  // fs 100 N, kt 3000 N/m, beta 0.1: phi_max = 8.5 cm, beyond every amplitude; chi = −0.5, so
+  // D ∝ a^2.5 (Segalman), against viscous damping's a².
+  const auto b = behaviour_of(Term::iwan, {100.0, 3000.0, -0.5, 0.1}, 0.002, 0.05);
+  EXPECT_EQ(b.behaviour, "microslip") << b.finding;
+  EXPECT_NEAR(b.slope, 2.5, 0.15) << b.finding;
+  EXPECT_NE(b.finding.find("chi"), std::string::npos);
+}
+
+TEST(JointBehaviour, AGapIsAClearanceWhereContactIsMade) {
+  // delta 1 cm, kg 5000 N/m: no dissipation of its own, the stiffness constant up to 1 cm.
+  const auto b = behaviour_of(Term::gap, {0.01, 5000.0}, 0.002, 0.05);
+  EXPECT_EQ(b.behaviour, "clearance") << b.finding;
+  EXPECT_NEAR(b.contact_amplitude, 0.01, 0.002) << b.finding;
+  EXPECT_GT(b.stiffness_change, 0.3);
+}
+
+TEST(JointBehaviour, ACubicStiffnessOrAViscousJointIsNeitherSlipNorClearance) {
+  // k3 stiffens from zero amplitude on (k_eq = k + 3/4 k3 a²): not a contact closing.
+  const auto cubic = behaviour_of(Term::k3, {}, 0.002, 0.05, 1.6e8);
+  EXPECT_EQ(cubic.behaviour, "") << cubic.finding;
+  EXPECT_TRUE(std::isnan(cubic.contact_amplitude));
+  const auto linear = behaviour_of(Term::k, {}, 0.002, 0.05);
+  EXPECT_EQ(linear.behaviour, "") << linear.finding;
+  EXPECT_NE(linear.finding.find("no sign of slip"), std::string::npos);
+  // One amplitude: nothing to say about a trend.
+  EXPECT_TRUE(behaviour_of(Term::jenkins, {5000.0, 5.0}, 0.01, 0.01).finding.empty());
 }
 
 } // namespace

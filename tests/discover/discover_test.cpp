@@ -7,6 +7,8 @@
 // reported as linear.
 #include "discover/discover.hpp"
 
+#include "constructed.hpp"
+#include "identify/random_tests.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
 
@@ -227,6 +229,91 @@ TEST(Discover, AWrongGivenValueIsCorrectedByTheRefit) {
   EXPECT_NEAR(value_of(r, "tip", Term::k3), 1.6e8, 0.01 * 1.6e8);
   EXPECT_EQ(r.stop_reason.find("not in the library"), std::string::npos);
 }
+
+// A term with named parameters hidden at the tip beside k and c: discovery, told only k and c,
+// must name it (nothing else added), give its parameters with intervals that hold the truth
+// where the tests determine them, and say in words what the data show of the joint.
+struct HiddenParametric {
+  Term term;
+  std::vector<double> parameters; ///< in the table's order
+  std::vector<double> levels;
+  bool table;            ///< stepped-sine fundamentals (noise unknown), else records
+  std::string behaviour; ///< what the diagnosis must say of the tip
+};
+
+class HiddenParametricTerm : public ::testing::TestWithParam<HiddenParametric> {};
+
+TEST_P(HiddenParametricTerm, IsNamedWithItsParametersAndTheDiagnosisSaysWhatItDoes) {
+  const HiddenParametric h = GetParam();
+  Data d;
+  joints::Joint truth = joint("tip", 7, {Term::k, Term::c, h.term}, {4800.0, 20.0, 1.0});
+  truth.parameters.resize(3);
+  truth.set_parameters(2, h.parameters);
+  d.truth = {truth};
+  d.levels = h.levels;
+  d.table = h.table;
+  discover::Options o;
+  if (h.table) o.harmonics = {1};
+  const discover::Result r =
+      discover::discover(frf::Substructure(d.model), {linear_start("tip", 7)}, measure(d), o);
+  SCOPED_TRACE(describe(r));
+  ASSERT_EQ(r.steps.size(), 1u);
+  ASSERT_TRUE(r.steps[0].added.term.has_value());
+  EXPECT_EQ(*r.steps[0].added.term, h.term);
+  EXPECT_EQ(r.steps[0].added.joint, "tip");
+  EXPECT_EQ(r.states.back().damping_scale, 1.0);
+  EXPECT_LT(r.gap.back(), 0.1 * r.gap.front());
+  // Its parameters: every determined one's 95 % interval holds the truth, within a margin for
+  // the harmonic balance's truncation of the loop's corners (1 %); some are determined.
+  const auto& params = r.steps[0].added.parameters;
+  ASSERT_EQ(params.size(), h.parameters.size());
+  int determined = 0;
+  for (std::size_t p = 0; p < params.size(); ++p) {
+    if (!params[p].determined) {
+      EXPECT_TRUE(std::isnan(params[p].value)) << params[p].name; // never a value then
+      continue;
+    }
+    ++determined;
+    const double truth_p = h.parameters[p], margin = 0.01 * std::abs(truth_p);
+    EXPECT_LE(params[p].ci_low - margin, truth_p) << params[p].name << " = " << params[p].value;
+    EXPECT_GE(params[p].ci_high + margin, truth_p) << params[p].name << " = " << params[p].value;
+  }
+  EXPECT_GT(determined, 0);
+  if (std::isfinite(std_of(r, "tip", Term::k))) {
+    EXPECT_NEAR(value_of(r, "tip", Term::k), 4800.0, 0.05 * 4800.0);
+  } else { // an iwan in microslip: k apart from kt is not determined, their sum is
+    ASSERT_EQ(h.term, Term::iwan);
+    const auto& tip = r.states.back().joints.front();
+    const double kt = tip.parameter(static_cast<std::size_t>(tip.term_index(Term::iwan)), "kt");
+    EXPECT_NEAR(value_of(r, "tip", Term::k) + kt, 4800.0 + h.parameters[1], 0.02 * 7800.0);
+  }
+  // The diagnosis, from the equivalent stiffness and damping of each test alone.
+  EXPECT_EQ(r.diagnosis.nature, joints::is_hysteretic(h.term) ? "hysteretic" : "conservative");
+  ASSERT_FALSE(r.diagnosis.behaviour.empty());
+  const discover::JointBehaviour& b = r.diagnosis.behaviour.front();
+  EXPECT_EQ(b.joint, "tip");
+  EXPECT_EQ(b.behaviour, h.behaviour) << b.finding << [&] {
+    std::ostringstream o;
+    o << "\nslope " << b.slope << " share " << b.hysteretic_share << "\n";
+    for (std::size_t i = 0; i < b.amplitude.size(); ++i)
+      o << b.frequency_hz[i] << " " << b.amplitude[i] << " D " << b.dissipation[i] << " k "
+        << b.stiffness[i] << "\n";
+    return o.str();
+  }();
+  EXPECT_FALSE(b.model_amplitude.empty());
+}
+
+// Jenkins: slips at 1 mm (fs / kt), below every test's amplitude: Coulomb sliding. Iwan: its
+// largest slip displacement phi_max = 8.5 cm beyond every amplitude: microslip. Gap: contact at
+// ±1 cm, inside the tests' span (1 mm … 5 cm).
+INSTANTIATE_TEST_SUITE_P(
+    AtTheTip, HiddenParametricTerm,
+    ::testing::Values(
+        HiddenParametric{Term::jenkins, {5000.0, 5.0}, {10.0, 40.0, 80.0}, true, "macroslip"},
+        HiddenParametric{
+            Term::iwan, {100.0, 3000.0, -0.5, 0.1}, {10.0, 40.0, 80.0}, false, "microslip"},
+        HiddenParametric{Term::gap, {0.01, 5000.0}, {10.0, 40.0, 80.0}, true, "clearance"}),
+    [](const auto& info) { return std::string(joints::term_name(info.param.term)); });
 
 TEST(Discover, ThroughMeasuredFrfsAsThroughTheModel) {
   // The substructure given by its measured FRF at the tip (sampled from the model every
@@ -543,6 +630,106 @@ TEST(Discover, AFrictionThatFallsWithTheAmplitudeIsNamedAsOutsideTheLibrary) {
   EXPECT_NE(findings.find("fc at 'tip' is not one number"), std::string::npos) << findings;
   EXPECT_NE(findings.find("it falls with the deformation amplitude"), std::string::npos)
       << findings;
+}
+
+// Periodic broadband tests (issue 30): multisine virtual tests of the cantilever, force at the
+// tip, 1–4 Hz (Schroeder phases, every 0.25 Hz line), period 4 s, 256 Hz, `periods` periods from
+// rest with a fade-in, by time integration in modal coordinates (never the harmonic balance
+// discovery re-simulates with; 16 steps a sample: a period error (ωh)²/12 of 3e-5 at 12 Hz, the
+// third harmonic of 4 Hz), each channel's noise `noise` of its RMS (force too), a seed per level.
+std::vector<identify::Measurement> multisine_tests(const std::vector<joints::Joint>& truth,
+                                                   const std::vector<double>& levels, double noise,
+                                                   int periods = 8) {
+  static const frf::Substructure cantilever(test::paper_cantilever());
+  std::vector<identify::SineTest> records;
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    const identify::ExcitationSpec spec{
+        identify::Excitation::multisine, 1.0, 4.0, levels[i], 1, 4.0 * periods, 256.0, 4.0};
+    identify::ForcedOptions o;
+    o.fade_in_s = identify::default_fade_in_s(spec);
+    o.substeps = 16;
+    o.route = identify::TransientRoute::modal;
+    o.quantities = {identify::Quantity::displacement, identify::Quantity::velocity};
+    identify::ForcedTest test = identify::simulate_forced(
+        cantilever, truth, identify::generated_force(spec, {7, fem::Dof::uy}), o);
+    identify::add_noise(test, noise, 100 + i);
+    test.record.source = "multisine_" + std::to_string(static_cast<int>(levels[i])) + "N.csv";
+    records.push_back(std::move(test.record));
+  }
+  return identify::measure(records, {.harmonics = 3});
+}
+
+// A hidden cubic stiffness at the tip, multisine tests at four levels with 1 % noise: compared at
+// their lines, re-simulated by the harmonic balance at 1/T, k3 is named and nothing else, within
+// 4 standard deviations of the truth, and the gap falls from far above the noise to it.
+TEST(Discover, PeriodicMultisineTestsNameAHiddenCubicStiffness) {
+  const std::vector<identify::Measurement> tests =
+      multisine_tests({joint("tip", 7, {Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8})},
+                      {10.0, 30.0, 60.0, 90.0}, 0.01);
+  for (const auto& m : tests) {
+    ASSERT_EQ(m.kind, identify::RecordKind::periodic) << m.source;
+    EXPECT_TRUE(m.left_out.empty()) << m.left_out;
+  }
+  const discover::Result r = discover::discover(frf::Substructure(test::paper_cantilever()),
+                                                {linear_start("tip", 7)}, tests);
+  SCOPED_TRACE(describe(r));
+  ASSERT_EQ(r.steps.size(), 1u);
+  ASSERT_TRUE(r.steps[0].added.term.has_value());
+  EXPECT_EQ(*r.steps[0].added.term, Term::k3);
+  EXPECT_EQ(r.steps[0].added.joint, "tip");
+  EXPECT_EQ(r.states.back().damping_scale, 1.0);
+  EXPECT_LT(std::abs(value_of(r, "tip", Term::k3) - 1.6e8), 4.0 * std_of(r, "tip", Term::k3));
+  EXPECT_LT(std::abs(value_of(r, "tip", Term::k) - 4800.0), 4.0 * std_of(r, "tip", Term::k));
+  EXPECT_LT(std::abs(value_of(r, "tip", Term::c) - 20.0), 4.0 * std_of(r, "tip", Term::c));
+  // Cross-validated (four tests: leave one out) and compared at the periodic tests' lines: the
+  // 13 excited ones (4 … 16) at least, two real values each.
+  EXPECT_GT(r.steps[0].cv_before, 0.0);
+  EXPECT_LT(r.steps[0].cv_after, r.steps[0].cv_before);
+  EXPECT_GT(r.compared_values, static_cast<int>(tests.size()) * 2 * 13);
+  // The missing k3 stands far out of the noise at the start; the end is at the noise level.
+  EXPECT_GT(r.gap.front(), 10.0 * r.noise_gap);
+  expect_at_noise_level(r);
+  EXPECT_EQ(r.diagnosis.joint, "tip");
+  EXPECT_EQ(r.diagnosis.nature, "conservative");
+  EXPECT_TRUE(r.curves.empty() || r.curves.back().empty()); // no sine sweep through a multisine
+  // The report's comparisons: every excited line of every test (its FRF over them).
+  ASSERT_EQ(r.comparisons.back().size(), tests.size() * 13);
+  EXPECT_EQ(r.comparisons.back()[0].frequency_hz, 1.0);
+  EXPECT_EQ(r.comparisons.back()[0].measured, tests[0].X(4, 0));
+}
+
+// A periodic test re-simulated through measured FRFs needs them to twice line max(K, 10) × its
+// highest driven line: lines 4 and 6 every 0.25 Hz, K = 3: line 60, 15 Hz, doubled 30 Hz; FRFs to
+// 20 Hz are refused, naming the test and saying how far to measure.
+TEST(Discover, APeriodicTestBeyondTheMeasuredFrfsBandIsRefusedNamingIt) {
+  const frf::Substructure model(test::paper_cantilever());
+  const int tip = model.dofs().equation({7, fem::Dof::uy});
+  const frf::ModalSynthesis H = model.synthesis({tip}, 100.0);
+  frf::MeasuredFrf frf;
+  frf.dofs = {{7, fem::Dof::uy}};
+  frf::MeasuredFunction f{{7, fem::Dof::uy}, {7, fem::Dof::uy}, {}, {}, "sampled from the model"};
+  for (int i = 0; i <= 400; ++i) { // to 20 Hz
+    const int e[] = {tip};
+    f.frequencies_hz.push_back(0.05 * i);
+    f.receptance.push_back(H.receptance(2.0 * std::numbers::pi * 0.05 * i, e, e)(0, 0));
+  }
+  frf.functions.push_back(f);
+  std::vector<std::complex<double>> X(7, 1e-4);
+  identify::Measurement m =
+      test::measurement("multisine.csv", 0.25, 0.0, X, std::vector<double>(7, 1e-12));
+  m.kind = identify::RecordKind::periodic;
+  m.F(4, 0) = 10.0, m.F(6, 0) = 10.0;
+  m.lines = m.excited_lines = {4, 6};
+  try {
+    (void)discover::discover(frf::Substructure(frf), {linear_start("tip", 7)}, {m});
+    ADD_FAILURE() << "a band to 20 Hz was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "multisine.csv: the measured FRFs reach 20 Hz; this periodic test's "
+                           "re-simulation needs 30 Hz (twice line 60: the joints' response up to "
+                           "10 times its highest driven line, doubled to estimate the "
+                           "simulation's own error). Measure the FRFs to that, or use fewer of "
+                           "its lines (--band)");
+  }
 }
 
 TEST(Discover, BadInputIsRefusedWithTheReason) {

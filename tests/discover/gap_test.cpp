@@ -46,6 +46,43 @@ TEST(ComparedValues, ATableGivesTheFundamentalAndNoNoiseLevel) {
   EXPECT_TRUE(std::isnan(c.noise_gap));
 }
 
+// A periodic test is compared at its lines, not at harmonics 0 … K: here lines 4 and 6 excited,
+// 12 where only the joint puts response; lines 1 … 3, 5, 7 … 11 (noise) and the mean are not
+// compared. The excited lines are judged as harmonic 1, the others as harmonic 2 (1 when only
+// the fundamental is compared); the simulated value is read at the line's row.
+TEST(ComparedValues, APeriodicTestAtItsLinesGroupedAsExcitedAndNot) {
+  std::vector<std::complex<double>> X(13, 0.01);
+  X[4] = 3.0, X[6] = {0.0, 4.0}, X[12] = 0.5;
+  identify::Measurement m =
+      test::measurement("multisine.csv", 0.25, 0.0, X, std::vector<double>(13, 0.02));
+  m.kind = identify::RecordKind::periodic;
+  m.lines = {4, 6, 12};
+  m.excited_lines = {4, 6};
+  const Compared c = compared_values({m}, 3);
+  ASSERT_EQ(c.entries.size(), 3u);
+  EXPECT_EQ(c.values, 6);
+  const int rows[] = {4, 6, 12}, groups[] = {1, 1, 2};
+  for (std::size_t e = 0; e < 3; ++e) {
+    EXPECT_EQ(c.entries[e].row, rows[e]);
+    EXPECT_EQ(c.entries[e].harmonic, groups[e]);
+    EXPECT_TRUE(c.entries[e].line);
+  }
+  // Σ|X|² = 9 + 16 + 0.25; the noise level from the three lines' variances.
+  EXPECT_NEAR(c.measured2, 25.25, 1e-12);
+  EXPECT_NEAR(c.noise_gap, std::sqrt(0.06 / 25.25), 1e-15);
+  EXPECT_EQ(compared_values({m}, 1).entries[2].harmonic, 1);
+  // Simulated exactly at the excited lines, 0 at line 12: the misfit is line 12's alone.
+  std::vector<std::complex<double>> sim(13, 0.0);
+  sim[4] = 3.0, sim[6] = {0.0, 4.0};
+  const Misfit f = misfit(c, test::simulated({sim}).X);
+  EXPECT_NEAR(f.squared, 0.25, 1e-15);
+  EXPECT_NEAR(f.chi2, 2.0 * 0.25 / 0.02, 1e-12);
+  const std::vector<double> chi2 = chi2_by_harmonic(c, test::simulated({sim}).X);
+  EXPECT_NEAR(chi2[1], 0.0, 1e-15);
+  EXPECT_NEAR(chi2[2], 0.25 / 0.02, 1e-12);
+  EXPECT_TRUE(std::isnan(chi2[0]) && std::isnan(chi2[3]));
+}
+
 TEST(ComparedValues, EveryResponseZeroIsRefused) {
   try {
     (void)compared_values({test::measurement("a", 3.0, 10.0, {0.0, 0.0}, {0.1, 0.1})}, 1);

@@ -260,6 +260,20 @@ TEST(Selection, FinalistsAreTheBestSimulatedAdditions) {
   EXPECT_EQ(finalists(ranking, 2), (std::vector<std::size_t>{3, 1}));
 }
 
+TEST(Selection, TheBestParametricCandidateIsAFinalistBesidesTheCount) {
+  // Its start (a describing-function fit) screens it; output error gives its parameters: the
+  // best parametric candidate is refined besides the count where it ranks among count + 1.
+  std::vector<discover::Candidate> ranking{
+      test::candidate(Term::k3, 0.1, 10.0), test::candidate(Term::iwan, 0.2, 30.0),
+      test::candidate(Term::c2, 0.1, 20.0), test::candidate(Term::jenkins, 0.2, 25.0),
+      test::candidate(Term::gap, 0.3, 40.0)};
+  EXPECT_EQ(finalists(ranking, 1), (std::vector<std::size_t>{0})); // jenkins third: not refined
+  EXPECT_EQ(finalists(ranking, 2), (std::vector<std::size_t>{0, 2, 3}));
+  ranking[3].criterion = 5.0; // jenkins first: refined besides the count
+  EXPECT_EQ(finalists(ranking, 1), (std::vector<std::size_t>{3, 0}));
+  EXPECT_EQ(finalists(ranking, 0), (std::vector<std::size_t>{3}));
+}
+
 TEST(CrossValidation, LeavesOneTestOutUpTo30TestsElseUsesFolds) {
   EXPECT_TRUE(held_out(3, 10).empty());
   EXPECT_EQ(held_out(4, 10), (std::vector<std::vector<int>>{{0}, {1}, {2}, {3}}));

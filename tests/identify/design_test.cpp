@@ -4,6 +4,7 @@
 
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
+#include "identify/parametric.hpp"
 #include "support/cantilever.hpp"
 #include "support/failing_substructure.hpp"
 
@@ -333,3 +334,57 @@ TEST(Design, PredictedBiasIsTheMeanErrorOfRepeatedIdentifications) {
   }
   EXPECT_GE(significant, 1) << "no term is biased beyond the scatter: the test would not fail";
 }
+
+namespace {
+
+TEST(Design, ParametricLevelsSayWhichForcesReachMacroslip) {
+  // An iwan (fs 3 N, kt 1e4 N/m, chi -0.5, beta 0.1) not fixed beside k and c: its macroslip
+  // starts at Segalman's φ_max = fs (1 + β) / (kt (β + (χ + 1)/(χ + 2))) = 3.3e-4 / (0.1 + 1/3)
+  // = 7.6154e-4 m. The level reported at each frequency must be the smallest candidate force
+  // whose predicted deformation reaches φ_max (the next smaller one stays below), and where no
+  // candidate reaches it a linear guess above the largest.
+  const frf::Substructure sub{test::paper_cantilever()};
+  joints::Joint j = tip_joint({Term::k, Term::c, Term::iwan}, {4800.0, 20.0, 1.0});
+  j.set_parameters(2, {3.0, 1.0e4, -0.5, 0.1}, false);
+  const std::vector<joints::Joint> joints{j};
+  const double phi_max = 3.0 * 1.1 / (1.0e4 * (0.1 + 1.0 / 3.0));
+  std::vector<identify::SineTestPlan> plans;
+  for (double f : {1.0, 3.0})
+    for (double a : {0.5, 2.0, 8.0})
+      plans.push_back({f, a});
+  identify::DesignOptions o;
+  o.max_misfit = std::numeric_limits<double>::infinity();
+  const auto candidates =
+      identify::predict_candidates(sub, identify::with_parametric_fixed(joints), tip, plans, o);
+  const auto levels = identify::parametric_levels(joints, candidates);
+  ASSERT_EQ(levels.size(), 1u);
+  const identify::ParametricLevel& l = levels[0];
+  EXPECT_EQ(l.regime, "macroslip");
+  EXPECT_NEAR(l.threshold, phi_max, 1e-12 * phi_max);
+  ASSERT_EQ(l.frequency_hz.size(), 2u);
+  for (std::size_t f = 0; f < 2; ++f) {
+    double lowest = std::numeric_limits<double>::quiet_NaN(), below = 0.0;
+    for (const auto& c : candidates)
+      if (c.plan.frequency_hz == l.frequency_hz[f] && c.usable) {
+        if (c.joint_amplitude[0] >= phi_max && !(c.plan.amplitude >= lowest))
+          lowest = c.plan.amplitude;
+      }
+    for (const auto& c : candidates)
+      if (c.plan.frequency_hz == l.frequency_hz[f] && c.usable && c.plan.amplitude < lowest)
+        below = std::max(below, c.joint_amplitude[0]);
+    if (std::isnan(lowest)) {
+      EXPECT_TRUE(std::isnan(l.lowest_force[f]));
+      EXPECT_GT(l.guess_force[f], 8.0);
+    } else {
+      EXPECT_EQ(l.lowest_force[f], lowest);
+      EXPECT_LT(below, phi_max);
+    }
+  }
+  // At 1 Hz, well below the resonance, 0.5 N deforms the joint by about 0.5 N over the joint's
+  // and the beam's static stiffness (4800 + 1e4 + 3EI/L³ ≈ 4900 N/m), 2.5e-5 m: 30 times below
+  // φ_max, never the level.
+  EXPECT_NE(l.lowest_force[0], 0.5);
+  EXPECT_NE(l.sentence.find("iwan.fs apart from iwan.beta"), std::string::npos) << l.sentence;
+}
+
+} // namespace

@@ -7,6 +7,7 @@
 #include "identify/output_error.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
 
@@ -169,6 +170,40 @@ TEST(ParametricIdentification, EquationErrorTakesAParametricTermOnlyFixed) {
     EXPECT_NE(what.find("'iwan' (fs, kt, chi, beta)"), std::string::npos) << what;
   }
   EXPECT_NO_THROW(identify::check_identifiable({tip(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}, true)}));
+}
+
+TEST(ParametricIdentification, AFailedDescribingFunctionFitIsAStatusNamingTheJointAndTerm) {
+  // A substructure whose modal analysis fails (a numerical outcome, not bad input): no test gives
+  // the joint's equivalent stiffness, so the start fails. That is a status whose reason names the
+  // joint and the term and passes the per-test fits' own status up (the modal analysis' reason),
+  // through the output-error pipeline too; nothing is thrown.
+  const frf::Substructure sub = test::failing_substructure();
+  joints::Joint j{"j", 3, 0, fem::Dof::ux, {Term::k, Term::c, Term::jenkins}, {0.0, 0.0, 1.0},
+                  {},  {}};
+  j.fixed.assign(3, false);
+  j.parameters.resize(3);
+  j.parameters[2].assign(2, joints::Parameter{});
+  // A sine record at 2 Hz, 4 periods of 64 samples: force and displacement at node 3.
+  identify::Record r;
+  r.source = "r.csv";
+  r.excitation_hz = 2.0;
+  const int n = 256;
+  r.t = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / (64.0 * 2.0));
+  const Eigen::VectorXd wt = 2.0 * pi * 2.0 * r.t;
+  r.channels.push_back({identify::Quantity::force, {3, fem::Dof::ux}, wt.array().sin()});
+  r.channels.push_back(
+      {identify::Quantity::displacement, {3, fem::Dof::ux}, 1e-3 * wt.array().cos()});
+  const identify::Measurement m = identify::measure(identify::SineTest{r}, {.harmonics = 1});
+  const identify::DescribingFunctionStart start =
+      identify::describing_function_start(sub, {j}, {m}, {});
+  ASSERT_FALSE(start.status.ok());
+  const std::string& why = start.status.reason;
+  EXPECT_EQ(why.rfind("joint 'j': the describing-function fit of its jenkins", 0), 0u) << why;
+  EXPECT_NE(why.find(test::failing_modes_reason), std::string::npos) << why;
+  EXPECT_EQ(start.status.code, fem::Status::Code::numerical_issue) << why;
+  const identify::FitResult r2 = identify::output_error(sub, {j}, {m}, {});
+  EXPECT_EQ(r2.status.reason, why);
+  EXPECT_TRUE(r2.joints.empty());
 }
 
 } // namespace
