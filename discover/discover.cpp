@@ -151,7 +151,10 @@ private:
     if (last.added.term) take_fit(last.added, state.fit, last.added.joint, *last.added.term);
     last.gap_after = last.added.gap = state.gap;
     last.added.explained = explained(last.gap_after, last.gap_before);
-    last.finding = finding(last);
+    const std::size_t n = out.states.size();
+    last.finding = last.added.refit && n >= 2
+                       ? refit_finding(last, out.states[n - 2].joints, state.joints)
+                       : finding(last);
   }
 
   // Every candidate, evaluated in parallel (each only reads the shared problem); the finalists
@@ -185,13 +188,16 @@ private:
   }
 
   // The cross-validated gap of a state on the tests that it and the model now re-simulated,
-  // kept per set of tests left out for the model now (computed once per step for most).
+  // kept per set of tests left out for the model now (computed once per step for most). Values
+  // given and never fitted are used as given in every fold: refitting them per fold would make
+  // the model now's held-out gap that of the refit candidate, which then never passes.
   CrossValidation cross_validated_now(const State& now, const State& candidate,
                                       std::map<std::vector<int>, CrossValidation>& kept) {
     const std::vector<int> out = united(now.failed, candidate.failed);
     const auto it = kept.find(out);
     if (it != kept.end()) return it->second;
-    return kept[out] = cross_validated(problem_, now.joints, now.damping_scale, out);
+    return kept[out] =
+               cross_validated(problem_, now.joints, now.damping_scale, out, values_fitted_);
   }
 
   // 2. One step: the admissible candidate with the lowest criterion is added. False when the
@@ -250,9 +256,10 @@ private:
     s.gap_before = s.added.gap_now >= 0.0 ? s.added.gap_now : state.gap;
     s.cv_before = choice.cv_now.value_or(-1.0);
     s.cv_after = s.added.cv_gap;
+    const std::vector<joints::Joint> before = state.joints;
     state = std::move(states[*choice.chosen]);
     s.gap_after = s.added.gap_now >= 0.0 ? s.added.gap : state.gap;
-    s.finding = finding(s);
+    s.finding = s.added.refit ? refit_finding(s, before, state.joints) : finding(s);
     values_fitted_ = true;
     warn_left_out(out, state,
                   "the model after step " + std::to_string(out.steps.size() + 1) + " (+ " +

@@ -103,6 +103,20 @@ std::string finding(const Step& s) {
                      number(s.gap_before), number(s.gap_after), pct(s.added.explained), left_out);
 }
 
+std::string refit_finding(const Step& s, const std::vector<joints::Joint>& before,
+                          const std::vector<joints::Joint>& after) {
+  std::string changes;
+  for (std::size_t j = 0; j < before.size() && j < after.size(); ++j)
+    for (std::size_t t = 0; t < before[j].terms.size() && t < after[j].values.size(); ++t)
+      if (!before[j].fixed[t])
+        changes += fmt::format("{}{} at '{}' {} → {}", changes.empty() ? "" : ", ",
+                               joints::term_name(before[j].terms[t]), before[j].name,
+                               number(before[j].values[t]), number(after[j].values[t]));
+  return fmt::format("Refitted the starting values ({}): the gap fell from {} to {} ({} of it "
+                     "explained).",
+                     changes, number(s.gap_before), number(s.gap_after), pct(s.added.explained));
+}
+
 std::string summary(const Result& r, const Compared& compared) {
   std::string added;
   for (const auto& s : r.steps)

@@ -16,6 +16,11 @@ std::vector<Comparison> comparisons(const std::vector<identify::Measurement>& te
 /// "Added k3 at 'tip' (cubic stiffness) = … [lo, hi]: the gap fell from … to … (… explained)."
 std::string finding(const Step& step);
 
+/// A refit's finding: "Refitted the starting values: k at 'tip' 1e+04 → 1.2e+04, …: the gap
+/// fell from … to … (… explained)." Each value not held fixed, from `before` to `after`.
+std::string refit_finding(const Step& step, const std::vector<joints::Joint>& before,
+                          const std::vector<joints::Joint>& after);
+
 /// The run in one sentence: what was added, how the gap shrank, against the noise level.
 std::string summary(const Result& result, const Compared& compared);
 

@@ -254,7 +254,7 @@ std::vector<std::vector<int>> held_out(int tests, int folds) {
 }
 
 CrossValidation cross_validated(Problem& problem, const std::vector<joints::Joint>& joints,
-                                double scale, const std::vector<int>& left_out) {
+                                double scale, const std::vector<int>& left_out, bool fit_per_fold) {
   const int n = static_cast<int>(problem.tests().size());
   const std::vector<std::vector<int>> folds = held_out(n, problem.options().folds);
   if (folds.empty())
@@ -275,9 +275,9 @@ CrossValidation cross_validated(Problem& problem, const std::vector<joints::Join
       std::vector<int> train;
       for (int i = 0; i < n; ++i)
         if (std::find(held.begin(), held.end(), i) == held.end()) train.push_back(i);
-      std::vector<joints::Joint> fitted;
+      std::vector<joints::Joint> fitted = joints;
       try {
-        fitted = problem.identify(joints, sim, train).identified(joints);
+        if (fit_per_fold) fitted = problem.identify(joints, sim, train).identified(joints);
       } catch (const std::invalid_argument& e) {
         return {0.0, 0.0,
                 fmt::format("without {} the terms cannot be identified ({})",
@@ -285,7 +285,7 @@ CrossValidation cross_validated(Problem& problem, const std::vector<joints::Join
       }
       // A fold's estimate may come out with negative damping or friction (fewer tests, more
       // noise): brought back to 0, as the output-error refinement does.
-      clamp_dissipative(fitted);
+      if (fit_per_fold) clamp_dissipative(fitted);
       Part part;
       for (int i : held) {
         // Tests the models compared cannot re-simulate at all are in neither sum.

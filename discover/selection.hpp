@@ -117,9 +117,12 @@ std::vector<std::vector<int>> held_out(int tests, int folds);
 /// the others (negative damping or friction brought back to 0; a failed prediction counts as
 /// predicting nothing), the tests `left_out` (ascending: those the models compared cannot
 /// re-simulate) in neither sum. Not computed, saying why, for fewer than 4 tests or a fold that
-/// cannot be identified.
+/// cannot be identified. With `fit_per_fold` false the joints' values are used as they are in
+/// every fold: a model whose values were given, never fitted to any test, predicts held-out
+/// tests with those values (refitting them per fold would cross-validate a refit instead).
 CrossValidation cross_validated(Problem& problem, const std::vector<joints::Joint>& joints,
-                                double scale, const std::vector<int>& left_out = {});
+                                double scale, const std::vector<int>& left_out = {},
+                                bool fit_per_fold = true);
 
 // A coefficient identified per test.
 
