@@ -76,8 +76,9 @@ Preconditions preconditions(const std::vector<identify::Measurement>& tests,
 
   p.damping_scale = options.substructure_damping && substructure_has_modes;
   if (options.substructure_damping && !substructure_has_modes)
-    p.limits.push_back("the substructure's damping scale is not tried: the substructure "
-                       "(measured FRFs) has no modes whose damping could be scaled");
+    // emplace_back: a moved temporary gave GCC 12's -Warray-bounds false positive here.
+    p.limits.emplace_back("the substructure's damping scale is not tried: the substructure "
+                          "(measured FRFs) has no modes whose damping could be scaled");
   return p;
 }
 

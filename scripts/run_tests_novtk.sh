@@ -35,6 +35,20 @@ if [[ "${1:-}" == "--sanitize" ]]; then
   repeats+="|EveryCommandHasHelp|FlagsShowNoDefaultAndEveryPictureHasNoPlot"
   repeats+="|EveryHarmonicBalanceTakesBalanceHarmonics|IdentifyThroughMeasuredFrfsAsThroughTheModel"
   repeats+="|RandomAndCompareCheckTheirOptions|DiscoverNamesAHiddenCubicStiffnessAndWritesItsReport)$"
+  # Second methods by long time integration and sweeps over a parameter: the physics checks of
+  # the harmonic balance, the modal time model and the fits against time integration, which run
+  # uninstrumented in the main suite, while shorter tests run the same code instrumented
+  # (HarmonicBalance.*, TimeModel.TwoModalSubstructuresJoined..., Continuation.Softening...,
+  # SimulateSineTests.TimeIntegrationAndHarmonicBalanceAgree, SparseCholesky.SolvesLike...).
+  # Instrumented times, 2026-12-05 (loaded machine): 63-338 s each, 1 300 of 1 770 test-seconds
+  # in the first 274 tests.
+  repeats+="|^HarmonicBalance\.(.*TimeIntegration|AnAsymmetricStartFindsTheSymmetryBreakingSteadyState)$"
+  repeats+="|^TimeModel\.(LinearSteadyStateIsTheModalModelsReceptance"
+  repeats+="|ModalModelAgreesWithTheFiniteElementModelItComesFrom)$"
+  repeats+="|^FitTest\.(CoulombFrictionFromTimeIntegrationAmplitudeSweep"
+  repeats+="|PaperModelIFromTimeIntegrationFrequencySweep)$|^Continuation\.HardeningCubicFoldsAndStability$"
+  repeats+="|^SparseCholesky\.OwnBlockSolveEqualsCholmodsForEveryWidth$"
+  repeats+="|^SimulateSineTests\.EveryTermAgreesWithTimeIntegrationHarmonicByHarmonic$"
   exclude=(-E "_study$|^MonteCarlo/|^docs_|$repeats")
 fi
 bash scripts/setup.sh
