@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -2695,7 +2696,12 @@ TEST_F(SteppedSineCli, AnUndeterminedIntervalIsFlaggedNeverWrittenAsAResult) {
   ASSERT_EQ(run.status, 0) << run.err;
   const json j = json::parse(test::read_text(out / "discovery.json"));
   int undetermined = 0, determined = 0;
-  auto check = [&](const json& c) {
+  std::function<void(const json&)> check = [&](const json& c) {
+    if (c.contains("parameters")) { // a parametric term: each parameter has its own interval
+      for (const auto& p : c["parameters"])
+        if (!p["fixed"].get<bool>()) check(p);
+      return;
+    }
     if (c["determined"].get<bool>()) {
       ++determined;
       ASSERT_TRUE(c["ci95"][0].is_number() && c["ci95"][1].is_number()) << c.dump();
