@@ -518,6 +518,86 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
                   "as far as these tests tell it stayed in microslip",
         said, k_open ? "k apart from iwan.kt, and " : ""));
   };
+  // A jenkins that never slipped, or a gap that never closed, in any test: the first acts as
+  // its spring kt alone (k + kt is what the tests determine; fs only has a lower bound), the
+  // second not at all (delta only has a lower bound, kg none). Said so, the combination given;
+  // the undetermined parameters have no value.
+  const auto never_engaged = [&](std::size_t j, const joints::Joint& J, JointEstimate& je) {
+    for (const joints::Term term : {joints::Term::jenkins, joints::Term::gap}) {
+      const int t = J.term_index(term);
+      if (t < 0 || je.terms[static_cast<std::size_t>(t)].parameters.empty()) continue;
+      const auto ti = static_cast<std::size_t>(t);
+      auto& pars = je.terms[ti].parameters;
+      double peak = 0.0; // the largest deformation of the joint over the tests (a bound)
+      for (const Test& test : tests)
+        peak = std::max(peak, test.Y.col(static_cast<Eigen::Index>(j)).cwiseAbs().sum());
+      const bool jenkins = term == joints::Term::jenkins;
+      const double kt = jenkins ? identified[j].parameter(ti, "kt") : 0.0;
+      const double reach =
+          jenkins ? identified[j].parameter(ti, "fs") / kt : identified[j].parameter(ti, "delta");
+      // A gap whose contact force stays negligible (the fit may close it at no stiffness, kg → 0,
+      // where delta has no effect either): below 1e-6 of the joint's spring force.
+      const double contact =
+          jenkins ? 0.0 : identified[j].parameter(ti, "kg") * std::max(0.0, peak - reach);
+      const int k_term = J.term_index(joints::Term::k);
+      const bool no_force =
+          !jenkins && k_term >= 0 &&
+          contact <= 1e-6 * std::abs(identified[j].values[static_cast<std::size_t>(k_term)]) * peak;
+      if (!(peak < reach) && !no_force) continue; // it slips, or makes contact, in some test
+      const int k_index = J.term_index(joints::Term::k);
+      const bool kt_fixed =
+          jenkins &&
+          pars[static_cast<std::size_t>(joints::parameter_index(joints::Term::jenkins, "kt"))]
+              .fixed;
+      const bool k_open =
+          jenkins && !kt_fixed && k_index >= 0 && !J.fixed[static_cast<std::size_t>(k_index)];
+      std::vector<std::string> undetermined =
+          jenkins ? std::vector<std::string>{"fs"} : std::vector<std::string>{"delta", "kg"};
+      if (k_open) undetermined.push_back("kt");
+      std::string names; // listed as undetermined ("k apart from jenkins.kt" says kt's)
+      for (ParameterEstimate& p : pars)
+        if (!p.fixed &&
+            std::find(undetermined.begin(), undetermined.end(), p.name) != undetermined.end()) {
+          p.value = p.std = p.ci_low = p.ci_high = nan;
+          p.determined = false;
+          const std::string name = fmt::format("{}.{}", joints::term_name(term), p.name);
+          std::erase(poorly, fmt::format("{} of '{}'", name, je.name));
+          if (!(k_open && p.name == "kt")) names += (names.empty() ? "" : " and ") + name;
+        }
+      std::string said;
+      if (k_open) {
+        auto& k = je.terms[static_cast<std::size_t>(k_index)];
+        k.value = k.std = k.ci_low = k.ci_high = nan;
+        k.determined = false;
+        std::erase(poorly, fmt::format("k of '{}'", je.name));
+        const auto sum = combination([&](const std::vector<joints::Joint>& js) {
+          return js[j].values[static_cast<std::size_t>(k_index)] + js[j].parameter(ti, "kt");
+        });
+        said = fmt::format("the tests determine k + jenkins.kt = {:.5g} [{:.5g}, {:.5g}] N/m; k "
+                           "apart from jenkins.kt{} {} undetermined",
+                           sum[0], sum[2], sum[3], names.empty() ? "" : ", and " + names,
+                           names.empty() ? "is" : "are");
+      } else if (!names.empty()) {
+        said = fmt::format("{} {} undetermined", names,
+                           names.find(" and ") == std::string::npos ? "is" : "are");
+      } else {
+        continue; // nothing of it was identified
+      }
+      out.identifiability.push_back(fmt::format(
+          "joint '{}': its {} in any test ({}), where {}: {} (no value is given for them; the "
+          "tests show only that {} exceeds {:.3g} m{}): a test whose deformation reaches beyond "
+          "it would determine them",
+          je.name, jenkins ? "jenkins never slipped" : "gap never closed",
+          peak < reach
+              ? fmt::format("largest deformation {:.3g} m, below {} ≈ {:.3g} m", peak,
+                            jenkins ? "its slip displacement fs/kt" : "its clearance delta", reach)
+              : fmt::format("largest deformation {:.3g} m; the fit leaves it no contact "
+                            "force: kg (peak − delta) = {:.3g} N",
+                            peak, contact),
+          jenkins ? "it acts as its spring kt alone" : "it exerts no force", said,
+          jenkins ? "fs/kt" : "delta", peak, jenkins ? "" : " or that kg is negligible"));
+    }
+  };
   out.joints.clear();
   Eigen::Index q = 0;
   for (std::size_t j = 0; j < identified.size(); ++j) {
@@ -543,8 +623,10 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
           const double a = parameter_from_u(info[p], u - tq * su),
                        b = parameter_from_u(info[p], u + tq * su);
           pe.ci_low = std::min(a, b), pe.ci_high = std::max(a, b);
+          // A value at its bound (e.g. 0) with an interval to infinity is not a result.
           pe.determined =
-              std::isfinite(pe.std) && pe.std <= o.poorly_determined * std::abs(pe.value);
+              std::isfinite(pe.std) && pe.std <= o.poorly_determined * std::abs(pe.value) &&
+              std::isfinite(pe.ci_low) && std::isfinite(pe.ci_high) && pe.ci_high > pe.ci_low;
           if (!pe.determined)
             poorly.push_back(
                 fmt::format("{}.{} of '{}'", joints::term_name(te.term), pe.name, je.name));
@@ -568,6 +650,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
       je.terms.push_back(te);
     }
     microslip(j, identified[j], je);
+    never_engaged(j, identified[j], je);
     out.joints.push_back(std::move(je));
   }
   double misfit = 0.0, size = 0.0; // of the displacement values (m)

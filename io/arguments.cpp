@@ -64,4 +64,27 @@ std::vector<identify::Quantity> parse_channels(const std::string& name,
   return out;
 }
 
+void check_sine_tests(const SineTestNames& names, const std::vector<double>& frequencies,
+                      const identify::SimulationOptions& options) {
+  if (frequencies.empty())
+    throw Error(fmt::format("{}: expected at least one frequency (Hz)", names.freq));
+  for (double f : frequencies)
+    if (!(std::isfinite(f) && f > 0.0))
+      throw Error(fmt::format("{}: expected frequencies > 0 Hz, got {}", names.freq, f));
+  if (options.periods < 1)
+    throw Error(fmt::format("{}: expected at least 1, got {}", names.periods, options.periods));
+  if (options.steps_per_period < 8)
+    throw Error(fmt::format("{}: expected at least 8, got {}", names.steps_per_period,
+                            options.steps_per_period));
+  if (options.samples_per_period != 0 &&
+      (options.samples_per_period < 8 ||
+       options.steps_per_period % options.samples_per_period != 0))
+    throw Error(fmt::format("{}: expected at least 8 and a divisor of {} ({}), got {}",
+                            names.samples_per_period, names.steps_per_period,
+                            options.steps_per_period, options.samples_per_period));
+  if (options.balance.harmonics < 1)
+    throw Error(fmt::format("{}: expected at least 1, got {}", names.balance_harmonics,
+                            options.balance.harmonics));
+}
+
 } // namespace jointid::io

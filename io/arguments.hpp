@@ -4,6 +4,7 @@
 /// "harmonics" in Python) and throws io::Error starting with that name and saying what was
 /// expected, so that both front ends refuse the same input with the same words.
 #include "identify/record.hpp"
+#include "identify/sine_tests.hpp"
 
 #include <string>
 #include <vector>
@@ -25,5 +26,15 @@ void check_noise(const std::string& name, double noise);
 /// Measured quantities "x", "v", "a" (displacement, velocity, acceleration), each once.
 std::vector<identify::Quantity> parse_channels(const std::string& name,
                                                const std::vector<std::string>& channels);
+
+/// How a front end spells the options of its sine tests (check_sine_tests).
+struct SineTestNames {
+  std::string freq, periods, steps_per_period, samples_per_period, balance_harmonics;
+};
+/// Sine tests' frequencies (at least one, each > 0 Hz) and sampling: at least one period, 8
+/// steps a period, the samples kept a divisor of the steps (0: every step), at least one
+/// balance harmonic.
+void check_sine_tests(const SineTestNames& names, const std::vector<double>& frequencies,
+                      const identify::SimulationOptions& options);
 
 } // namespace jointid::io

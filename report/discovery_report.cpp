@@ -301,9 +301,18 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
         verdict += fmt::format(" (compared without the {} test{} it could not re-simulate: {})",
                                cand.left_out.size(), cand.left_out.size() == 1 ? "" : "s",
                                listed(cand.left_out));
-      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", cand.name(), cand.effect(),
-                        g4(cand.value), interval(cand.ci_low, cand.ci_high), g4(cand.gap),
-                        pct(cand.explained), verdict);
+      // A parametric term (jenkins, iwan, gap) has no single value: its parameters, each with
+      // its interval, or "—" where its fit gave none.
+      const bool parametric = cand.term && joints::has_parameters(*cand.term);
+      const std::string value = !parametric ? g4(cand.value)
+                                : cand.parameters.empty()
+                                    ? std::string("—")
+                                    : parameters_text(cand.parameters, *cand.term);
+      const std::string ci = !parametric               ? interval(cand.ci_low, cand.ci_high)
+                             : cand.parameters.empty() ? std::string("—")
+                                                       : std::string("(with each parameter)");
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", cand.name(), cand.effect(), value,
+                        ci, g4(cand.gap), pct(cand.explained), verdict);
     }
     md += "\n";
   }

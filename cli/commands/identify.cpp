@@ -120,31 +120,43 @@ void Identify::run() {
 }
 
 void Identify::print(const identify::FitResult& result) const {
-  fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", "joint", "term", "effect", "value", "std",
-             "95 % interval");
+  // The joint and term columns as wide as their longest entry ("iwan.beta", a long joint name).
+  std::size_t jw = 12, tw = 5;
+  for (const auto& j : result.joints) {
+    jw = std::max(jw, j.name.size());
+    for (const auto& t : j.terms) {
+      tw = std::max(tw, joints::term_name(t.term).size());
+      for (const auto& p : t.parameters)
+        tw = std::max(tw, joints::term_name(t.term).size() + 1 + p.name.size());
+    }
+  }
+  const auto row = [&](std::string_view joint, std::string_view term, std::string_view effect,
+                       std::string_view value, std::string_view std, std::string_view interval) {
+    fmt::print("{:<{}} {:<{}} {:<26} {:>14} {:>11}  {}\n", joint, jw, term, tw, effect, value, std,
+               interval);
+  };
+  row("joint", "term", "effect", "value", "std", "95 % interval");
   for (const auto& j : result.joints)
     for (const auto& t : j.terms) {
       if (!t.parameters.empty()) { // a parametric term: one line per parameter
         for (const auto& p : t.parameters)
-          fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", j.name,
-                     fmt::format("{}.{}", joints::term_name(t.term), p.name),
-                     joints::term_effect(t.term),
-                     p.determined ? fmt::format("{:.7g}", p.value) : std::string("undetermined"),
-                     p.fixed || !p.determined ? std::string() : fmt::format("{:.3g}", p.std),
-                     p.fixed        ? std::string("(fixed)")
-                     : p.determined ? fmt::format("[{:.7g}, {:.7g}]", p.ci_low, p.ci_high)
-                                    : std::string("(see below)"));
+          row(j.name, fmt::format("{}.{}", joints::term_name(t.term), p.name),
+              joints::term_effect(t.term),
+              p.determined ? fmt::format("{:.7g}", p.value) : std::string("undetermined"),
+              p.fixed || !p.determined ? std::string() : fmt::format("{:.3g}", p.std),
+              p.fixed        ? std::string("(fixed)")
+              : p.determined ? fmt::format("[{:.7g}, {:.7g}]", p.ci_low, p.ci_high)
+                             : std::string("(see below)"));
         continue;
       }
       if (std::isnan(t.value)) { // not determined apart from another term: no value
-        fmt::print("{:<12} {:<5} {:<26} {:>14} {:>11}  {}\n", j.name, joints::term_name(t.term),
-                   joints::term_effect(t.term), "undetermined", "", "(see below)");
+        row(j.name, joints::term_name(t.term), joints::term_effect(t.term), "undetermined", "",
+            "(see below)");
         continue;
       }
-      fmt::print("{:<12} {:<5} {:<26} {:>14.7g} {:>11.3g}  {}\n", j.name, joints::term_name(t.term),
-                 joints::term_effect(t.term), t.value, t.std,
-                 t.fixed ? std::string("(fixed)")
-                         : fmt::format("[{:.7g}, {:.7g}]", t.ci_low, t.ci_high));
+      row(j.name, joints::term_name(t.term), joints::term_effect(t.term),
+          fmt::format("{:.7g}", t.value), fmt::format("{:.3g}", t.std),
+          t.fixed ? std::string("(fixed)") : fmt::format("[{:.7g}, {:.7g}]", t.ci_low, t.ci_high));
     }
   fmt::print("{} equations, {} unknowns, condition number {:.3g}, residual {:.3g} m rms ({:.3g} "
              "relative)\n",

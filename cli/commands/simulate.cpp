@@ -7,6 +7,7 @@
 #include "identify/random_tests.hpp"
 #include "identify/sine_tests.hpp"
 #include "identify/stepped_sine.hpp"
+#include "io/arguments.hpp"
 #include "io/files.hpp"
 #include "io/record_csv.hpp"
 
@@ -144,26 +145,11 @@ void Simulate::run_sine() {
                     "--excitation random, sweep, multisine or record");
   if (period_ != 0.0) throw io::Error("--period: only with --excitation multisine");
   if (force_.empty()) throw io::Error("--force: expected NODE:DOF of the sine force, e.g. 7:uy");
-  if (frequencies_.empty()) throw io::Error("--freq: expected at least one frequency (Hz)");
-  for (double f : frequencies_)
-    if (!(std::isfinite(f) && f > 0.0))
-      throw io::Error(fmt::format("--freq: expected frequencies > 0 Hz, got {}", f));
+  io::check_sine_tests(
+      {"--freq", "--periods", "--steps-per-period", "--samples-per-period", "--balance-harmonics"},
+      frequencies_, sine_);
   check_amplitudes(amplitudes_);
   identify::SimulationOptions options = sine_;
-  if (options.periods < 1)
-    throw io::Error(fmt::format("--periods: expected at least 1, got {}", options.periods));
-  if (options.steps_per_period < 8)
-    throw io::Error(
-        fmt::format("--steps-per-period: expected at least 8, got {}", options.steps_per_period));
-  if (options.samples_per_period != 0 &&
-      (options.samples_per_period < 8 ||
-       options.steps_per_period % options.samples_per_period != 0))
-    throw io::Error(fmt::format("--samples-per-period: expected at least 8 and a divisor of "
-                                "--steps-per-period ({}), got {}",
-                                options.steps_per_period, options.samples_per_period));
-  if (options.balance.harmonics < 1)
-    throw io::Error(
-        fmt::format("--balance-harmonics: expected at least 1, got {}", options.balance.harmonics));
   check_noise(noise_);
   options.quantities = parse_channels(channels_);
   options.method = method_ == "time" ? identify::SimulationMethod::time_integration

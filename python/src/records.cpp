@@ -118,26 +118,11 @@ struct SimulateArguments {
 
 py::list simulate_sine(const ModelPtr& model, const SimulateArguments& a) {
   // 1. The arguments, as `jointid simulate` checks its options.
-  if (a.freq_hz.empty()) throw io::Error("freq_hz: expected at least one frequency (Hz)");
-  for (double f : a.freq_hz)
-    if (!(std::isfinite(f) && f > 0.0))
-      throw io::Error(fmt::format("freq_hz: expected frequencies > 0 Hz, got {}", f));
+  io::check_sine_tests(
+      {"freq_hz", "periods", "steps_per_period", "samples_per_period", "balance_harmonics"},
+      a.freq_hz, a.options);
   check_amplitudes(a.amplitude);
   identify::SimulationOptions options = a.options;
-  if (options.periods < 1)
-    throw io::Error(fmt::format("periods: expected at least 1, got {}", options.periods));
-  if (options.steps_per_period < 8)
-    throw io::Error(
-        fmt::format("steps_per_period: expected at least 8, got {}", options.steps_per_period));
-  if (options.samples_per_period != 0 &&
-      (options.samples_per_period < 8 ||
-       options.steps_per_period % options.samples_per_period != 0))
-    throw io::Error(fmt::format("samples_per_period: expected at least 8 and a divisor of "
-                                "steps_per_period ({}), got {}",
-                                options.steps_per_period, options.samples_per_period));
-  if (options.balance.harmonics < 1)
-    throw io::Error(
-        fmt::format("balance_harmonics: expected at least 1, got {}", options.balance.harmonics));
   io::check_noise("noise", a.noise);
   options.quantities = io::parse_channels("channels", a.channels);
   if (a.method == "time")

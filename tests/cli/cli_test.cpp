@@ -738,6 +738,18 @@ TEST_F(CliTest, DiscoverNamesAHiddenJenkinsSliderFromASteppedSineTable) {
   const std::string report = test::read_text(out / "report.md");
   EXPECT_NE(report.find("jenkins at 'tip'"), std::string::npos);
   EXPECT_NE(report.find("fs = "), std::string::npos);
+  // The candidate tables give a parametric term's parameters (or "—"), never a value of 1.
+  const std::size_t candidates = report.find("## Candidates");
+  ASSERT_NE(candidates, std::string::npos);
+  int rows = 0;
+  for (std::size_t at = report.find("| jenkins at 'tip' |", candidates); at != std::string::npos;
+       at = report.find("| jenkins at 'tip' |", at + 1), ++rows) {
+    const std::string row = report.substr(at, report.find('\n', at) - at);
+    EXPECT_EQ(row.find("| 1 |"), std::string::npos) << row;
+    EXPECT_TRUE(row.find("kt = ") != std::string::npos || row.find("| — |") != std::string::npos)
+        << row;
+  }
+  EXPECT_GE(rows, 1);
 }
 
 TEST_F(CliTest, SimulateWritesASteppedSineTableThatIdentifyReads) {

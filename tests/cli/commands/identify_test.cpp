@@ -123,8 +123,19 @@ void identified_back(const TermCase& c, int seed) {
   for (const auto& [name, v] : c.truth) {
     ASSERT_TRUE(terms_out[2]["parameters"].contains(name)) << terms_out[2].dump();
     expect_within_interval(terms_out[2]["parameters"][name], v, name);
-    // the printed table gives it, "<term>.<parameter>", with its interval
-    EXPECT_NE(run.out.find("tip          " + name), std::string::npos) << run.out;
+    // the printed table gives it, "<term>.<parameter>", with its interval, in a term column as
+    // wide as its longest entry: the effect column starts where the header's does
+    const std::size_t at = run.out.find("tip          " + name + " ");
+    ASSERT_NE(at, std::string::npos) << run.out;
+    const std::size_t header = run.out.rfind("joint", at);
+    ASSERT_NE(header, std::string::npos) << run.out;
+    const std::size_t effect = run.out.find("effect", header) - header;
+    const std::string line = run.out.substr(at, run.out.find('\n', at) - at);
+    ASSERT_GT(line.size(), effect) << run.out;
+    EXPECT_EQ(line[effect - 1], ' ') << run.out;
+    EXPECT_NE(line[effect], ' ') << run.out;
+    EXPECT_EQ(line.substr(13, effect - 13).find_first_not_of(name + " "), std::string::npos)
+        << run.out;
   }
   EXPECT_TRUE(j["identifiability"].empty()) << j["identifiability"].dump();
   // the start is said
@@ -186,6 +197,74 @@ TEST(IdentifyParametric, IwanInMicroslipSaysWhatTheTestsDoNotDetermine) {
   EXPECT_LE(std::abs(sum - 14800.0), widen * std::max(sum - lo, hi - sum)) << said;
   EXPECT_NE(run.out.find("undetermined"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("not determined: joint 'tip': its iwan"), std::string::npos) << run.out;
+}
+
+// The sentence of `identify` that says what a jenkins that never slipped or a gap that never
+// closed leaves undetermined: its term's undetermined parameters, null in results.json and
+// flagged, and the combination the tests determine with its interval holding the truth.
+json never_engaged(const std::string& truth_values, const std::string& term, int seed,
+                   std::string& said) {
+  const test::TempDir dir;
+  const std::string terms = "terms = [\"k\", \"c\", \"" + term + "\"]\n";
+  const auto records = simulate(dir.path(), terms + truth_values, "0.5,1", seed);
+  const Outcome run = identify(dir.path(), terms, records);
+  EXPECT_EQ(run.status, 0) << run.err;
+  if (run.status != 0) return json();
+  const json j = json::parse(test::read_text(dir.path() / "result.json"));
+  EXPECT_EQ(j["identifiability"].size(), 1u) << j["identifiability"].dump();
+  if (j["identifiability"].empty()) return json();
+  said = j["identifiability"][0];
+  EXPECT_NE(run.out.find("not determined: joint 'tip': its " + term), std::string::npos) << run.out;
+  return j;
+}
+
+TEST(IdentifyParametric, AJenkinsThatNeverSlipsSaysWhatTheTestsDetermine) {
+  // fs/kt = 1e-3 m, beyond the tip's deformation at 0.5 and 1 N: the slider sticks, the joint is
+  // k + kt = 14800 N/m in every test; fs and k apart from kt are undetermined.
+  std::string said;
+  const json j = never_engaged(
+      "values = { k = 4800.0, c = 20.0, \"jenkins.kt\" = 1.0e4, \"jenkins.fs\" = 10.0 }\n",
+      "jenkins", 51, said);
+  ASSERT_FALSE(j.is_null());
+  const json& t = j["joints"][0]["terms"];
+  for (const char* name : {"jenkins.fs", "jenkins.kt"}) {
+    EXPECT_FALSE(t[2]["parameters"][name]["determined"].get<bool>()) << name;
+    EXPECT_TRUE(t[2]["parameters"][name]["value"].is_null()) << name;
+  }
+  EXPECT_TRUE(t[0]["value"].is_null()); // k apart from kt
+  expect_within_interval(t[1], 20.0, "c");
+  EXPECT_NE(said.find("its jenkins never slipped in any test"), std::string::npos) << said;
+  EXPECT_NE(said.find("k apart from jenkins.kt, and jenkins.fs are undetermined"),
+            std::string::npos)
+      << said;
+  const auto at = said.find("k + jenkins.kt = ");
+  ASSERT_NE(at, std::string::npos) << said;
+  std::size_t used = 0;
+  const double sum = std::stod(said.substr(at + 17), &used);
+  const std::string rest = said.substr(at + 17 + used);
+  ASSERT_EQ(rest.rfind(" [", 0), 0u) << said;
+  const double lo = std::stod(rest.substr(2)), hi = std::stod(rest.substr(rest.find(", ") + 2));
+  EXPECT_LE(std::abs(sum - 14800.0), widen * std::max(sum - lo, hi - sum)) << said;
+}
+
+TEST(IdentifyParametric, AGapThatNeverClosesSaysItsParametersAreUndetermined) {
+  // delta = 5e-3 m, far beyond the tip's deformation at 0.5 and 1 N: the gap exerts no force,
+  // k and c are the joint's, delta and kg undetermined.
+  std::string said;
+  const json j = never_engaged(
+      "values = { k = 4800.0, c = 20.0, \"gap.delta\" = 5.0e-3, \"gap.kg\" = 2.0e4 }\n", "gap", 61,
+      said);
+  ASSERT_FALSE(j.is_null());
+  const json& t = j["joints"][0]["terms"];
+  for (const char* name : {"gap.delta", "gap.kg"}) {
+    EXPECT_FALSE(t[2]["parameters"][name]["determined"].get<bool>()) << name;
+    EXPECT_TRUE(t[2]["parameters"][name]["value"].is_null()) << name;
+  }
+  expect_within_interval(t[0], 4800.0, "k");
+  expect_within_interval(t[1], 20.0, "c");
+  EXPECT_NE(said.find("its gap never closed in any test"), std::string::npos) << said;
+  EXPECT_NE(said.find("gap.delta and gap.kg are undetermined"), std::string::npos) << said;
+  EXPECT_NE(said.find("delta exceeds"), std::string::npos) << said;
 }
 
 TEST(IdentifyParametric, RefusesWhatOutputErrorCannotTake) {

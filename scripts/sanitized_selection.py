@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""Which tests the instrumented run leaves to the uninstrumented one, from the latter's times.
+
+Usage: sanitized_selection.py COST_DATA [--limit SECONDS] [--report]
+
+COST_DATA is ctest's own record of the main suite's run (build/Testing/Temporary/
+CTestCostData.txt: a line "<test> <runs> <average seconds>" per test). Under AddressSanitizer
+and UndefinedBehaviorSanitizer a test runs several times slower, and the slowest tests are the
+ones that repeat the same code many times (parameter sweeps, long time integrations, repeated
+discoveries): they add time, not coverage. So the instrumented run takes every test that took
+at most --limit seconds uninstrumented (default 1) and, of every GoogleTest suite (the name up
+to its first '.', e.g. "Discover" or "AtTheTip/HiddenTerm"), at least its fastest test, so
+that no suite's code goes unchecked. Prints a ctest regular expression that matches the tests
+left out (one alternative per test, anchored), or nothing when none is; with --report, a table
+of what is left out and what stays, on stderr.
+"""
+import re
+import sys
+
+
+def read_costs(path):
+    costs = {}
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            line = line.rstrip("\n")
+            if line == "---":  # the failed tests' names follow
+                break
+            parts = line.rsplit(" ", 2)
+            if len(parts) != 3:
+                continue
+            name, _, cost = parts
+            try:
+                costs[name] = float(cost)
+            except ValueError:
+                raise SystemExit(f"{path}: '{line}': expected '<test> <runs> <seconds>'")
+    return costs
+
+
+def suite(name):
+    return name.split(".", 1)[0] if "." in name else name
+
+
+def main(argv):
+    if not argv or argv[0].startswith("-"):
+        raise SystemExit(__doc__)
+    path, limit, report = argv[0], 1.0, False
+    rest = argv[1:]
+    while rest:
+        if rest[0] == "--limit" and len(rest) > 1:
+            try:
+                limit = float(rest[1])
+            except ValueError:
+                raise SystemExit(f"--limit: expected seconds, got '{rest[1]}'")
+            rest = rest[2:]
+        elif rest[0] == "--report":
+            report, rest = True, rest[1:]
+        else:
+            raise SystemExit(f"unknown argument '{rest[0]}'\n{__doc__}")
+    costs = read_costs(path)
+    fastest = {}
+    for name, cost in costs.items():
+        s = suite(name)
+        if s not in fastest or cost < costs[fastest[s]]:
+            fastest[s] = name
+    kept = {n for n in costs if costs[n] <= limit} | set(fastest.values())
+    left = sorted((n for n in costs if n not in kept), key=lambda n: -costs[n])
+    if report:
+        total = sum(costs.values())
+        out = sum(costs[n] for n in left)
+        print(f"{len(costs)} tests, {total:.0f} s uninstrumented; left out: {len(left)} "
+              f"({out:.0f} s); instrumented: {len(costs) - len(left)} "
+              f"({total - out:.0f} s)", file=sys.stderr)
+        for n in left:
+            print(f"  left out {costs[n]:8.2f} s  {n}", file=sys.stderr)
+        for n in sorted(kept - {n for n in costs if costs[n] <= limit}, key=lambda n: -costs[n]):
+            print(f"  kept     {costs[n]:8.2f} s  {n} (its suite's fastest)", file=sys.stderr)
+    if left:
+        print("|".join("^" + re.sub(r"([\\.^$|()\[\]*+?{}])", r"\\\1", n) + "$" for n in left))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
