@@ -19,6 +19,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -44,16 +45,28 @@ protected:
   static void SetUpTestSuite() {
     dir_ = std::make_unique<test::TempDir>();
     test::write_text(model(), test::cantilever_toml());
-    simulate_ =
-        jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3.4,4.2,5",
-                 "--amplitude", "10", "--steps-per-period", std::to_string(steps_per_period),
-                 "--periods", std::to_string(periods), "-o", records_dir().string()},
-                dir_->path());
   }
-  static void TearDownTestSuite() { dir_.reset(); }
+  static void TearDownTestSuite() {
+    dir_.reset();
+    simulated_.reset();
+  }
 
   static fs::path model() { return *dir_ / "cantilever.toml"; }
-  static fs::path records_dir() { return *dir_ / "records"; }
+  // The suite's three records, simulated on first use: each test runs in a process of its own
+  // (gtest_discover_tests), and most never read them (instrumented, the simulation took 10 s).
+  static const Outcome& simulated() {
+    if (!simulated_)
+      simulated_ =
+          jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "3.4,4.2,5",
+                   "--amplitude", "10", "--steps-per-period", std::to_string(steps_per_period),
+                   "--periods", std::to_string(periods), "-o", (*dir_ / "records").string()},
+                  dir_->path());
+    return *simulated_;
+  }
+  static fs::path records_dir() {
+    (void)simulated();
+    return *dir_ / "records";
+  }
   static std::vector<std::string> record_files() {
     return {(records_dir() / "sine_f3.4Hz_F10N.csv").string(),
             (records_dir() / "sine_f4.2Hz_F10N.csv").string(),
@@ -62,10 +75,10 @@ protected:
   static const fs::path& dir() { return dir_->path(); }
 
   static std::unique_ptr<test::TempDir> dir_;
-  static Outcome simulate_;
+  static std::optional<Outcome> simulated_;
 };
 std::unique_ptr<test::TempDir> CliTest::dir_;
-Outcome CliTest::simulate_;
+std::optional<Outcome> CliTest::simulated_;
 
 TEST_F(CliTest, EveryCommandHasHelp) {
   for (const std::vector<std::string>& args : {std::vector<std::string>{"--help"},
@@ -91,7 +104,7 @@ TEST_F(CliTest, EveryCommandHasHelp) {
 }
 
 TEST_F(CliTest, SimulateWritesReadableRecords) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const auto files = record_files();
   for (std::size_t i = 0; i < files.size(); ++i) {
     const double f = frequencies[i];
@@ -128,7 +141,7 @@ TEST_F(CliTest, SimulateWritesReadableRecords) {
 }
 
 TEST_F(CliTest, HarmonicBalanceAgreesWithTimeIntegration) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path out = dir() / "hb";
   const Outcome run = jointid({"simulate", model().string(), "--force", "7:uy", "--freq", "4.2",
                                "--amplitude", "10", "--method", "hb", "--steps-per-period", "512",
@@ -144,7 +157,7 @@ TEST_F(CliTest, HarmonicBalanceAgreesWithTimeIntegration) {
 }
 
 TEST_F(CliTest, IdentifyRecoversTheJoint) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path result = dir() / "result.json";
   std::vector<std::string> args{"identify", model().string()};
   for (const auto& f : record_files())
@@ -186,7 +199,7 @@ TEST_F(CliTest, IdentifyThroughMeasuredFrfsAsThroughTheModel) {
   // model, 0.01 Hz lines, as accelerance: the usual sensor) in a universal file named by [frf];
   // the records' frequencies (3.4, 4.2, 5 Hz) lie on the lines, so identify gives the model
   // file's values to rounding. `modes` has nothing to compute; time integration needs elements.
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path h = dir() / "measured_h";
   const Outcome frf =
       jointid({"frf", model().string(), "--drive", "7:uy", "--freq-range", "0:10", "--points",
@@ -262,7 +275,7 @@ TEST_F(CliTest, IdentifyByOutputError) {
   // The suite's records (time integration, no noise) identified by output error on harmonics
   // 1–3: the model's values to the time integrator's own error (its period elongation at 512
   // steps a period, about 1e-4), the method named, the misfit beyond the (tiny) noise said.
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path result = dir() / "output_error.json";
   std::vector<std::string> args{"identify", model().string()};
   for (const auto& f : record_files())
@@ -392,7 +405,7 @@ TEST_F(CliTest, ModesOfAFreeStructureWarnAboutRigidBodyModes) {
 }
 
 TEST_F(CliTest, BadModelFailsAndKeepsTheOldResult) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path bad = dir() / "bad_model.toml";
   const std::string text =
       test::replaced(test::cantilever_toml(), "rho = 7850.0", "rho = 7850.0\nrhoo = 1.0");
@@ -411,7 +424,7 @@ TEST_F(CliTest, BadModelFailsAndKeepsTheOldResult) {
 }
 
 TEST_F(CliTest, RecordWithoutTheJointChannelFails) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   identify::Record r = io::read_record(record_files()[0]);
   r.channels.erase(r.channels.begin() + 1, r.channels.begin() + 3); // drop x@7:uy and v@7:uy
   const fs::path partial = dir() / "no_x.csv";
@@ -429,7 +442,7 @@ TEST_F(CliTest, RecordWithoutTheJointChannelFails) {
 
 // The silent wrong answers of issue 10: each now names its culprit.
 TEST_F(CliTest, ZeroForceForeignChannelAndHarmonicZeroAloneAreNamed) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   // A record whose force channel is zero in every sample: refused, naming it.
   identify::Record zero = io::read_record(record_files()[0]);
   zero.channels[0].samples.setZero();
@@ -815,7 +828,7 @@ TEST_F(CliTest, NoiseIsSeededAndAFileGivenTwiceIsRefused) {
 }
 
 TEST_F(CliTest, DiscoverChecksItsOptionsBeforeReading) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const std::string rec = record_files()[0];
   const fs::path out = dir() / "never_discover";
   expect_one_line_error(
@@ -843,7 +856,7 @@ std::vector<std::string> temporary_files(const fs::path& dir) {
 }
 
 TEST_F(CliTest, FailedRunKeepsAGoodResultByteForByte) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path out = dir() / "kept";
   fs::create_directories(out);
   const fs::path result = out / "result.json";
@@ -873,7 +886,7 @@ TEST_F(CliTest, FailedRunKeepsAGoodResultByteForByte) {
 }
 
 TEST_F(CliTest, OutputOverAnInputIsRefused) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path copy = dir() / "inputs";
   fs::create_directories(copy);
   const fs::path record = copy / "rec.csv", model_copy = copy / "model.toml";
@@ -908,7 +921,7 @@ TEST_F(CliTest, OutputOverAnInputIsRefused) {
 // installed its handler (seen in /proc/PID/status) and has run a little; the job is far longer
 // than the wait, so the signal always lands mid-run, however loaded the machine.
 TEST_F(CliTest, InterruptMidRunKeepsThePreviousOutputs) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path out = dir() / "interrupted";
   fs::create_directories(out);
   std::vector<std::string> previous;
@@ -1374,7 +1387,7 @@ TEST_F(CliTest, IdentifyTakesAMultisineRecordAsPeriodicAndRefusesARandomOne) {
 // harmonic (the suite's records hold 512 samples a period: harmonic 60 is there, 300 is above
 // their Nyquist frequency and refused naming the record).
 TEST_F(CliTest, IdentifyHarmonicsAreCappedOnlyByTheSampling) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   std::vector<std::string> args{"identify", model().string()};
   for (const auto& f : record_files())
     args.push_back(f);
@@ -1744,7 +1757,7 @@ TEST_F(CliTest, OptionsOutOfRangeAreNamedBeforeAnythingIsRead) {
 }
 
 TEST_F(CliTest, OutputOfTheWrongKindIsRefused) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   // simulate writes into a directory: an existing file there is not one.
   const fs::path file = dir() / "a_file.txt";
   test::write_text(file, "keep\n");
@@ -1766,7 +1779,7 @@ TEST_F(CliTest, OutputOfTheWrongKindIsRefused) {
 }
 
 TEST_F(CliTest, AModelWithoutJointsIsNamed) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const std::string text = test::cantilever_toml();
   const fs::path linear = dir() / "no_joints.toml";
   test::write_text(linear, text.substr(0, text.find("[[joints]]")));
@@ -2001,7 +2014,7 @@ TEST_F(CliTest, ZeroForceTablesAndRecordsAreRefusedByEveryCommand) {
 // A [modal] substructure with a 0 Hz mode, identified with harmonic 0 (issue 31): the mode is
 // named, not "term k has no effect".
 TEST_F(CliTest, AZeroHertzModeOfAModalModelIsNamedAtHarmonicZero) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path modal = dir() / "free_modal.toml";
   test::write_text(modal, "[model]\ndimension = 2\n\n[modal]\ndofs = [\"7:uy\"]\n"
                           "frequencies_hz = [0.0, 30.0]\ndamping = [0.0, 0.02]\n"
@@ -2018,7 +2031,7 @@ TEST_F(CliTest, AZeroHertzModeOfAModalModelIsNamedAtHarmonicZero) {
 }
 
 TEST_F(CliTest, InseparableJointsAreNamedByIdentify) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   // A second joint at the tip with a stiffness of its own: the two k act alike in every test.
   const fs::path twin = dir() / "twin.toml";
   test::write_text(twin, test::cantilever_toml() +
@@ -2075,7 +2088,7 @@ TEST_F(CliTest, VersionIsTheProjects) {
 // Every option whose value is one of a list shows the list in --help, and a value not in it is
 // refused before anything is read, naming the option and the choices.
 TEST_F(CliTest, EnumeratedOptionsListTheirChoices) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   struct Enumerated {
     std::string command, option, choices, named;
   };
@@ -2125,7 +2138,7 @@ TEST_F(CliTest, FlagsShowNoDefaultAndEveryPictureHasNoPlot) {
 // --balance-harmonics is the harmonic balance's truncation in every command that runs one: a
 // value out of its range is refused naming it (so the command took it for the truncation).
 TEST_F(CliTest, EveryHarmonicBalanceTakesBalanceHarmonics) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const fs::path out = dir() / "never_balanced";
   const std::string rec = record_files()[0];
   auto fails = [&](const std::string& command, std::vector<std::string> extra,
@@ -2147,7 +2160,7 @@ TEST_F(CliTest, EveryHarmonicBalanceTakesBalanceHarmonics) {
 // (identify, discover), --harmonics where it meant the truncation (simulate, response) and
 // --no-plots (discover).
 TEST_F(CliTest, OldSpellingsStillWorkAndWarn) {
-  ASSERT_EQ(simulate_.status, 0) << simulate_.err;
+  ASSERT_EQ(simulated().status, 0) << simulated().err;
   const std::string renamed_harmonics =
       "jointid: warning: --harmonics is now --balance-harmonics\n";
   const fs::path sim = dir() / "old_simulate";

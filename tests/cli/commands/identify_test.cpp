@@ -96,6 +96,19 @@ void expect_within_interval(const json& entry, double truth, const std::string& 
       << name << " = " << value << " [" << lo << ", " << hi << "], truth " << truth;
 }
 
+// The sentence gives `label` (e.g. "k + iwan.kt = ") a value and its interval,
+// "<value> [<low>, <high>]", and the (widened) interval holds the truth.
+void expect_combination(const std::string& said, const std::string& label, double truth) {
+  const auto at = said.find(label);
+  ASSERT_NE(at, std::string::npos) << said;
+  std::size_t used = 0;
+  const double value = std::stod(said.substr(at + label.size()), &used);
+  const std::string rest = said.substr(at + label.size() + used);
+  ASSERT_EQ(rest.rfind(" [", 0), 0u) << said;
+  const double lo = std::stod(rest.substr(2)), hi = std::stod(rest.substr(rest.find(", ") + 2));
+  EXPECT_LE(std::abs(value - truth), widen * std::max(value - lo, hi - value)) << said;
+}
+
 struct TermCase {
   std::string term;
   std::vector<std::pair<std::string, double>> truth; // "<term>.<parameter>", value
@@ -187,14 +200,7 @@ TEST(IdentifyParametric, IwanInMicroslipSaysWhatTheTestsDoNotDetermine) {
   const std::string said = j["identifiability"][0];
   EXPECT_NE(said.find("microslip"), std::string::npos) << said;
   EXPECT_NE(said.find("iwan.fs apart from iwan.beta are undetermined"), std::string::npos) << said;
-  const auto at = said.find("k + iwan.kt = ");
-  ASSERT_NE(at, std::string::npos) << said;
-  std::size_t used = 0;
-  const double sum = std::stod(said.substr(at + 14), &used);
-  const std::string rest = said.substr(at + 14 + used);
-  ASSERT_EQ(rest.rfind(" [", 0), 0u) << said;
-  const double lo = std::stod(rest.substr(2)), hi = std::stod(rest.substr(rest.find(", ") + 2));
-  EXPECT_LE(std::abs(sum - 14800.0), widen * std::max(sum - lo, hi - sum)) << said;
+  expect_combination(said, "k + iwan.kt = ", 14800.0);
   EXPECT_NE(run.out.find("undetermined"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("not determined: joint 'tip': its iwan"), std::string::npos) << run.out;
 }
@@ -237,14 +243,7 @@ TEST(IdentifyParametric, AJenkinsThatNeverSlipsSaysWhatTheTestsDetermine) {
   EXPECT_NE(said.find("k apart from jenkins.kt, and jenkins.fs are undetermined"),
             std::string::npos)
       << said;
-  const auto at = said.find("k + jenkins.kt = ");
-  ASSERT_NE(at, std::string::npos) << said;
-  std::size_t used = 0;
-  const double sum = std::stod(said.substr(at + 17), &used);
-  const std::string rest = said.substr(at + 17 + used);
-  ASSERT_EQ(rest.rfind(" [", 0), 0u) << said;
-  const double lo = std::stod(rest.substr(2)), hi = std::stod(rest.substr(rest.find(", ") + 2));
-  EXPECT_LE(std::abs(sum - 14800.0), widen * std::max(sum - lo, hi - sum)) << said;
+  expect_combination(said, "k + jenkins.kt = ", 14800.0);
 }
 
 TEST(IdentifyParametric, AGapThatNeverClosesSaysItsParametersAreUndetermined) {
