@@ -58,6 +58,7 @@ Outcome consider_term(const Problem& problem, const State& state, const Simulato
       j.values.push_back(0.0);
       j.fixed.push_back(false);
       if (!j.given.empty()) j.given.push_back(false);
+      if (!j.parameters.empty()) j.parameters.emplace_back(); // a coefficient term: none
     }
   try {
     const identify::FitResult fit = problem.identify(joints, sim, problem.all_tests());
