@@ -411,6 +411,13 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
     const double sd = std::sqrt(std::max(g.dot(C * g), 0.0));
     return std::array<double, 4>{v, sd, v - tq * sd, v + tq * sd};
   };
+  // The largest deformation of joint j over the tests (a bound: Σ|Y_k| at the estimate).
+  const auto peak_of = [&](std::size_t j) {
+    double peak = 0.0;
+    for (const Test& test : tests)
+      peak = std::max(peak, test.Y.col(static_cast<Eigen::Index>(j)).cwiseAbs().sum());
+    return peak;
+  };
   const auto microslip = [&](std::size_t j, const joints::Joint& J, JointEstimate& je) {
     const int t = J.term_index(joints::Term::iwan);
     if (t < 0 || je.terms[static_cast<std::size_t>(t)].parameters.empty()) return;
@@ -423,9 +430,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
                                   js[j].parameter(ti, "chi"), js[j].parameter(ti, "beta"));
     };
     const double phi_max = density(identified).phi_max;
-    double peak = 0.0; // the largest deformation of the joint over the tests (a bound: Σ|Y_k|)
-    for (const Test& test : tests)
-      peak = std::max(peak, test.Y.col(static_cast<Eigen::Index>(j)).cwiseAbs().sum());
+    const double peak = peak_of(j);
     const int k_index = J.term_index(joints::Term::k);
     const bool k_open = k_index >= 0 && !J.fixed[static_cast<std::size_t>(k_index)];
     // The estimate's φ_max itself is poorly told where the tests barely reach it: a fit may
@@ -528,9 +533,7 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
       if (t < 0 || je.terms[static_cast<std::size_t>(t)].parameters.empty()) continue;
       const auto ti = static_cast<std::size_t>(t);
       auto& pars = je.terms[ti].parameters;
-      double peak = 0.0; // the largest deformation of the joint over the tests (a bound)
-      for (const Test& test : tests)
-        peak = std::max(peak, test.Y.col(static_cast<Eigen::Index>(j)).cwiseAbs().sum());
+      const double peak = peak_of(j);
       const bool jenkins = term == joints::Term::jenkins;
       const double kt = jenkins ? identified[j].parameter(ti, "kt") : 0.0;
       const double reach =
@@ -539,12 +542,12 @@ FitResult output_error(const frf::ModalSynthesis& H, const fem::DofMap& dofs,
       // where delta has no effect either): below 1e-6 of the joint's spring force.
       const double contact =
           jenkins ? 0.0 : identified[j].parameter(ti, "kg") * std::max(0.0, peak - reach);
-      const int k_term = J.term_index(joints::Term::k);
-      const bool no_force =
-          !jenkins && k_term >= 0 &&
-          contact <= 1e-6 * std::abs(identified[j].values[static_cast<std::size_t>(k_term)]) * peak;
-      if (!(peak < reach) && !no_force) continue; // it slips, or makes contact, in some test
       const int k_index = J.term_index(joints::Term::k);
+      const bool no_force =
+          !jenkins && k_index >= 0 &&
+          contact <=
+              1e-6 * std::abs(identified[j].values[static_cast<std::size_t>(k_index)]) * peak;
+      if (!(peak < reach) && !no_force) continue; // it slips, or makes contact, in some test
       const bool kt_fixed =
           jenkins &&
           pars[static_cast<std::size_t>(joints::parameter_index(joints::Term::jenkins, "kt"))]
