@@ -188,12 +188,12 @@ public:
             const double a = identify::parameter_from_u(pi, u - tq * su),
                          b = identify::parameter_from_u(pi, u + tq * su);
             pe.ci_low = std::min(a, b), pe.ci_high = std::max(a, b);
+            // An interval too wide to fix the parameter's scale is no result either.
             pe.determined = !undetermined[static_cast<std::size_t>(qi)] && std::isfinite(pe.std) &&
-                            pe.ci_high > pe.ci_low;
+                            identify::interval_determines(pi, pe.value, pe.ci_low, pe.ci_high);
             // Never a value where the tests do not determine it (the model keeps one to
             // simulate with).
-            if (undetermined[static_cast<std::size_t>(qi)])
-              pe.value = pe.std = pe.ci_low = pe.ci_high = nan;
+            if (!pe.determined) pe.value = pe.std = pe.ci_low = pe.ci_high = nan;
           }
           je.terms.push_back(te);
           continue;

@@ -45,6 +45,13 @@ double parameter_from_u(const joints::ParameterInfo& info, double u) {
   return u;
 }
 
+bool interval_determines(const joints::ParameterInfo& info, double value, double lo, double hi) {
+  if (!(std::isfinite(lo) && std::isfinite(hi) && hi > lo)) return false;
+  if (is_log(info)) return lo > 0.0 && hi <= 100.0 * lo;
+  if (is_exponent(info)) return hi - lo <= 0.5 * (info.high - info.low);
+  return hi - lo <= 2.0 * std::abs(value);
+}
+
 Complex describing_function(const joints::Joint& j, std::size_t t, double a, int samples) {
   const auto n = static_cast<std::size_t>(samples);
   std::vector<double> y(n), g(n);

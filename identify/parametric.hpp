@@ -36,6 +36,12 @@ double joint_amplitude(const Measurement& m, const joints::Joint& joint);
 /// unbounded above), chi = −1/(1 + e^{−u}) for an exponent in (−1, 0]; else p itself.
 double parameter_to_u(const joints::ParameterInfo& info, double p);
 double parameter_from_u(const joints::ParameterInfo& info, double u);
+/// Whether a 95 % interval [lo, hi] of a parameter is a result: finite, of non-zero width, and
+/// narrow enough to fix the parameter's scale — within a factor of 100 (hi / lo ≤ 100) for a
+/// positive parameter, within half its range for an exponent in (−1, 0], within its value's
+/// size either side for any other. Wider, the tests do not determine it (an interval such as
+/// kt ∈ [1e-10, 2.5e27] N/m says nothing about kt).
+bool interval_determines(const joints::ParameterInfo& info, double value, double lo, double hi);
 
 /// One test's equivalent dynamic stiffness of a joint: Z = k_eq + iω c_eq of the linear spring
 /// and damper that reproduce its force's fundamental at the amplitude of its deformation's (m),

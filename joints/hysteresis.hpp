@@ -90,9 +90,18 @@ struct LoopEntry {
 
 /// Work arrays of steady_loop(), kept by the caller to reuse their memory.
 struct LoopWork {
+  /// A run of elements (in order of φ) that share their state: at rest since the start
+  /// (virgin, x = 0), or last dragged to the extreme e at sample `anchor` in direction s,
+  /// x_i = e − s φ_i.
+  struct Group {
+    int lo = 0, hi = 0; ///< elements [lo, hi) in order of φ
+    bool virgin = true;
+    int anchor = -1;
+    double e = 0.0, s = 0.0;
+  };
+  std::vector<double> k, phi, K, P; ///< in order of φ; K, P: prefix sums of k and k φ
+  std::vector<Group> groups;        ///< largest φ first
   std::vector<double> x, x_start;
-  std::vector<int> anchor;
-  std::vector<LoopEntry> groups;
 };
 
 /// The sliders' steady hysteresis loop under the periodic deformation sampled at y over one
@@ -105,6 +114,10 @@ struct LoopWork {
 /// sample m where it last slid (its position there was y_m ∓ φ_i; for the antisymmetric form
 /// a sample of the second half is −y of the first: the sign turns). An element sliding at n
 /// contributes nothing (its force is ±f_i). False if the loop did not close.
+/// Cost: per sample, the runs of elements that share a state (the memory of the deformation's
+/// extremes, a few for a smooth loop) rather than every element: with elements ordered by φ,
+/// those that slide at a sample are the ones of smallest φ (|x_φ − x_ψ| ≤ |φ − ψ| for elements
+/// started alike), so each sample drags a prefix of them to a new extreme.
 bool steady_loop(const Sliders& sliders, std::span<const double> y, bool antisymmetric,
                  std::span<double> g, std::vector<LoopEntry>* derivative, LoopWork& work,
                  int max_passes = 8);

@@ -52,10 +52,16 @@ if [[ "${1:-}" == "--sanitize" ]]; then
   # Beyond those, every test that took over 1 s in the main suite's last run in ./build (ctest's
   # cost data; CI runs the main suite first), but the fastest of each suite, so that no suite's
   # code goes unchecked: the slow tests repeat the same code over sweeps and long time
-  # integrations, instrumented several times slower (scripts/sanitized_selection.py).
+  # integrations, instrumented several times slower (scripts/sanitized_selection.py). A suite
+  # whose fastest test took over 3 s (a whole discovery per parameter: 15-25 times slower
+  # instrumented) is left out whole; shorter discovery and identification tests run its code.
+  # And every test that took over 15 s in an earlier instrumented run (scripts/sanitized_costs.txt:
+  # mostly time integrations with dry friction, 30-50 times slower instrumented; the integrators'
+  # own shorter tests run instrumented).
   costs=build/Testing/Temporary/CTestCostData.txt
   if [[ -f "$costs" ]]; then
-    slow=$(python3 scripts/sanitized_selection.py "$costs" --limit 1 --report)
+    slow=$(python3 scripts/sanitized_selection.py "$costs" --limit 1 --suite-limit 3 \
+      --instrumented scripts/sanitized_costs.txt --instrumented-limit 15 --report)
     [[ -n "$slow" ]] && repeats+="|$slow"
   else
     echo "run_tests_novtk: no $costs (the main suite has not run here): only the listed tests" \
@@ -66,7 +72,9 @@ if [[ "${1:-}" == "--sanitize" ]]; then
   config+=(-DJOINTID_BUILD_EXAMPLES=OFF)
 fi
 bash scripts/setup.sh
-cmake -S . -B "$build" "${config[@]}" -DJOINTID_WITH_VTK=OFF -DJOINTID_WITH_SLEPC=OFF \
+# shellcheck source=scripts/compiler_cache.sh
+source scripts/compiler_cache.sh
+cmake -S . -B "$build" "${config[@]}" "${cache_cmake_args[@]}" -DJOINTID_WITH_VTK=OFF -DJOINTID_WITH_SLEPC=OFF \
   -DJOINTID_BUILD_TESTS=ON -DJOINTID_BUILD_BENCH=OFF "$@" >/dev/null
 cmake --build "$build" -j "$(nproc)"
 ctest --test-dir "$build" --output-on-failure --timeout 1800 -j "$(nproc)" "${exclude[@]}"

@@ -12,6 +12,9 @@ packages=(build-essential cmake pkg-config libeigen3-dev libspectra-dev libsuite
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
   # FFTW (pkg-config fftw3): random excitation signals and Welch spectra (fem/fft.hpp).
   libfftw3-dev
+  # ccache: CI's sanitized build takes the tests' objects of the plain build from it
+  # (scripts/compiler_cache.sh).
+  ccache
   # OpenBLAS takes over libblas.so.3 (Debian's alternatives) from the reference BLAS, which
   # CHOLMOD's supernodal factorisation otherwise runs on: 8x faster on a 10^5-DOF frame.
   libopenblas0-pthread

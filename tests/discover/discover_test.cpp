@@ -315,6 +315,37 @@ INSTANTIATE_TEST_SUITE_P(
         HiddenParametric{Term::gap, {0.01, 5000.0}, {10.0, 40.0, 80.0}, true, "clearance"}),
     [](const auto& info) { return std::string(joints::term_name(info.param.term)); });
 
+TEST(Discover, ACoefficientTermIsTriedBesideAParametricTermOfTheStart) {
+  // A starting joint that carries a parametric term (the true jenkins, given with its
+  // parameters) and lacks a cubic stiffness: every coefficient candidate is added beside the
+  // jenkins, its parameters kept in step with the terms. (Until a411160 each such candidate
+  // threw "parameters and terms differ in number" and the run stopped before any step.)
+  Data d;
+  d.frequencies = {2.0, 3.0, 4.0, 5.0};
+  d.table = true;
+  joints::Joint truth =
+      joint("tip", 7, {Term::k, Term::c, Term::jenkins, Term::k3}, {4800.0, 20.0, 1.0, 1.6e8});
+  truth.parameters.resize(4);
+  truth.set_parameters(2, {5000.0, 5.0});
+  d.truth = {truth};
+  joints::Joint start = joint("tip", 7, {Term::k, Term::c, Term::jenkins}, {4800.0, 20.0, 1.0});
+  start.parameters.resize(3);
+  start.set_parameters(2, {5000.0, 5.0});
+  start.given.assign(3, true);
+  discover::Options o;
+  o.harmonics = {1};
+  const discover::Result r = discover::discover(frf::Substructure(d.model), {start}, measure(d), o);
+  SCOPED_TRACE(describe(r));
+  ASSERT_FALSE(r.steps.empty());
+  ASSERT_TRUE(r.steps[0].added.term.has_value());
+  EXPECT_EQ(*r.steps[0].added.term, Term::k3);
+  EXPECT_EQ(r.steps[0].added.joint, "tip");
+  // The 1 % noise on 12 fundamentals: k3 within a few per cent.
+  EXPECT_NEAR(value_of(r, "tip", Term::k3), 1.6e8, 0.05 * 1.6e8);
+  const auto& tip = r.states.back().joints.front();
+  EXPECT_EQ(tip.parameters.size(), tip.terms.size());
+}
+
 TEST(Discover, ThroughMeasuredFrfsAsThroughTheModel) {
   // The substructure given by its measured FRF at the tip (sampled from the model every
   // 0.005 Hz up to 80 Hz: the tests at 2–5 Hz lie on the lines), the cubic stiffness hidden.

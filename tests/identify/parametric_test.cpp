@@ -13,6 +13,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 namespace jointid {
 namespace {
@@ -83,6 +85,27 @@ const identify::ParameterEstimate& parameter(const identify::FitResult& r, const
   for (const auto& p : r.joints.at(0).terms.at(2).parameters)
     if (p.name == name) return p;
   throw std::invalid_argument(name);
+}
+
+TEST(ParametricIdentification, AnIntervalThatDoesNotFixTheScaleIsNotAResult) {
+  // iwan's kt (positive: a factor of 100 at most), chi (an exponent in (−1, 0]: half its range
+  // at most), and a zero-width or infinite interval, never.
+  const auto& iwan = joints::term_info(Term::iwan).parameters;
+  const auto find = [&](const std::string& name) -> const joints::ParameterInfo& {
+    for (const auto& p : iwan)
+      if (p.name == name) return p;
+    throw std::logic_error(name);
+  };
+  const joints::ParameterInfo &kt = find("kt"), &chi = find("chi");
+  EXPECT_TRUE(identify::interval_determines(kt, 3000.0, 1000.0, 9000.0));
+  EXPECT_TRUE(identify::interval_determines(kt, 3000.0, 300.0, 30000.0));
+  EXPECT_FALSE(identify::interval_determines(kt, 5.177e8, 1.06e-10, 2.527e27));
+  EXPECT_FALSE(identify::interval_determines(kt, 3000.0, 100.0, 30000.0));
+  EXPECT_FALSE(identify::interval_determines(kt, 3000.0, 3000.0, 3000.0));
+  EXPECT_FALSE(identify::interval_determines(kt, 3000.0, 0.0, 3000.0));
+  EXPECT_FALSE(identify::interval_determines(kt, 3000.0, 1000.0, INFINITY));
+  EXPECT_TRUE(identify::interval_determines(chi, -0.5, -0.7, -0.3));
+  EXPECT_FALSE(identify::interval_determines(chi, -0.5, -0.95, -0.05));
 }
 
 TEST(ParametricIdentification, EachTermSimulatedByTimeIntegrationIsIdentifiedBack) {

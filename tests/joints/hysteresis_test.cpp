@@ -221,6 +221,78 @@ TEST(SteadyLoop, DerivativeMatchesFiniteDifferences) {
   }
 }
 
+TEST(SteadyLoop, IsTheReturnMapOfEveryElementPassAfterPass) {
+  // steady_loop follows runs of elements that share a state; the definition is the return map
+  // x_i ← clamp(x_i, y − φ_i, y + φ_i) of every element at every sample, from rest, pass after
+  // pass until the positions repeat. Both against each other on deformations with inner loops
+  // (three harmonics, a mean), for a Jenkins element and an iwan appended out of order of φ,
+  // in the full and the antisymmetric form: the forces, the closing and the derivative's
+  // entries (summed per (n, m)) agree to rounding.
+  Sliders s = jenkins_sliders(4.0e3, 0.5);
+  s.append(iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 40));
+  s.append(jenkins_sliders(1.0e3, 4.0)); // φ = 4 mm: sticks at the smaller amplitudes
+  for (bool antisymmetric : {false, true})
+    for (double a : {5e-5, 4e-4, 3e-3}) {
+      const int N = antisymmetric ? 32 : 64;
+      std::vector<double> y(static_cast<std::size_t>(N));
+      for (int n = 0; n < N; ++n) {
+        const double th = 2.0 * pi * n / 64.0;
+        y[static_cast<std::size_t>(n)] =
+            a * (std::sin(th + 0.2) + 0.45 * std::sin(3.0 * th + 1.3) + 0.2 * std::cos(5.0 * th)) +
+            (antisymmetric ? 0.0 : 0.3 * a);
+      }
+      // The definition, element by element.
+      const int full = antisymmetric ? 2 * N : N;
+      const std::size_t n_el = s.stiffness.size();
+      std::vector<double> x(n_el, 0.0), x0;
+      std::vector<int> anchor(n_el, -1);
+      std::vector<double> g_ref(y.size());
+      std::vector<double> J_ref(static_cast<std::size_t>(N * N), 0.0);
+      bool closed_ref = false;
+      for (int pass = 0; pass < 8 && !closed_ref; ++pass) {
+        x0 = x;
+        std::fill(J_ref.begin(), J_ref.end(), 0.0);
+        for (int t = 0; t < full; ++t) {
+          const double yt =
+              t < N ? y[static_cast<std::size_t>(t)] : -y[static_cast<std::size_t>(t - N)];
+          double f = 0.0;
+          for (std::size_t i = 0; i < n_el; ++i) {
+            const double phi = s.reach[i], k = s.stiffness[i], d = yt - x[i];
+            const bool slides = d > phi || d < -phi;
+            if (d > phi) x[i] = yt - phi;
+            if (d < -phi) x[i] = yt + phi;
+            if (slides) anchor[i] = t;
+            f += k * (yt - x[i]);
+            if (t >= N || slides) continue;
+            J_ref[static_cast<std::size_t>(t * N + t)] += k;
+            const int m = anchor[i];
+            if (m >= 0)
+              J_ref[static_cast<std::size_t>(t * N + (m < N ? m : m - N))] += m < N ? -k : k;
+          }
+          if (t < N) g_ref[static_cast<std::size_t>(t)] = f;
+        }
+        closed_ref = x == x0;
+      }
+      std::vector<double> g(y.size());
+      std::vector<LoopEntry> entries;
+      LoopWork work;
+      EXPECT_EQ(steady_loop(s, y, antisymmetric, g, &entries, work), closed_ref);
+      std::vector<double> J(static_cast<std::size_t>(N * N), 0.0);
+      for (const LoopEntry& e : entries)
+        J[static_cast<std::size_t>(e.n * N + e.m)] += e.value;
+      const double K = s.stiffness_sum(), scale = K * 2.0 * a;
+      for (int n = 0; n < N; ++n) {
+        EXPECT_NEAR(g[static_cast<std::size_t>(n)], g_ref[static_cast<std::size_t>(n)],
+                    1e-12 * scale)
+            << "a " << a << " n " << n;
+        for (int m = 0; m < N; ++m)
+          EXPECT_NEAR(J[static_cast<std::size_t>(n * N + m)],
+                      J_ref[static_cast<std::size_t>(n * N + m)], 1e-12 * K)
+              << "a " << a << " n " << n << " m " << m;
+      }
+    }
+}
+
 TEST(Gap, NoForceInsideTheClearanceContactStiffnessBeyond) {
   const double delta = 1e-3, kg = 5e5;
   double slope = -1.0;
