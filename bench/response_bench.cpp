@@ -2,11 +2,18 @@
 // README's hardening cantilever (examples/response/hardening_tip.toml: the paper's cantilever
 // with k = 4800 N/m, c = 2 N s/m, k3 = 1.6e8 N/m³ at the tip), 15 → 30 Hz at 80 N (two folds),
 // with and without the Floquet stability of each point, for K = 5 and 9 harmonics. Counters:
-// points traced and time per point. Results: docs/benchmarks.md.
+// points traced and time per point. And one steady hysteresis loop of a 100-slider iwan
+// (joints::steady_loop, the AFT force of every harmonic-balance residual with an iwan) at 64 and
+// 512 samples, with and without its derivative. Results: docs/benchmarks.md.
 #include "frf/continuation.hpp"
+#include "joints/hysteresis.hpp"
 #include "support/cantilever.hpp"
 
 #include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
 
 using namespace jointid;
 using joints::Term;
@@ -36,8 +43,28 @@ void BM_ResponseCurve(benchmark::State& state) {
                                                        benchmark::Counter::kInvert);
 }
 
+// range(0): samples a period; range(1): 1 with the derivative. The deformation: a fundamental
+// of 0.2 mm (about a tenth of the iwan's phi_max: microslip) with a third harmonic of a tenth.
+void BM_SteadyLoopIwan100(benchmark::State& state) {
+  const joints::Sliders s = joints::iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 100);
+  const int N = static_cast<int>(state.range(0));
+  std::vector<double> y(static_cast<std::size_t>(N)), g(y.size());
+  for (int n = 0; n < N; ++n) {
+    const double th = 2.0 * std::numbers::pi * n / N;
+    y[static_cast<std::size_t>(n)] = 2e-4 * (std::sin(th + 0.3) + 0.1 * std::sin(3.0 * th));
+  }
+  joints::LoopWork work;
+  std::vector<joints::LoopEntry> entries;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        joints::steady_loop(s, y, false, g, state.range(1) ? &entries : nullptr, work));
+    benchmark::DoNotOptimize(g.data());
+  }
+}
+
 } // namespace
 
+BENCHMARK(BM_SteadyLoopIwan100)->ArgsProduct({{64, 512}, {0, 1}});
 BENCHMARK(BM_ResponseCurve)
     ->Args({5, 0})
     ->Args({5, 1})

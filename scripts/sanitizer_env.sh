@@ -13,6 +13,6 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # needs. A Release build whose instrumented code takes these flags after the build type's
 # (JOINTID_SANITIZE_FLAGS): uninstrumented test code (JOINTID_SANITIZE_TEST_CODE=OFF) then
 # compiles exactly as in the plain Release build, and a compiler cache reuses its objects.
-sanitize_cmake_args=(-DCMAKE_BUILD_TYPE=Release
-  "-DJOINTID_SANITIZE_FLAGS=-O2 -g1 -UNDEBUG -DEIGEN_NO_DEBUG"
+sanitize_flags="-O2 -g1 -UNDEBUG -DEIGEN_NO_DEBUG"
+sanitize_cmake_args=(-DCMAKE_BUILD_TYPE=Release "-DJOINTID_SANITIZE_FLAGS=$sanitize_flags"
   -DJOINTID_SANITIZE=address,undefined)
