@@ -57,31 +57,30 @@ def main(argv):
     path, limit, suite_limit, report = argv[0], 1.0, float("inf"), False
     instrumented_path, instrumented_limit = None, 10.0
     rest = argv[1:]
+
+    def seconds(option, text):
+        try:
+            return float(text)
+        except ValueError:
+            raise SystemExit(f"{option}: expected seconds, got '{text}'")
+
     while rest:
-        if rest[0] == "--limit" and len(rest) > 1:
-            try:
-                limit = float(rest[1])
-            except ValueError:
-                raise SystemExit(f"--limit: expected seconds, got '{rest[1]}'")
+        option = rest[0]
+        if option in ("--limit", "--suite-limit", "--instrumented-limit") and len(rest) > 1:
+            value = seconds(option, rest[1])
+            if option == "--limit":
+                limit = value
+            elif option == "--suite-limit":
+                suite_limit = value
+            else:
+                instrumented_limit = value
             rest = rest[2:]
-        elif rest[0] == "--suite-limit" and len(rest) > 1:
-            try:
-                suite_limit = float(rest[1])
-            except ValueError:
-                raise SystemExit(f"--suite-limit: expected seconds, got '{rest[1]}'")
-            rest = rest[2:]
-        elif rest[0] == "--instrumented" and len(rest) > 1:
+        elif option == "--instrumented" and len(rest) > 1:
             instrumented_path, rest = rest[1], rest[2:]
-        elif rest[0] == "--instrumented-limit" and len(rest) > 1:
-            try:
-                instrumented_limit = float(rest[1])
-            except ValueError:
-                raise SystemExit(f"--instrumented-limit: expected seconds, got '{rest[1]}'")
-            rest = rest[2:]
-        elif rest[0] == "--report":
+        elif option == "--report":
             report, rest = True, rest[1:]
         else:
-            raise SystemExit(f"unknown argument '{rest[0]}'\n{__doc__}")
+            raise SystemExit(f"unknown argument '{option}'\n{__doc__}")
     costs = read_costs(path)
     fastest = {}
     for name, cost in costs.items():
