@@ -2,6 +2,7 @@
 
 #include "discover/diagnosis.hpp"
 #include "discover/selection.hpp"
+#include "fem/constants.hpp"
 #include "fem/minimise.hpp"
 #include "identify/parametric.hpp"
 
@@ -15,10 +16,7 @@
 
 namespace jointid::discover::detail {
 
-namespace {
-constexpr double inf = std::numeric_limits<double>::infinity();
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-} // namespace
+namespace {} // namespace
 
 Outcome refused(Candidate c, const State& state, const std::string& why) {
   c.rejected = why;

@@ -2,6 +2,7 @@
 
 #include "discover/selection.hpp"
 #include "discover/text.hpp"
+#include "fem/constants.hpp"
 #include "fem/parallel.hpp"
 
 #include <algorithm>
@@ -14,9 +15,6 @@
 namespace jointid::discover::detail {
 
 namespace {
-
-constexpr double inf = std::numeric_limits<double>::infinity();
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // The tests swept through: grouped by force level (a sweep over frequency) or by frequency.
 struct Sweeps {

@@ -2,6 +2,7 @@
 
 #include "discover/selection.hpp"
 #include "discover/text.hpp"
+#include "fem/constants.hpp"
 
 #include <fmt/format.h>
 
@@ -22,7 +23,6 @@ namespace jointid::discover::detail {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double inf = std::numeric_limits<double>::infinity();
 
 // The largest unexplained second harmonic: its share of the fundamental and of the noise, where
 // and in which tests it appears (5 × beyond the noise).

@@ -1,5 +1,7 @@
 #include "discover/gap.hpp"
 
+#include "fem/constants.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -7,9 +9,7 @@
 
 namespace jointid::discover::detail {
 
-namespace {
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-} // namespace
+namespace {} // namespace
 
 Compared compared_values(const std::vector<identify::Measurement>& tests, int harmonics) {
   Compared c;

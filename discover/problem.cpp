@@ -1,6 +1,7 @@
 #include "discover/problem.hpp"
 
 #include "discover/selection.hpp"
+#include "fem/constants.hpp"
 #include "identify/parametric.hpp"
 
 #include <fmt/format.h>
@@ -13,8 +14,6 @@
 namespace jointid::discover::detail {
 
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 bool is_periodic(const identify::Measurement& m) {
   return m.kind == identify::RecordKind::periodic;
@@ -362,6 +361,23 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
   s.converged = s.failed.empty();
   score(s);
   return s;
+}
+
+std::vector<std::vector<Eigen::MatrixXcd>>
+Problem::derivatives(const State& at, const std::vector<std::vector<joints::Joint>>& moved,
+                     const std::vector<double>& steps, const Simulator& sim) const {
+  std::vector<std::vector<Eigen::MatrixXcd>> out(tests_.size());
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    const int t = static_cast<int>(i);
+    if (i >= at.Y.size() || at.Y[i].size() == 0 ||
+        std::binary_search(at.failed.begin(), at.failed.end(), t))
+      continue;
+    if (o_.checkpoint) o_.checkpoint();
+    out[i] = sim.balance[i].output_derivatives(at.joints, drive_[i], at.Y[i], moved, steps);
+    for (Eigen::MatrixXcd& d : out[i])
+      if (d.size() > 0) d = d.topRows(rows_[i] + 1).eval();
+  }
+  return out;
 }
 
 frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,

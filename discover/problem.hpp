@@ -103,6 +103,14 @@ public:
   State evaluate_each(const std::vector<joints::Joint>& joints,
                       const std::vector<std::vector<joints::Joint>>& per_test, const Simulator& sim,
                       const State* warm = nullptr) const;
+  /// The derivatives of every test's simulated harmonics at `at` (State::X: rows(i) + 1 ×
+  /// responses) with respect to moves of its joints, `moved[p]` by steps[p], by implicit
+  /// differentiation of each test's harmonic balance (frf::HarmonicBalance::output_derivatives):
+  /// [test][p], no entries for a test `at` left out, an empty matrix where a derivative could
+  /// not be formed (the caller re-simulates for it).
+  std::vector<std::vector<Eigen::MatrixXcd>>
+  derivatives(const State& at, const std::vector<std::vector<joints::Joint>>& moved,
+              const std::vector<double>& steps, const Simulator& sim) const;
   /// Test i's steady state: from `warm` or the measured deformation first, else from the linear
   /// response with load continuation.
   frf::HarmonicBalanceResult solve(const Simulator& sim, int i,

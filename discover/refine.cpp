@@ -1,6 +1,7 @@
 #include "discover/refine.hpp"
 
 #include "discover/selection.hpp"
+#include "fem/constants.hpp"
 #include "identify/parametric.hpp"
 #include "identify/statistics.hpp"
 
@@ -19,7 +20,6 @@ namespace jointid::discover::detail {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // Every named parameter in its range: a step far out in a parameter's coordinate saturates it
 // (an exponent at −1, a logarithm's exponential at +∞), which no simulation takes.
@@ -325,10 +325,43 @@ private:
     return j;
   }
 
-  // The Jacobian at the current values, by a forward difference (backward where forward leaves
-  // the physical models or does not converge); false where a column cannot be formed.
+  // The Jacobian at the current values: by implicit differentiation of every test's harmonic
+  // balance (Problem::derivatives) over a forward step (backward where forward leaves the
+  // physical models), else by re-simulating every test for that step; false where a column
+  // cannot be formed.
   bool jacobian() {
+    std::vector<std::vector<joints::Joint>> moved;
+    std::vector<double> steps;
+    std::vector<Eigen::Index> column;
+    for (Eigen::Index q = 0; q < size(); ++q)
+      for (double h : {step_(q), -step_(q)}) {
+        Eigen::VectorXd bq = b_;
+        bq(q) += h;
+        std::vector<joints::Joint> jq = joints_with(bq);
+        if (!physical_problem(jq).empty() || !in_range(jq)) continue;
+        moved.push_back(std::move(jq)), steps.push_back(h), column.push_back(q);
+        break;
+      }
+    const auto D = problem_.derivatives(current_, moved, steps, sim_);
+    for (std::size_t m = 0; m < column.size(); ++m) {
+      Eigen::Index n = 0;
+      const Eigen::Index q = column[m];
+      for (std::size_t i = 0; i < compared_.entries.size() && n >= 0; ++i) {
+        const auto& e = compared_.entries[i];
+        if (std::binary_search(left_out_.begin(), left_out_.end(), e.test)) continue;
+        const auto& d = D[static_cast<std::size_t>(e.test)];
+        if (d.size() <= m || d[m].size() == 0) {
+          n = -1; // not formed for this test: re-simulate below
+          break;
+        }
+        const Complex dx = d[m](e.row, e.response);
+        J_(n++, q) = -weight_[i] * dx.real();
+        if (e.harmonic != 0) J_(n++, q) = -weight_[i] * dx.imag();
+      }
+      if (n < 0) J_.col(q).setConstant(nan);
+    }
     for (Eigen::Index q = 0; q < size(); ++q) {
+      if (J_.col(q).allFinite()) continue;
       for (double h : {step_(q), -step_(q)}) {
         Eigen::VectorXd bq = b_;
         bq(q) += h;

@@ -3,6 +3,7 @@
 #include "discover/preconditions.hpp"
 #include "discover/problem.hpp"
 #include "discover/text.hpp"
+#include "fem/constants.hpp"
 #include "fem/parallel.hpp"
 
 #include <Eigen/Core>
@@ -17,9 +18,7 @@
 
 namespace jointid::discover::detail {
 
-namespace {
-constexpr double inf = std::numeric_limits<double>::infinity();
-} // namespace
+namespace {} // namespace
 
 double information_criterion(const Compared& compared, const Misfit& misfit, int parameters,
                              bool converged) {

@@ -13,6 +13,7 @@
 //    reaching it only through the joints' non-linearity: a second-order effect of the noise).
 #include "discover/problem.hpp"
 
+#include "fem/constants.hpp"
 #include "fem/parallel.hpp"
 #include "fem/time_integration.hpp"
 #include "identify/harmonics.hpp"
@@ -29,7 +30,6 @@ namespace jointid::discover::detail {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 bool has_friction(const std::vector<joints::Joint>& joints) {
   for (const auto& j : joints)

@@ -1,5 +1,6 @@
 #include "fem/excitation.hpp"
 
+#include "fem/constants.hpp"
 #include "fem/fft.hpp"
 
 #include <cmath>
@@ -11,8 +12,6 @@
 namespace jointid::fem {
 
 namespace {
-
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 std::string str(double x) {
   char buffer[64];

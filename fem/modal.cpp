@@ -2,6 +2,7 @@
 
 #include "fem/assert.hpp"
 #include "fem/block_lanczos.hpp"
+#include "fem/constants.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -29,8 +30,6 @@ double Modes::frequency_hz(int r) const {
 }
 
 namespace {
-
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,6 +1,7 @@
 #include "fem/slepc_modal.hpp"
 
 #include "fem/assembly.hpp"
+#include "fem/constants.hpp"
 #include "fem/dof_map.hpp"
 
 #include <Eigen/SparseCore>
@@ -18,8 +19,6 @@
 namespace jointid::fem {
 
 namespace {
-
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

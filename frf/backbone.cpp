@@ -1,5 +1,6 @@
 #include "frf/backbone.hpp"
 
+#include "fem/text.hpp"
 #include "frf/hb_equations.hpp"
 
 #include <Eigen/Dense>
@@ -16,21 +17,14 @@ using detail::two_pi;
 
 namespace {
 
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(4);
-  s << v;
-  return s.str();
-}
-
 // The harmonic balance of the self-excited structure at (ω, ξ): its receptances and equations.
-struct Frame {
+struct ModeFrame {
   std::unique_ptr<HarmonicBalance> hb;
   std::unique_ptr<detail::Equations> eq;
 };
 
 // A point of the backbone: the packed harmonics z, ω and ξ at the reference amplitude a.
-struct State {
+struct ModeState {
   Eigen::VectorXd z;
   double omega = 0.0, xi = 0.0, a = 0.0;
 };
@@ -43,8 +37,8 @@ public:
       : H_(H), joints_(joints), dofs_(dofs), outputs_{amplitude_equation}, reference_(reference),
         o_(o), no_force_(Eigen::MatrixXcd::Zero(2, 0)) {}
 
-  Frame frame(double omega, double xi) const {
-    Frame f;
+  ModeFrame frame(double omega, double xi) const {
+    ModeFrame f;
     f.hb = std::make_unique<HarmonicBalance>(H_.with_self_excitation(xi), joints_, dofs_,
                                              std::vector<int>{}, outputs_, omega / two_pi, o_);
     f.eq = f.hb->equations(joints_, no_force_);
@@ -53,21 +47,21 @@ public:
 
   // The packed unknowns for the joints' deformation harmonics Y (K+1 × n_joints) at (ω, ξ).
   Eigen::VectorXd pack(const Eigen::MatrixXcd& Y, double omega, double xi) const {
-    const Frame f = frame(omega, xi);
+    const ModeFrame f = frame(omega, xi);
     return f.hb->first_guess(*f.eq, &Y);
   }
-  Eigen::MatrixXcd unpack(const State& s) const {
+  Eigen::MatrixXcd unpack(const ModeState& s) const {
     return frame(s.omega, s.xi).eq->unpack(s.z, static_cast<int>(joints_.size()));
   }
 
   // Newton on [R(z; ω, ξ); Im Y_1,ref; Re Y_1,ref − a] = 0 from s, in coordinates scaled by the
   // amplitude (z; friction forces through their compliance) and by ω (ω, ξ). True when the
   // residual is within the tolerance relative to |z| and the conditions hold.
-  bool solve(State& s, double a, std::string& why) const {
+  bool solve(ModeState& s, double a, std::string& why) const {
     const double tol = std::max(o_.tolerance, 1e-10);
     s.a = a;
     for (int it = 0; it < 40; ++it) {
-      const Frame f = frame(s.omega, s.xi);
+      const ModeFrame f = frame(s.omega, s.xi);
       const detail::Equations& P = *f.eq;
       const int n = P.size(), o = reference_ * P.m() + P.at(P.symmetric() ? 0 : 1);
       Eigen::MatrixXd J;
@@ -110,7 +104,7 @@ public:
       const double merit = std::sqrt(R.squaredNorm() + phase * phase + amp * amp);
       bool improved = false;
       for (double t = 1.0; t > 1e-3; t *= 0.5) {
-        State trial = s;
+        ModeState trial = s;
         trial.z += t * unit.cwiseProduct(du.head(n));
         trial.omega += t * s.omega * du(n);
         trial.xi += t * s.omega * du(n + 1);
@@ -124,7 +118,7 @@ public:
         }
       }
       if (!improved) {
-        why = "Newton stalled at relative residual " + number(relative);
+        why = "Newton stalled at relative residual " + significant(relative, 4);
         return false;
       }
     }
@@ -133,8 +127,8 @@ public:
   }
 
   // The point's numbers: |X_1| at the amplitude DOF, |Y_1| of the reference joint, f, D.
-  BackbonePoint point(const State& s) const {
-    const Frame f = frame(s.omega, s.xi);
+  BackbonePoint point(const ModeState& s) const {
+    const ModeFrame f = frame(s.omega, s.xi);
     const HarmonicBalanceResult r = f.hb->result(*f.eq, s.z);
     BackbonePoint p;
     p.amplitude = std::abs(r.X(1, 0));
@@ -171,10 +165,10 @@ std::vector<joints::Joint> linearised(const std::vector<joints::Joint>& joints) 
   return out;
 }
 
-class Tracer {
+class ModeTracer {
 public:
-  Tracer(const ModalSynthesis& H, const std::vector<joints::Joint>& joints, const fem::DofMap& dofs,
-         int mode, int amplitude_equation, const BackboneOptions& o)
+  ModeTracer(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
+             const fem::DofMap& dofs, int mode, int amplitude_equation, const BackboneOptions& o)
       : H_(H), joints_(joints), dofs_(dofs), mode_(mode), amplitude_equation_(amplitude_equation),
         o_(o), linear_joints_(linearised(joints)) {
     if (joints.empty())
@@ -213,7 +207,7 @@ public:
     if (!(largest > 1e-6 * P.cwiseAbs().maxCoeff()))
       throw std::invalid_argument(
           "backbone: mode " + std::to_string(mode) + " (" +
-          number(std::sqrt(std::max(eig.eigenvalues()(mode - 1), 0.0)) / two_pi) +
+          significant(std::sqrt(std::max(eig.eigenvalues()(mode - 1), 0.0)) / two_pi, 4) +
           " Hz) does not deform any joint (each is at a node of the mode), so its joints cannot "
           "change it with amplitude; choose another mode");
     reference_ = static_cast<int>(ref);
@@ -233,7 +227,7 @@ public:
     const int K = o_.hb.harmonics, nj = static_cast<int>(joints_.size());
     Eigen::MatrixXcd Y = Eigen::MatrixXcd::Zero(K + 1, nj);
     Y.row(1) = shape0_.cast<Complex>().transpose();
-    State s;
+    ModeState s;
     s.omega = omega0_, s.xi = xi0_;
     s.z = lin.pack(Y, s.omega, s.xi);
     LinearMode out;
@@ -252,25 +246,25 @@ public:
   // The backbone over joint amplitudes a0 … a1 (linear() first).
   void trace(double a0, double a1, Backbone& out) const {
     const Epmc epmc(H_, joints_, dofs_, amplitude_equation_, reference_, o_.hb);
-    State s = *linear_state_;
+    ModeState s = *linear_state_;
     s.z = epmc.pack(linear_Y_ * a0, s.omega, s.xi);
     std::string why;
     if (!epmc.solve(s, a0, why)) {
       out.status = fem::Status::failure(fem::Status::Code::not_converging,
                                         "backbone: no solution at the first amplitude, " +
-                                            number(a0) + " (joint deformation): " + why);
+                                            significant(a0, 4) + " (joint deformation): " + why);
       return;
     }
     out.points.push_back(epmc.point(s));
-    std::optional<State> before;
+    std::optional<ModeState> before;
     const int n = o_.points;
     for (int i = 1; i < n; ++i) {
       const double a = a0 * std::pow(a1 / a0, static_cast<double>(i) / (n - 1));
       if (!advance(epmc, s, before, a, 0, why)) {
-        out.status =
-            fem::Status::failure(fem::Status::Code::not_converging,
-                                 "backbone: stopped at joint deformation " + number(a) + " after " +
-                                     std::to_string(out.points.size()) + " points: " + why);
+        out.status = fem::Status::failure(
+            fem::Status::Code::not_converging,
+            "backbone: stopped at joint deformation " + significant(a, 4) + " after " +
+                std::to_string(out.points.size()) + " points: " + why);
         return;
       }
       out.points.push_back(epmc.point(s));
@@ -280,9 +274,9 @@ public:
 private:
   // From s (and the point before it, for a secant prediction of ω and ξ in log amplitude) to
   // amplitude a; a failed step is halved (in log amplitude) up to max_refinements times.
-  bool advance(const Epmc& epmc, State& s, std::optional<State>& before, double a, int depth,
-               std::string& why) const {
-    State next = s;
+  bool advance(const Epmc& epmc, ModeState& s, std::optional<ModeState>& before, double a,
+               int depth, std::string& why) const {
+    ModeState next = s;
     const double r = a / s.a;
     next.z *= r;
     if (before) {
@@ -310,21 +304,21 @@ private:
   int reference_ = 0;
   double omega0_ = 0.0, xi0_ = 0.0;
   Eigen::VectorXd shape0_;
-  std::optional<State> linear_state_;
+  std::optional<ModeState> linear_state_;
   Eigen::MatrixXcd linear_Y_;
 };
 
 void check_range(double a0, double a1) {
   if (!(a0 > 0.0) || !(a1 > a0) || !std::isfinite(a1))
     throw std::invalid_argument("backbone: the amplitudes must be finite with 0 < from < to, got " +
-                                number(a0) + " and " + number(a1));
+                                significant(a0, 4) + " and " + significant(a1, 4));
 }
 
 Backbone run(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
              const fem::DofMap& dofs, int mode, int amplitude_equation, double from, double to,
              bool at_dof, const BackboneOptions& o) {
   check_range(from, to);
-  Tracer tracer(H, joints, dofs, mode, amplitude_equation, o);
+  ModeTracer tracer(H, joints, dofs, mode, amplitude_equation, o);
   Backbone out;
   out.mode = mode;
   out.amplitude_dof = dofs.node_dof(amplitude_equation);

@@ -1,5 +1,6 @@
 #include "frf/continuation.hpp"
 
+#include "fem/text.hpp"
 #include "frf/hb_equations.hpp"
 #include "joints/basis.hpp"
 
@@ -27,13 +28,6 @@ bool has_exact_friction(const std::vector<joints::Joint>& joints, const Harmonic
 }
 
 // A residual or a step as %g would print it: 7.05e-06, not 0.000007 (or 0.000000).
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
-}
-
 std::string hz(double f) {
   std::ostringstream s;
   s.precision(6);
@@ -423,7 +417,7 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
     }
     if (!ok) {
       branch.notes.push_back("no steady state found at the start, " + hz(start_hz) + " (residual " +
-                             number(s.residual) + ")");
+                             significant(s.residual, 3) + ")");
       return branch;
     }
   }
@@ -524,7 +518,7 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
     }
     if (ds < o.min_step) {
       branch.notes.push_back("continuation stalled at " + hz(s.omega / two_pi) +
-                             ": no step down to " + number(o.min_step) + " converged");
+                             ": no step down to " + significant(o.min_step, 3) + " converged");
       return branch;
     }
     const Eigen::VectorXd u = scale(s.z, s.omega);

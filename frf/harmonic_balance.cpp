@@ -550,6 +550,46 @@ HarmonicBalanceResult HarmonicBalance::solve(const std::vector<joints::Joint>& j
   return out;
 }
 
+std::vector<Eigen::MatrixXcd>
+HarmonicBalance::output_derivatives(const std::vector<joints::Joint>& joints,
+                                    const Eigen::MatrixXcd& F, const Eigen::MatrixXcd& start,
+                                    const std::vector<std::vector<joints::Joint>>& moved,
+                                    std::span<const double> steps) const {
+  JOINTID_ASSERT(moved.size() == steps.size(), "a step per move");
+  const std::unique_ptr<Equations> P = equations(joints, F, &start);
+  Eigen::VectorXd z = first_guess(*P, &start);
+  int iterations = 0;
+  double residual = 0.0;
+  if (!detail::newton(*P, z, 1.0, options_, iterations, residual)) return {};
+  const int n = P->size();
+  Eigen::VectorXd r0(n), r(n);
+  Eigen::MatrixXd J(n, n);
+  P->residual(z, 1.0, r0, &J);
+  detail::SmallLU<double> lu;
+  lu.compute(J);
+  if (!(lu.min_pivot > 1e-13 * std::max(1.0, J.lpNorm<Eigen::Infinity>()))) return {};
+  const Eigen::MatrixXcd X = result(*P, z).X;
+  std::vector<Eigen::MatrixXcd> out(moved.size());
+  for (std::size_t p = 0; p < moved.size(); ++p) {
+    std::unique_ptr<Equations> Pm;
+    try {
+      Pm = equations(moved[p], F, &start);
+    } catch (const std::invalid_argument&) {
+      continue; // out of the joints' range
+    }
+    if (Pm->size() != n || Pm->symmetric() != P->symmetric() ||
+        Pm->friction.size() != P->friction.size())
+      continue;
+    Pm->residual(z, 1.0, r, nullptr);
+    Eigen::VectorXd dz = r0 - r; // −(R_moved(z) − R(z))
+    lu.solve_in_place(dz);
+    if (!dz.allFinite()) continue;
+    const Eigen::VectorXd zm = z + dz;
+    out[p] = (result(*Pm, zm).X - X) / steps[p];
+  }
+  return out;
+}
+
 HarmonicBalanceResult
 harmonic_balance(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
                  const fem::DofMap& dofs, int force_equation, double amplitude, double frequency_hz,

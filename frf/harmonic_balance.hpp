@@ -31,7 +31,9 @@
 
 #include <array>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 namespace jointid::frf {
 
@@ -119,6 +121,23 @@ public:
                               const Eigen::MatrixXcd* start = nullptr) const;
   const HarmonicBalanceOptions& options() const { return options_; }
   double frequency_hz() const { return frequency_hz_; }
+
+  /// The derivatives of a steady state's outputs with respect to the joints' values and
+  /// parameters, by implicit differentiation. The steady state z is the one solve() reaches from
+  /// `start` (a converged steady state of `joints`: Newton confirms it in an iteration or two).
+  /// For each `moved[p]` (the joints with one value or parameter moved by steps[p]) the entry is
+  /// (X(moved) − X)/steps[p] to first order: the step dz = −J⁻¹ (R_moved(z) − R(z)), with J the
+  /// equations' (generalised) Jacobian at z, and the outputs of z + dz under the moved joints.
+  /// One factorisation for every move, where a finite difference solves the steady state again
+  /// per move. Returns no entries where the steady state is not reached from `start` or J is
+  /// singular (a friction joint stuck throughout the period), and an empty entry where a move
+  /// changes the equations' unknowns (an even term moved from 0 breaks half-wave symmetry) or
+  /// leaves the joints' range: re-simulate those.
+  std::vector<Eigen::MatrixXcd>
+  output_derivatives(const std::vector<joints::Joint>& joints, const Eigen::MatrixXcd& F,
+                     const Eigen::MatrixXcd& start,
+                     const std::vector<std::vector<joints::Joint>>& moved,
+                     std::span<const double> steps) const;
 
   /// Low level, for the frequency continuation: the equations R(z) = 0 for these joints and
   /// force (they refer to `joints` and to this object, which must outlive them), the packed

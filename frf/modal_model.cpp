@@ -1,5 +1,7 @@
 #include "frf/modal_model.hpp"
 
+#include "fem/text.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -14,12 +16,6 @@ std::string size_text(Eigen::Index rows, Eigen::Index cols) {
 }
 
 // The shortest text that reads back as `value` (1e-07, 80.3).
-std::string number(double value) {
-  char buffer[32];
-  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
-  return std::string(buffer, end);
-}
-
 // Mode r, 1-based in messages as in tables of modes.
 std::string mode(Eigen::Index r) {
   return "mode " + std::to_string(r + 1);
@@ -48,9 +44,9 @@ void ModalModel::validate() const {
          " (one row per mode, one column per DOF)");
   for (Eigen::Index r = 0; r < m; ++r) {
     if (!std::isfinite(frequencies_hz(r)) || frequencies_hz(r) < 0.0)
-      fail(mode(r) + ": expected a frequency >= 0 Hz, got " + number(frequencies_hz(r)));
+      fail(mode(r) + ": expected a frequency >= 0 Hz, got " + shortest(frequencies_hz(r)));
     if (!std::isfinite(damping(r)) || damping(r) < 0.0)
-      fail(mode(r) + ": expected a damping ratio >= 0, got " + number(damping(r)));
+      fail(mode(r) + ": expected a damping ratio >= 0, got " + shortest(damping(r)));
     for (Eigen::Index i = 0; i < n; ++i)
       if (!std::isfinite(shapes(r, i)))
         fail(mode(r) + ": the shape at " + fem::to_string(dofs[i]) + " is not finite");
@@ -66,8 +62,8 @@ void ModalModel::validate() const {
     for (Eigen::Index j = i + 1; j < n; ++j)
       if (std::abs(R(i, j) - R(j, i)) > tolerance)
         fail("the residual flexibility is not symmetric: (" + fem::to_string(dofs[i]) + ", " +
-             fem::to_string(dofs[j]) + ") = " + number(R(i, j)) + " but (" +
-             fem::to_string(dofs[j]) + ", " + fem::to_string(dofs[i]) + ") = " + number(R(j, i)) +
+             fem::to_string(dofs[j]) + ") = " + shortest(R(i, j)) + " but (" +
+             fem::to_string(dofs[j]) + ", " + fem::to_string(dofs[i]) + ") = " + shortest(R(j, i)) +
              " m/N");
 }
 

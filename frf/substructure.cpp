@@ -1,6 +1,7 @@
 #include "frf/substructure.hpp"
 
 #include "fem/damping.hpp"
+#include "fem/text.hpp"
 
 #include <Eigen/SparseCholesky>
 
@@ -22,12 +23,6 @@ int dense_limit() {
 }
 
 // The shortest text that reads back as `value`.
-std::string number(double value) {
-  char buffer[32];
-  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
-  return std::string(buffer, end);
-}
-
 } // namespace
 
 Substructure::Substructure(fem::Model model)
@@ -58,13 +53,13 @@ Substructure::Substructure(fem::Assembled system, fem::Damping damping) : dampin
           throw std::invalid_argument(
               std::string(name) + " is not symmetric: entries (" + std::to_string(it.row() + 1) +
               ", " + std::to_string(it.col() + 1) + ") and (" + std::to_string(it.col() + 1) +
-              ", " + std::to_string(it.row() + 1) + ") differ by " + number(it.value()));
+              ", " + std::to_string(it.row() + 1) + ") differ by " + shortest(it.value()));
   }
   for (int i = 0; i < n; ++i)
     if (system.M.coeff(i, i) < 0.0)
       throw std::invalid_argument("M: diagonal entry " + std::to_string(i + 1) + " (" +
                                   fem::to_string(system.dofs.node_dof(i)) +
-                                  ") is negative: " + number(system.M.coeff(i, i)));
+                                  ") is negative: " + shortest(system.M.coeff(i, i)));
   // K positive definite: a substructure given by its matrices is held (no rigid-body motion,
   // no mechanism) and has no negative stiffness; otherwise its first modes are at 0 Hz (or
   // imaginary) and every receptance near them meaningless. The LDLᵀ factorisation (fill-reducing
@@ -80,8 +75,8 @@ Substructure::Substructure(fem::Assembled system, fem::Damping damping) : dampin
       if (D(i) > 1e-10 * std::abs(diagonal)) continue;
       throw std::invalid_argument(
           "K is not positive definite: its factorisation breaks down at " +
-          fem::to_string(system.dofs.node_dof(e)) + " (pivot " + number(D(i)) + ", diagonal " +
-          number(diagonal) + "): " +
+          fem::to_string(system.dofs.node_dof(e)) + " (pivot " + shortest(D(i)) + ", diagonal " +
+          shortest(diagonal) + "): " +
           (D(i) < -1e-10 * std::abs(diagonal)
                ? "a negative stiffness"
                : "a rigid-body motion or a mechanism (a 0 Hz mode)") +
@@ -211,7 +206,7 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
     if (notes && error > 1e-3)
       notes->push_back("measured FRFs: between lines the receptance is interpolated, with an "
                        "estimated error up to " +
-                       number(std::round(error * 1e4) / 1e4) + " of the FRF's peak (" + where +
+                       shortest(std::round(error * 1e4) / 1e4) + " of the FRF's peak (" + where +
                        "): measure with a finer frequency step, or at the tests' frequencies");
     return synthesis;
   }
@@ -227,7 +222,7 @@ ModalSynthesis Substructure::synthesis(std::vector<int> dofs, double f_max_hz,
           "receptance: a model of " + std::to_string(n) + " equations (more than " +
           std::to_string(dense_limit()) +
           ") uses the modes below the highest frequency of interest, which must be > 0 Hz, got " +
-          number(f_max_hz));
+          shortest(f_max_hz));
     fem::ModalOptions options;
     options.max_frequency_hz = f_max_hz;
     options.engine = fem::ModalEngine::sparse;

@@ -1,5 +1,6 @@
 #include "identify/design.hpp"
 
+#include "fem/constants.hpp"
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "joints/hysteresis.hpp"
@@ -16,8 +17,6 @@
 namespace jointid::identify {
 
 namespace {
-
-constexpr double inf = std::numeric_limits<double>::infinity();
 
 double channel_rms(const Channel& c) {
   const double mean = c.samples.mean();

@@ -1,7 +1,9 @@
 #include "identify/fit.hpp"
 
 #include "fem/assert.hpp"
+#include "fem/constants.hpp"
 #include "fem/fft.hpp"
+#include "fem/text.hpp"
 #include "identify/harmonics.hpp"
 #include "identify/statistics.hpp"
 
@@ -19,15 +21,6 @@
 namespace jointid::identify {
 
 namespace {
-
-constexpr double two_pi = 2.0 * std::numbers::pi;
-
-std::string percent(double fraction) {
-  std::ostringstream s;
-  s.precision(3);
-  s << 100.0 * fraction << " %";
-  return s.str();
-}
 
 // Lines 0 … K of a joint's basis functions on one period of its deformation y and rate ẏ (N
 // samples each). A broadband deformation makes basis functions with kinks (ẏ|ẏ|, sign ẏ) rich
@@ -299,7 +292,6 @@ FitResult::identified(const std::vector<joints::Joint>& model_joints) const {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // One equation of Q b = p: a real or imaginary part of the complex equation of set-2 DOF d at
 // harmonic k of a test.

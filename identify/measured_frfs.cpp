@@ -1,6 +1,8 @@
 #include "identify/measured_frfs.hpp"
 
+#include "fem/constants.hpp"
 #include "fem/fft.hpp"
+#include "identify/record_messages.hpp"
 #include "identify/spectra.hpp"
 
 #include <fmt/format.h>
@@ -18,7 +20,6 @@ namespace jointid::identify {
 namespace {
 
 using cd = std::complex<double>;
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 // The force has power at a line when its auto spectrum is at least this fraction of its largest
 // value in the band (40 dB below: a multisine's lines that are not excited, or the edges of a
@@ -66,13 +67,6 @@ cd derivative_factor(Quantity q, double omega) {
   default:
     return {1.0, 0.0};
   }
-}
-
-std::string channel_list(const Record& r) {
-  std::string out;
-  for (const Channel& c : r.channels)
-    out += (out.empty() ? "" : ", ") + c.name();
-  return out;
 }
 
 } // namespace

@@ -1,7 +1,10 @@
 #include "identify/measurement.hpp"
 
+#include "fem/constants.hpp"
+#include "fem/text.hpp"
 #include "identify/harmonics.hpp"
 #include "identify/periodic.hpp"
+#include "identify/record_messages.hpp"
 #include "identify/sweep.hpp"
 
 #include <Eigen/Dense>
@@ -17,39 +20,7 @@ namespace jointid::identify {
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 using Complex = std::complex<double>;
-
-// A number as %g would print it (6 significant digits): 2.5, 0.4, 1e-05.
-std::string number(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-std::string percent(double fraction) {
-  std::ostringstream s;
-  s.precision(3);
-  s << 100.0 * fraction << " %";
-  return s.str();
-}
-
-// Fraction of samples sitting at the channel's extreme values (a flat top: clipping). A
-// displacement that is flat because the point is at rest (its measured velocity is zero, as
-// in a friction joint's stick phase) is not clipped: pass that velocity to exempt it.
-double clipped_fraction(const Eigen::VectorXd& x, const Eigen::VectorXd* velocity = nullptr) {
-  const double hi = x.maxCoeff(), lo = x.minCoeff(),
-               tol = 1e-9 * std::max(std::abs(hi), std::abs(lo));
-  if (hi - lo <= tol) return 0.0;
-  const double vmax = velocity ? velocity->cwiseAbs().maxCoeff() : 0.0;
-  int at_edge = 0;
-  for (int i = 0; i < x.size(); ++i) {
-    const bool resting = velocity && std::abs((*velocity)(i)) <= 1e-6 * vmax;
-    if ((hi - x(i) <= tol || x(i) - lo <= tol) && !resting) ++at_edge;
-  }
-  return static_cast<double>(at_edge) / static_cast<double>(x.size());
-}
 
 // The samples of one channel's data over the analysed span (whole periods), with the span's
 // noise estimate: either the synchronous average of the periods or the trimmed record.
@@ -112,22 +83,9 @@ Measurement measure_sine(const Record& r, double frequency_hz, const MeasureOpti
   m.harmonics = K;
   const auto forces = r.all(Quantity::force);
   // Worded for every format a record is read from (CSV columns, UFF58 datasets).
-  const auto channel_list = [&] {
-    std::string names;
-    for (const auto& c : r.channels)
-      names += (names.empty() ? "" : ", ") + c.name();
-    return names.empty() ? std::string("none") : names;
-  };
-  if (forces.empty())
-    fail("no force channel among its channels (" + channel_list() +
-         "): a test needs its excitation force (a channel f@NODE:DOF) recorded with the "
-         "responses");
+  if (forces.empty()) fail(no_force_channel(r));
   const std::vector<const Channel*> best = best_response_channels(r, m);
-  if (best.empty())
-    fail("no response channel among its channels (" + channel_list() +
-         "): a test needs a displacement, velocity or acceleration recorded with its force, "
-         "e.g. x@" +
-         fem::to_string(forces.front()->at));
+  if (best.empty()) fail(no_response_channel(r));
 
   // A force channel that is zero in every sample measured no force.
   std::vector<const Channel*> loaded;
@@ -146,9 +104,9 @@ Measurement measure_sine(const Record& r, double frequency_hz, const MeasureOpti
   const double omega = two_pi * m.frequency_hz, dt = r.dt();
   const int n = whole_period_samples(r.t, m.frequency_hz);
   if (n == 0)
-    fail("shorter than one period of the excitation (" + number(m.frequency_hz) +
-         " Hz): " + number(static_cast<double>(r.t.size()) * dt) + " s recorded, a period lasts " +
-         number(1.0 / m.frequency_hz) + " s");
+    fail("shorter than one period of the excitation (" + significant(m.frequency_hz) +
+         " Hz): " + significant(static_cast<double>(r.t.size()) * dt) +
+         " s recorded, a period lasts " + significant(1.0 / m.frequency_hz) + " s");
   const double nyquist = 0.5 / dt;
   if (K * m.frequency_hz >= nyquist)
     fail(fmt::format("harmonic {} ({:.6g} Hz) is at or above the Nyquist frequency of the "

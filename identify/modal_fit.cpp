@@ -1,5 +1,7 @@
 #include "identify/modal_fit.hpp"
 
+#include "fem/constants.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <fmt/format.h>
@@ -16,7 +18,6 @@ namespace jointid::identify {
 namespace {
 
 using cd = std::complex<double>;
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 // ---------------------------------------------------------------------------------------------
 // LSCF: the normal equations' Toeplitz blocks and the poles at one order.

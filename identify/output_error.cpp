@@ -1,5 +1,6 @@
 #include "identify/output_error.hpp"
 
+#include "fem/constants.hpp"
 #include "identify/harmonics.hpp"
 #include "identify/parametric.hpp"
 #include "identify/statistics.hpp"
@@ -22,7 +23,6 @@ namespace jointid::identify {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 // One compared value: harmonic k of the displacement (or, from a separate velocity channel, of
 // the velocity: ikω X_k) at output `out` of test `test`.

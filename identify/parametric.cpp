@@ -1,5 +1,6 @@
 #include "identify/parametric.hpp"
 
+#include "fem/constants.hpp"
 #include "joints/hysteresis.hpp"
 
 #include <fmt/format.h>
@@ -16,7 +17,6 @@ namespace jointid::identify {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 bool is_log(const joints::ParameterInfo& info) {
   return info.low == 0.0 && std::isinf(info.high);

@@ -1,6 +1,8 @@
 #include "identify/periodic.hpp"
 
+#include "fem/constants.hpp"
 #include "fem/fft.hpp"
+#include "fem/text.hpp"
 #include "identify/record_messages.hpp"
 
 #include <fmt/format.h>
@@ -16,28 +18,7 @@ namespace jointid::identify {
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 using Complex = std::complex<double>;
-
-std::string percent(double fraction) {
-  return fmt::format("{:.3g} %", 100.0 * fraction);
-}
-
-// Fraction of samples sitting at the channel's extreme values (a flat top: clipping); a
-// displacement at rest (its velocity zero, as in a friction joint's stick phase) is exempt.
-double clipped_fraction(const Eigen::VectorXd& x, const Eigen::VectorXd* velocity) {
-  const double hi = x.maxCoeff(), lo = x.minCoeff(),
-               tol = 1e-9 * std::max(std::abs(hi), std::abs(lo));
-  if (hi - lo <= tol) return 0.0;
-  const double vmax = velocity ? velocity->cwiseAbs().maxCoeff() : 0.0;
-  int at_edge = 0;
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    const bool resting = velocity && std::abs((*velocity)(i)) <= 1e-6 * vmax;
-    if ((hi - x(i) <= tol || x(i) - lo <= tol) && !resting) ++at_edge;
-  }
-  return static_cast<double>(at_edge) / static_cast<double>(x.size());
-}
 
 // One channel cut into its kept periods, transformed: per period its FFT (bins 0 … N/2).
 struct PeriodSpectra {

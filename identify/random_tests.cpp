@@ -18,7 +18,7 @@ namespace jointid::identify {
 
 namespace {
 
-void add_unique(std::vector<int>& list, int value) {
+void add_output(std::vector<int>& list, int value) {
   if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
 }
 
@@ -126,9 +126,9 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
     history.equations.push_back(dofs.equation(at));
   std::vector<int> outputs = joints::joint_dof_set(joints, dofs);
   for (int e : history.equations)
-    add_unique(outputs, e);
+    add_output(outputs, e);
   for (const auto& at : o.extra_outputs)
-    add_unique(outputs, dofs.equation(at));
+    add_output(outputs, dofs.equation(at));
   const joints::JointForces forces(joints, dofs);
   const fem::LocalForces* local = joints.empty() ? nullptr : &forces;
   fem::TransientOptions options;
@@ -144,7 +144,7 @@ ForcedTest simulate_forced(const frf::Substructure& sub, const std::vector<joint
   to.static_correction = o.static_correction;
   to.loaded = history.equations;
   for (int e : joints::joint_dof_set(joints, dofs))
-    add_unique(to.loaded, e);
+    add_output(to.loaded, e);
   // The frequency below which 99 % of the force's power lies: a mode left out below it is
   // driven at its resonance, which the static correction does not hold (a warning).
   if (to.modal_coordinates) to.force_band_hz = power_band_hz(in, 0.99);

@@ -1,5 +1,6 @@
 #include "identify/record_kind.hpp"
 
+#include "fem/constants.hpp"
 #include "fem/fft.hpp"
 #include "identify/harmonics.hpp"
 #include "identify/record_messages.hpp"
@@ -15,8 +16,6 @@
 namespace jointid::identify {
 
 namespace {
-
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 // What the force's spectrum and autocorrelation say, kept for the refusal's message.
 struct Evidence {
@@ -208,14 +207,25 @@ const char* to_string(RecordKind kind) {
   return "";
 }
 
-namespace {
 std::string channel_list(const Record& r) {
   std::string names;
   for (const auto& c : r.channels)
     names += (names.empty() ? "" : ", ") + c.name();
   return names.empty() ? std::string("none") : names;
 }
-} // namespace
+
+double clipped_fraction(const Eigen::VectorXd& x, const Eigen::VectorXd* velocity) {
+  const double hi = x.maxCoeff(), lo = x.minCoeff(),
+               tol = 1e-9 * std::max(std::abs(hi), std::abs(lo));
+  if (hi - lo <= tol) return 0.0;
+  const double vmax = velocity ? velocity->cwiseAbs().maxCoeff() : 0.0;
+  int at_edge = 0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    const bool resting = velocity && std::abs((*velocity)(i)) <= 1e-6 * vmax;
+    if ((hi - x(i) <= tol || x(i) - lo <= tol) && !resting) ++at_edge;
+  }
+  return static_cast<double>(at_edge) / static_cast<double>(x.size());
+}
 
 std::string no_force_channel(const Record& r) {
   return "no force channel among its channels (" + channel_list(r) +

@@ -1,5 +1,6 @@
 #include "identify/sine_tests.hpp"
 
+#include "fem/constants.hpp"
 #include "fem/parallel.hpp"
 #include "fem/time_integration.hpp"
 #include "fem/transient.hpp"
@@ -19,8 +20,6 @@
 namespace jointid::identify {
 
 namespace {
-
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 std::string compact(double value) {
   return fmt::format("{}", value);

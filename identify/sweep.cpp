@@ -1,4 +1,6 @@
 #include "identify/sweep.hpp"
+
+#include "fem/constants.hpp"
 #include "identify/harmonics.hpp"
 
 #include "fem/fft.hpp"
@@ -17,8 +19,6 @@ namespace jointid::identify {
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 using Complex = std::complex<double>;
 
 // The unwrapped phase and the amplitude of x's analytic signal x + i H(x).

@@ -1,5 +1,6 @@
 #include "io/low_level_test.hpp"
 
+#include "fem/text.hpp"
 #include "io/files.hpp"
 #include "io/measured_frf_file.hpp"
 #include "io/record_csv.hpp"
@@ -18,12 +19,6 @@ namespace jointid::io {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string_view trim(std::string_view s) {
-  const auto a = s.find_first_not_of(" \t\r");
-  if (a == std::string_view::npos) return {};
-  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
 
 // "--max-order" on the command line, "max_order" in Python.
 std::string option(const ModalFitArguments& a, std::string name) {

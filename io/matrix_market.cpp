@@ -1,5 +1,6 @@
 #include "io/matrix_market.hpp"
 
+#include "fem/text.hpp"
 #include "io/files.hpp"
 
 #include <fmt/format.h>
@@ -29,12 +30,6 @@ std::string trimmed(const std::string& s) {
 }
 
 constexpr long long max_size = 10'000'000;
-
-std::string shortest(double value) {
-  char buffer[32];
-  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;
-  return std::string(buffer, end);
-}
 
 } // namespace
 

@@ -1,5 +1,6 @@
 #include "io/measured_frf_file.hpp"
 
+#include "fem/text.hpp"
 #include "frf/sweep.hpp"
 #include "io/files.hpp"
 #include "io/uff58.hpp"
@@ -17,12 +18,6 @@
 namespace jointid::io {
 
 namespace {
-
-std::string_view trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string_view::npos) return {};
-  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
 
 std::vector<std::string_view> split(std::string_view s, char by) {
   std::vector<std::string_view> out;

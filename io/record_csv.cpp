@@ -1,5 +1,6 @@
 #include "io/record_csv.hpp"
 
+#include "fem/text.hpp"
 #include "identify/harmonics.hpp"
 #include "io/files.hpp"
 #include "io/uff58.hpp"
@@ -21,17 +22,10 @@ namespace jointid::io {
 
 namespace {
 
-struct Line {
+struct CsvLine {
   int number = 0; ///< 1-based line in the file, 0 = none
   std::string_view text;
 };
-
-std::string_view trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r");
-  return s.substr(first, last - first + 1);
-}
 
 std::vector<std::string_view> split_fields(std::string_view line) {
   std::vector<std::string_view> fields;
@@ -58,9 +52,9 @@ std::optional<double> parse_double(std::string_view s) {
 struct CsvText {
   std::string name;
   std::string text;
-  std::vector<Line> comments; ///< text after '#'
-  Line header;
-  std::vector<Line> rows;
+  std::vector<CsvLine> comments; ///< text after '#'
+  CsvLine header;
+  std::vector<CsvLine> rows;
 
   [[noreturn]] void fail(int line, const std::string& what) const {
     throw Error(line > 0 ? fmt::format("{}:{}: {}", name, line, what)
@@ -114,7 +108,7 @@ std::vector<std::vector<double>> parse_rows(const CsvText& csv,
   std::vector<std::vector<double>> data(width);
   for (auto& column : data)
     column.reserve(csv.rows.size());
-  for (const Line& row : csv.rows) {
+  for (const CsvLine& row : csv.rows) {
     const auto fields = split_fields(row.text);
     if (fields.size() != width)
       csv.fail(row.number, fmt::format("row has {} field{}, expected {} ({})", fields.size(),
@@ -144,10 +138,6 @@ std::optional<std::string_view> declared_value(std::string_view text, std::strin
   return trim(after.substr(1));
 }
 
-std::string shortest(double value) {
-  return fmt::format("{}", value);
-}
-
 } // namespace
 
 identify::Record read_record(const std::filesystem::path& path) {
@@ -156,9 +146,11 @@ identify::Record read_record(const std::filesystem::path& path) {
   record.source = path.string();
 
   // The comments that declare what the record is: `key = value`, other comments ignored.
-  auto declared = [](const Line& c, std::string_view key) { return declared_value(c.text, key); };
+  auto declared = [](const CsvLine& c, std::string_view key) {
+    return declared_value(c.text, key);
+  };
   int sine_line = 0, period_line = 0, sweep_line = 0;
-  for (const Line& c : csv.comments) {
+  for (const CsvLine& c : csv.comments) {
     if (const auto value_text = declared(c, "excitation_hz")) {
       const auto value = parse_double(*value_text);
       if (!value || !std::isfinite(*value) || !(*value > 0.0))
@@ -379,7 +371,7 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
   // `# convention = x(t) = Re(X e^{iωt})` (the default), `Re(X e^{-iωt})` or `Im(X e^{iωt})`.
   PhaseConvention convention = PhaseConvention::positive;
   int convention_line = 0;
-  for (const Line& c : csv.comments) {
+  for (const CsvLine& c : csv.comments) {
     if (!c.text.starts_with("convention")) continue;
     const std::string_view after = trim(c.text.substr(std::string_view("convention").size()));
     if (after.empty() || after.front() != '=') continue; // some other comment
@@ -447,7 +439,7 @@ SteppedSineTable read_stepped_sine(const std::filesystem::path& path) {
       csv.fail(csv.rows[i].number,
                fmt::format("column 1 (freq_hz): expected a frequency > 0 Hz, got {}", data[0][i]));
   table.freq_hz = data[0];
-  for (const Line& row : csv.rows)
+  for (const CsvLine& row : csv.rows)
     table.lines.push_back(row.number);
   table.values.resize(static_cast<Eigen::Index>(n),
                       static_cast<Eigen::Index>(table.channels.size()));

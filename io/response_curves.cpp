@@ -1,20 +1,15 @@
 #include "io/response_curves.hpp"
 
+#include "io/json_text.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 
 namespace jointid::io {
 
-namespace {
-
-using Json = nlohmann::ordered_json; // keeps the contract's key order
-
-Json number(double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
-}
-
-} // namespace
+using json::Json;
+using json::number;
 
 std::string response_json(const frf::ResponseCurves& c) {
   Json j;

@@ -1,25 +1,24 @@
 // compare_json(): part of jointid_io.
 #include "io/spectra_comparison.hpp"
 
+#include "io/json_text.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 
 namespace jointid::io {
 
-namespace {
+using json::Json;
+using json::number;
 
-using Json = nlohmann::ordered_json;
+namespace {
 
 Json numbers(const Eigen::VectorXd& v) {
   Json a = Json::array();
   for (Eigen::Index i = 0; i < v.size(); ++i)
     a.push_back(std::isfinite(v(i)) ? Json(v(i)) : Json(nullptr));
   return a;
-}
-
-Json number(double value) {
-  return std::isfinite(value) ? Json(value) : Json(nullptr);
 }
 
 } // namespace

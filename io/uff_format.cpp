@@ -1,5 +1,6 @@
 #include "io/uff_format.hpp"
 
+#include "fem/text.hpp"
 #include "io/files.hpp"
 #include "io/uff58.hpp"
 
@@ -17,13 +18,6 @@ namespace jointid::io::detail {
 
 // ---------------------------------------------------------------------------------------------
 // Text helpers
-
-std::string_view trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r\n");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r\n");
-  return s.substr(first, last - first + 1);
-}
 
 std::string_view trim_right(std::string_view s) {
   const auto last = s.find_last_not_of(" \t\r\n");

@@ -4,6 +4,8 @@
 /// (io/uff58_mapping.cpp) share it: blank-separated fields, numbers in E or Fortran D form,
 /// lines with their numbers, records cut by the standard's columns or at blanks, and the
 /// messages that name a dataset, record and field.
+#include "fem/text.hpp"
+
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -17,7 +19,7 @@ namespace jointid::io::detail {
 // ---------------------------------------------------------------------------------------------
 // Text
 
-std::string_view trim(std::string_view s);
+using jointid::trim; // fem/text.hpp
 std::string_view trim_right(std::string_view s);
 std::vector<std::string_view> blank_separated(std::string_view s);
 /// A line or field as it may be shown in a message: at most 40 characters, non-printable bytes

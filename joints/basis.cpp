@@ -1,5 +1,7 @@
 #include "joints/basis.hpp"
 
+#include "fem/constants.hpp"
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -15,8 +17,6 @@ double zero(double, double) {
 double one(double, double) {
   return 1.0;
 }
-
-constexpr double inf = std::numeric_limits<double>::infinity();
 
 // The parametric terms' parameters (docs/method.md, "Terms with named parameters").
 constexpr std::array<ParameterInfo, 2> jenkins_parameters{{

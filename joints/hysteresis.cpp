@@ -1,5 +1,7 @@
 #include "joints/hysteresis.hpp"
 
+#include "fem/text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -8,12 +10,6 @@
 namespace jointid::joints {
 
 namespace {
-
-std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
 
 // The smallest cut of the iwan's quadrature grid, relative to φ_max.
 constexpr double smallest_cut = 1e-4;
@@ -41,13 +37,13 @@ void Sliders::append(const Sliders& other) {
 
 IwanDensity iwan_density(double fs, double kt, double chi, double beta) {
   if (!(fs > 0.0) || !std::isfinite(fs))
-    throw std::invalid_argument("iwan: fs must be > 0 N, got " + number(fs));
+    throw std::invalid_argument("iwan: fs must be > 0 N, got " + significant(fs));
   if (!(kt > 0.0) || !std::isfinite(kt))
-    throw std::invalid_argument("iwan: kt must be > 0 N/m, got " + number(kt));
+    throw std::invalid_argument("iwan: kt must be > 0 N/m, got " + significant(kt));
   if (!(chi > -1.0 && chi <= 0.0))
-    throw std::invalid_argument("iwan: chi must be in (-1, 0], got " + number(chi));
+    throw std::invalid_argument("iwan: chi must be in (-1, 0], got " + significant(chi));
   if (!(beta >= 0.0) || !std::isfinite(beta))
-    throw std::invalid_argument("iwan: beta must be >= 0, got " + number(beta));
+    throw std::invalid_argument("iwan: beta must be >= 0, got " + significant(beta));
   const double shape = beta + (chi + 1.0) / (chi + 2.0);
   IwanDensity d;
   d.chi = chi;
@@ -59,9 +55,9 @@ IwanDensity iwan_density(double fs, double kt, double chi, double beta) {
 
 Sliders jenkins_sliders(double kt, double fs) {
   if (!(kt > 0.0) || !std::isfinite(kt))
-    throw std::invalid_argument("jenkins: kt must be > 0 N/m, got " + number(kt));
+    throw std::invalid_argument("jenkins: kt must be > 0 N/m, got " + significant(kt));
   if (!(fs > 0.0) || !std::isfinite(fs))
-    throw std::invalid_argument("jenkins: fs must be > 0 N, got " + number(fs));
+    throw std::invalid_argument("jenkins: fs must be > 0 N, got " + significant(fs));
   return Sliders{{kt}, {fs / kt}};
 }
 

@@ -1,5 +1,6 @@
 #include "report/chart.hpp"
 
+#include "fem/text.hpp"
 #include "report/vtk_display.hpp"
 #include "report/vtk_render.hpp"
 
@@ -64,12 +65,6 @@ std::string series_name(const Series& series, std::size_t index) {
                               : "series " + quoted(series.label);
 }
 
-std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
-
 /// The x values a series is drawn at: its own, or 1 … n for bars on named categories.
 std::vector<double> x_of(const Chart& chart, const Series& series) {
   if (series.x.empty() && series.style == Series::Style::bars && !chart.x_categories.empty()) {
@@ -86,10 +81,10 @@ void check_values(const std::string& where, const char* axis, const std::vector<
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i]))
       throw std::invalid_argument(where + ": " + axis + "[" + std::to_string(i) +
-                                  "] = " + number(v[i]) + " is not finite");
+                                  "] = " + significant(v[i]) + " is not finite");
     if (log && !(v[i] > 0.0))
       throw std::invalid_argument(where + ": " + axis + "[" + std::to_string(i) +
-                                  "] = " + number(v[i]) + " on a logarithmic " + axis +
+                                  "] = " + significant(v[i]) + " on a logarithmic " + axis +
                                   " axis (need values > 0, or a linear axis)");
   }
 }
@@ -126,7 +121,7 @@ void check_figure(const Figure& figure) {
                                     std::to_string(rgb[1]) + ", " + std::to_string(rgb[2]) +
                                     "} (need 0 … 255 each, or {-1, -1, -1} for the palette)");
       if (!(series.width > 0.0) || !(series.width <= 100.0))
-        throw std::invalid_argument(where + ": width = " + number(series.width) +
+        throw std::invalid_argument(where + ": width = " + significant(series.width) +
                                     " pixels (need 0 < width ≤ 100)");
     }
   }

@@ -1,5 +1,7 @@
 #include "report/discovery_figures.hpp"
 
+#include "fem/constants.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -15,7 +17,6 @@ namespace jointid::report {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 // The tests' force levels grouped within 3 % (as discovery groups them): the groups' means,
 // ascending.

@@ -1,5 +1,6 @@
 #include "report/vtk_output.hpp"
 
+#include "fem/constants.hpp"
 #include "io/files.hpp"
 #include "report/vtk_display.hpp"
 #include "report/vtk_render.hpp"
@@ -50,8 +51,6 @@ namespace jointid::report {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr double two_pi = 2.0 * std::numbers::pi;
 
 // ---------------------------------------------------------------------------------------------
 // Checks and nodal mode shapes

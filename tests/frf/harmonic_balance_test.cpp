@@ -743,3 +743,92 @@ TEST(HarmonicBalance, ParametricTermsOutOfRangeAreRefusedNamingTheKey) {
   });
   EXPECT_NE(missing.find("'iwan.fs' has no value"), std::string::npos) << missing;
 }
+
+TEST(HarmonicBalance, OutputDerivativesAreThoseOfTheSolvedSteadyStates) {
+  // Implicit differentiation at a steady state (one factorisation for every move) against
+  // central differences of steady states solved to 1e-12: coefficients (k, c, exact friction
+  // fc, k3) and an iwan's four parameters, in microslip and in macroslip. The implicit
+  // derivative over a step h = 1e-6 of the value is first order, good to about h of the
+  // derivative (plus the solve's 1e-12 over h); the central difference over 1e-4 to (1e-4)²
+  // and 1e-12/1e-4: 1e-3 of the largest derivative asserted leaves room for the generalised
+  // Jacobian of friction's stick–slip samples, which a step can switch.
+  const PaperCantilever c;
+  const double f = 3.5;
+  frf::HarmonicBalanceOptions o;
+  o.harmonics = 9;
+  const std::vector<int> outputs{c.eq(7), c.eq(4)};
+  struct Case {
+    const char* name;
+    std::vector<joints::Joint> joints;
+    double F0;
+  };
+  std::vector<Case> cases{
+      {"k, c, fc, k3",
+       {make("tip", 7, 0, {Term::k, Term::c, Term::fc, Term::k3}, {4800.0, 20.0, 3.0, 1.6e8})},
+       40.0},
+      {"iwan, microslip", {parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1})}, 2.0},
+      {"iwan, macroslip", {parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1})}, 20.0},
+  };
+  // Each coefficient, and each parameter of a parametric term, moved by `relative` of itself.
+  auto moves = [](const std::vector<joints::Joint>& js, double relative) {
+    std::vector<std::vector<joints::Joint>> out;
+    std::vector<double> steps;
+    const joints::Joint& j = js[0];
+    for (std::size_t t = 0; t < j.terms.size(); ++t) {
+      if (joints::has_parameters(j.terms[t])) {
+        for (std::size_t q = 0; q < j.parameters[t].size(); ++q) {
+          std::vector<joints::Joint> m = js;
+          const double h = relative * std::abs(j.parameters[t][q].value);
+          m[0].parameters[t][q].value += h;
+          out.push_back(m), steps.push_back(h);
+        }
+        continue;
+      }
+      std::vector<joints::Joint> m = js;
+      const double h = relative * std::abs(j.values[t]);
+      m[0].values[t] += h;
+      out.push_back(m), steps.push_back(h);
+    }
+    return std::pair{out, steps};
+  };
+  for (const Case& t : cases) {
+    SCOPED_TRACE(t.name);
+    const frf::HarmonicBalance problem(c.H, t.joints, c.system.dofs, {c.eq(7)}, outputs, f, o);
+    const Eigen::MatrixXcd F = frf::sine_force(t.F0);
+    const frf::HarmonicBalanceResult at = problem.solve(t.joints, F);
+    ASSERT_TRUE(at.status.ok()) << at.status.reason;
+    const auto [moved, steps] = moves(t.joints, 1e-6);
+    const std::vector<Eigen::MatrixXcd> D =
+        problem.output_derivatives(t.joints, F, at.Y, moved, steps);
+    ASSERT_EQ(D.size(), moved.size());
+    const auto [up, h_up] = moves(t.joints, 1e-4);
+    const auto [down, h_down] = moves(t.joints, -1e-4);
+    for (std::size_t p = 0; p < moved.size(); ++p) {
+      SCOPED_TRACE("move " + std::to_string(p));
+      const frf::HarmonicBalanceResult a = problem.solve(up[p], F, &at.Y),
+                                       b = problem.solve(down[p], F, &at.Y);
+      ASSERT_TRUE(a.status.ok() && b.status.ok());
+      const Eigen::MatrixXcd central = (a.X - b.X) / (h_up[p] - h_down[p]);
+      ASSERT_EQ(D[p].rows(), central.rows());
+      ASSERT_EQ(D[p].cols(), central.cols());
+      const double scale = central.cwiseAbs().maxCoeff();
+      ASSERT_GT(scale, 0.0);
+      EXPECT_LE((D[p] - central).cwiseAbs().maxCoeff(), 1e-3 * scale);
+    }
+  }
+  // A move that changes the unknowns (an even term from 0: no half-wave symmetry) is left to
+  // the caller, the others are formed.
+  std::vector<joints::Joint> even{
+      make("tip", 7, 0, {Term::k, Term::c, Term::k2, Term::k3}, {4800.0, 20.0, 0.0, 1.6e8})};
+  const frf::HarmonicBalance problem(c.H, even, c.system.dofs, {c.eq(7)}, outputs, f, o);
+  const frf::HarmonicBalanceResult at = problem.solve(even, frf::sine_force(20.0));
+  ASSERT_TRUE(at.status.ok());
+  std::vector<joints::Joint> with_k2 = even, stiffer = even;
+  with_k2[0].values[2] = 1e3, stiffer[0].values[0] += 1e-2;
+  const std::vector<double> steps{1e3, 1e-2};
+  const auto D =
+      problem.output_derivatives(even, frf::sine_force(20.0), at.Y, {with_k2, stiffer}, steps);
+  ASSERT_EQ(D.size(), 2u);
+  EXPECT_EQ(D[0].size(), 0);
+  EXPECT_GT(D[1].size(), 0);
+}

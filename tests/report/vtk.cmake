@@ -5,12 +5,14 @@ add_executable(report_vtk_tests ${CMAKE_CURRENT_LIST_DIR}/vtk_output_test.cpp
                             ${CMAKE_CURRENT_LIST_DIR}/chart_test.cpp)
 target_link_libraries(report_vtk_tests PRIVATE jointid_report GTest::gtest_main ${VTK_LIBRARIES})
 target_include_directories(report_vtk_tests PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+jointid_test_code(report_vtk_tests)
 gtest_discover_tests(report_vtk_tests DISCOVERY_TIMEOUT 60)
 
 # A program that writes pictures and ParaView files of a cantilever and a portal frame.
 add_executable(report_vtk_demo ${CMAKE_CURRENT_LIST_DIR}/vtk_demo.cpp)
 target_link_libraries(report_vtk_demo PRIVATE jointid_report)
 target_include_directories(report_vtk_demo PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+jointid_test_code(report_vtk_demo)
 
 # Debian's VTK renders through GLX, so pictures need an X server: the discovered VtkPng tests
 # skip without DISPLAY, and these run them (and the demo) under a virtual one. xvfb-run -a can
