@@ -23,7 +23,6 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,37 +30,6 @@ namespace jointid::discover {
 
 namespace detail {
 namespace {
-
-// A candidate that adds a coefficient term, started from the model now with that term at 0:
-// output error from there can only improve on the model now. From the equation-error start
-// alone it may stop in a worse minimum: on a bolted beam's stepped-sine table, after an iwan
-// was refined, k3 from its equation-error start left a larger gap (0.053) than the model
-// without it (0.041), and the truth's k3 was never added. Empty where there is no such start
-// (a parametric term, a refit, a value per test, the damping scale).
-std::optional<std::vector<joints::Joint>> nested_start(const Candidate& c, const State& candidate,
-                                                       const State& now) {
-  if (!c.term || c.refit || c.varies || joints::has_parameters(*c.term) ||
-      candidate.joints.size() != now.joints.size() || candidate.damping_scale != now.damping_scale)
-    return std::nullopt;
-  std::vector<joints::Joint> js = candidate.joints;
-  for (std::size_t j = 0; j < js.size(); ++j) {
-    const joints::Joint& n = now.joints[j];
-    for (std::size_t t = 0; t < js[j].terms.size(); ++t) {
-      const int u = n.term_index(js[j].terms[t]);
-      if (u >= 0) {
-        const auto ui = static_cast<std::size_t>(u);
-        js[j].values[t] = n.values[ui];
-        if (t < js[j].parameters.size() && ui < n.parameters.size())
-          js[j].parameters[t] = n.parameters[ui];
-      } else if (js[j].name == c.joint && js[j].terms[t] == *c.term) {
-        js[j].values[t] = 0.0;
-      } else {
-        return std::nullopt; // the candidate differs from the model now in more than the term
-      }
-    }
-  }
-  return js;
-}
 
 class Loop {
 public:

@@ -479,6 +479,35 @@ Eigen::MatrixXd covariance_of_determined(const Eigen::MatrixXd& J, double s2,
   return C;
 }
 
+std::optional<std::vector<joints::Joint>> nested_start(const Candidate& c, const State& candidate,
+                                                       const State& now) {
+  if (!c.term || c.refit || c.varies || joints::has_parameters(*c.term) ||
+      candidate.joints.size() != now.joints.size() || candidate.damping_scale != now.damping_scale)
+    return std::nullopt;
+  std::vector<joints::Joint> js = candidate.joints;
+  for (std::size_t j = 0; j < js.size(); ++j) {
+    const joints::Joint& n = now.joints[j];
+    if (js[j].name != n.name) return std::nullopt;
+    for (std::size_t t = 0; t < js[j].terms.size(); ++t) {
+      const int u = n.term_index(js[j].terms[t]);
+      if (u >= 0) {
+        const auto ui = static_cast<std::size_t>(u);
+        js[j].values[t] = n.values[ui];
+        if (t < js[j].parameters.size() && ui < n.parameters.size())
+          js[j].parameters[t] = n.parameters[ui];
+      } else if (js[j].name == c.joint && js[j].terms[t] == *c.term) {
+        js[j].values[t] = 0.0;
+      } else {
+        return std::nullopt; // the candidate differs from the model now in more than the term
+      }
+    }
+    // every term of the model now is the candidate's too
+    for (const joints::Term t : n.terms)
+      if (js[j].term_index(t) < 0) return std::nullopt;
+  }
+  return js;
+}
+
 State refine(const Problem& problem, const State& start, const Simulator& sim) {
   try {
     return refine_from(problem, start, sim);

@@ -53,5 +53,47 @@ TEST(Refine, NegativeDampingIsBroughtBackFirst) {
   EXPECT_NEAR(refined.joints[0].values[1], m.c, 1e-3 * m.c);
 }
 
+TEST(Refine, AnAddedTermsSecondStartIsTheModelNowWithTheTermAtZero) {
+  // A candidate that adds k3, its equation-error values off (k 300, c 3, k3 5e6): its second
+  // start is the model now's k and c with k3 at 0, from which output error cannot end worse than
+  // the model now. There is none for a parametric term, a refit, or a candidate that differs
+  // from the model now in more than the term.
+  const test::OneMode m;
+  const frf::Substructure sub = m.substructure();
+  const auto tests = m.tests({2.5, 2.8, 3.0, 3.2, 3.5, 4.0}, 10.0, 1e-3);
+  Problem problem(sub, {m.joint(0.0, 0.0)}, tests, test::fundamental_only());
+  const Simulator& sim = problem.simulator(1.0);
+  const discover::State now = problem.evaluate({m.joint(0.9 * m.k, 1.2 * m.c)}, sim);
+  joints::Joint with_k3 = m.joint(300.0, 3.0);
+  with_k3.terms.push_back(joints::Term::k3);
+  with_k3.values.push_back(5e6);
+  with_k3.fixed.push_back(false);
+  const discover::State candidate = problem.evaluate({with_k3}, sim);
+  discover::Candidate c;
+  c.joint = "tip";
+  c.term = joints::Term::k3;
+  const auto start = nested_start(c, candidate, now);
+  ASSERT_TRUE(start.has_value());
+  ASSERT_EQ(start->size(), 1u);
+  EXPECT_EQ((*start)[0].terms, with_k3.terms);
+  EXPECT_EQ((*start)[0].values, (std::vector<double>{0.9 * m.k, 1.2 * m.c, 0.0}));
+  const discover::State refined = refine(problem, problem.evaluate(*start, sim), sim);
+  ASSERT_TRUE(refined.converged);
+  EXPECT_LE(refined.gap, now.gap);
+  EXPECT_LT(refined.gap, 0.1 * now.gap); // the search moved: k and c towards the truth
+
+  discover::Candidate refit = c;
+  refit.refit = true;
+  EXPECT_FALSE(nested_start(refit, candidate, now).has_value());
+  discover::Candidate iwan = c;
+  iwan.term = joints::Term::iwan;
+  EXPECT_FALSE(nested_start(iwan, candidate, now).has_value());
+  joints::Joint two = with_k3;
+  two.terms.push_back(joints::Term::c3);
+  two.values.push_back(1.0);
+  two.fixed.push_back(false);
+  EXPECT_FALSE(nested_start(c, problem.evaluate({two}, sim), now).has_value());
+}
+
 } // namespace
 } // namespace jointid

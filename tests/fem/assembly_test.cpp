@@ -3,6 +3,7 @@
 
 #include "fem/elements.hpp"
 #include "support/beam_models.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +14,7 @@ using namespace jointid;
 using fem::Dof;
 
 namespace {
-constexpr double eps = std::numeric_limits<double>::epsilon();
+using jointid::test::eps;
 }
 
 TEST(Assembly, CantileverEqualsHandAssembledBeamWithSupportRowsRemoved) {

@@ -3,6 +3,7 @@
 
 #include "fem/assembly.hpp"
 #include "support/beam_models.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +18,7 @@ using fem::Matrix6;
 
 namespace {
 
-constexpr double eps = std::numeric_limits<double>::epsilon();
+using jointid::test::eps;
 
 // A null-space check that is scale aware: for an exact null vector u, K u is a sum of terms
 // |K_ij u_j| that cancel, so the rounding is a few eps times ‖K‖‖u‖ (100 eps is generous for

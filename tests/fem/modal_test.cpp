@@ -4,6 +4,7 @@
 
 #include "bench/lattice.hpp"
 #include "support/beam_models.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,8 +21,8 @@ using fem::ModalEngine;
 
 namespace {
 
-constexpr double eps = std::numeric_limits<double>::epsilon();
-constexpr double pi = std::numbers::pi;
+using jointid::test::eps;
+using jointid::test::pi;
 
 // Roots βL of the beam characteristic equations, by Newton from a nearby start:
 // cantilever 1 + cos x cosh x = 0, free–free 1 − cos x cosh x = 0.

@@ -6,6 +6,7 @@
 #include "fem/damping.hpp"
 #include "joints/joint.hpp"
 #include "support/beam_models.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,8 +22,8 @@ using Complex = std::complex<double>;
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
-constexpr double eps = std::numeric_limits<double>::epsilon();
+using jointid::test::eps;
+using jointid::test::pi;
 
 // Complex amplitude X of x(t) = Re(X e^{iωt}) by a DFT over whole periods (exact for a
 // periodic signal sampled uniformly with no aliasing at the fundamental).

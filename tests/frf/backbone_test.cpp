@@ -1,6 +1,7 @@
 #include "frf/backbone.hpp"
 
 #include "../support/cantilever.hpp"
+#include "support/numbers.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
@@ -14,7 +15,7 @@ using joints::Term;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 joints::Joint make(int node, std::vector<Term> terms, std::vector<double> values) {
   joints::Joint j{"joint", node, 0, Dof::uy, std::move(terms), std::move(values), {}, {}};

@@ -1,8 +1,10 @@
 // Response curves by continuation: against fixed-frequency harmonic balance, the exact linear
 // FRF, time integration from rest, and the Floquet multipliers of the bare structure.
 #include "frf/continuation.hpp"
+
 #include "frf/modal_model.hpp"
 #include "frf/substructure.hpp"
+#include "support/numbers.hpp"
 
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
@@ -26,7 +28,9 @@ using joints::Term;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::harmonic;
+
+using jointid::test::two_pi;
 
 joints::Joint make(std::string name, int node, std::vector<Term> terms,
                    std::vector<double> values) {
@@ -41,14 +45,6 @@ frf::ResponseBranch trace(const PaperCantilever& c, const std::vector<joints::Jo
                           double f0, double f1, frf::ContinuationOptions o = {}) {
   return frf::trace_response(c.H, js, c.system.dofs, {c.eq(7)}, frf::sine_force(F0), {c.eq(7)}, f0,
                              f1, o);
-}
-
-// Harmonic k of a periodic record sampled over whole periods: x = Re Σ X_k e^{ikωt}.
-Complex harmonic(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double omega, int k) {
-  Complex sum = 0.0;
-  for (Eigen::Index i = 0; i < x.size(); ++i)
-    sum += x(i) * std::polar(1.0, -k * omega * t(i));
-  return (k == 0 ? 1.0 : 2.0) / static_cast<double>(x.size()) * sum;
 }
 
 // Where the branch's frequency moves forwards (+1) or backwards (−1) at point i.

@@ -1,7 +1,9 @@
 // Harmonic balance against the exact linear solution and against time integration.
 #include "frf/continuation.hpp"
+
 #include "frf/harmonic_balance.hpp"
 #include "frf/hb_equations.hpp" // the small LU of the Newton steps
+#include "support/numbers.hpp"
 
 #include "fem/damping.hpp"
 #include "fem/time_integration.hpp"
@@ -23,7 +25,9 @@ using joints::Term;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::harmonic;
+
+using jointid::test::two_pi;
 
 joints::Joint make(std::string name, int node, int node_b, std::vector<Term> terms,
                    std::vector<double> values) {
@@ -34,14 +38,6 @@ joints::Joint make(std::string name, int node, int node_b, std::vector<Term> ter
 }
 
 using PaperCantilever = test::SynthesisedCantilever;
-
-// Harmonic k of a periodic record sampled over whole periods: x = Re Σ X_k e^{ikωt}.
-Complex harmonic(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double omega, int k) {
-  Complex sum = 0.0;
-  for (Eigen::Index i = 0; i < x.size(); ++i)
-    sum += x(i) * std::polar(1.0, -k * omega * t(i));
-  return (k == 0 ? 1.0 : 2.0) / static_cast<double>(x.size()) * sum;
-}
 
 } // namespace
 

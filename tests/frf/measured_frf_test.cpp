@@ -2,9 +2,11 @@
 // receptance it samples (and the error bound of a cubic), reciprocity, the band, and what
 // MeasuredFrf::validate refuses.
 #include "frf/measured_frf.hpp"
+
 #include "frf/receptance.hpp"
 #include "frf/substructure.hpp"
 #include "support/error_of.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,7 +22,7 @@ using test::error_of;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 // Two modes (10 Hz, ζ 1 %; 31 Hz, ζ 2 %) at two DOFs, mass-normalised shapes: the analytic
 // receptance the "measurement" samples.

@@ -4,6 +4,7 @@
 
 #include "support/beam_models.hpp"
 #include "support/cantilever.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,18 +20,11 @@ using fem::Dof;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::all_modes;
 
-fem::Modes all_modes(const fem::Assembled& s) {
-  fem::ModalOptions o;
-  o.num_modes = 0;
-  o.engine = fem::ModalEngine::dense;
-  return fem::modal_analysis(s, o);
-}
+using jointid::test::relative_difference;
 
-double relative_difference(const frf::CMatrix& a, const frf::CMatrix& b) {
-  return (a - b).norm() / b.norm();
-}
+using jointid::test::two_pi;
 
 // A cantilever with a few DOFs of interest: tip uy and rz, mid-span uy, node 3 uy.
 struct Cantilever {

@@ -6,6 +6,7 @@
 #include "support/beam_models.hpp"
 #include "support/cantilever.hpp"
 #include "support/failing_substructure.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,21 +22,14 @@ using fem::Dof;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::all_modes;
 
-double relative_difference(const frf::CMatrix& a, const frf::CMatrix& b) {
-  return (a - b).norm() / b.norm();
-}
+using jointid::test::relative_difference;
+
+using jointid::test::two_pi;
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
-}
-
-fem::Modes all_modes(const fem::Assembled& s) {
-  fem::ModalOptions o;
-  o.num_modes = 0;
-  o.engine = fem::ModalEngine::dense;
-  return fem::modal_analysis(s, o);
 }
 
 // A cantilever of 800 beam elements: 1600 equations, above the dense limit (1500).

@@ -4,6 +4,7 @@
 
 #include "support/beam_models.hpp"
 #include "support/failing_substructure.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,7 +19,7 @@ using fem::Dof;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 TEST(FrfSweep, OscillatorReceptanceMobilityAndAccelerance) {
   // m ẍ + c ẋ + k x = F e^{iωt} with c = α m (Rayleigh): H = 1 / (k − ω² m + iω c).

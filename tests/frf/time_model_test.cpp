@@ -12,6 +12,7 @@
 #include "support/beam_models.hpp"
 #include "support/cantilever.hpp"
 #include "support/error_of.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -29,7 +30,9 @@ using Complex = std::complex<double>;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::harmonic;
+
+using jointid::test::two_pi;
 
 joints::Joint joint(std::string name, int node, int node_b, std::vector<Term> terms,
                     std::vector<double> values) {
@@ -67,14 +70,6 @@ frf::ModalModel modal_model_of(const fem::Model& model, double below_hz,
     m.shapes.col(static_cast<Eigen::Index>(i)) = modes.phi.row(eq[i]).transpose();
   m.residual_flexibility = synthesis.residual_flexibility(eq, eq);
   return m;
-}
-
-// Harmonic k of samples over whole periods from t = 0 (x = Re Σ X_k e^{ikωt}).
-Complex harmonic(const Eigen::VectorXd& x, const Eigen::VectorXd& t, double omega, int k) {
-  Complex sum = 0.0;
-  for (Eigen::Index i = 0; i < x.size(); ++i)
-    sum += x(i) * std::polar(1.0, -k * omega * t(i));
-  return (k == 0 ? 1.0 : 2.0) / static_cast<double>(x.size()) * sum;
 }
 
 // The periodic steady state of a substructure with its joints under F0 sin(2π f t) at `force`.

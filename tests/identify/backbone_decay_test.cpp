@@ -5,7 +5,9 @@
 // extrema) and the damping ratio (the logarithmic decrement per half cycle, π D / √(1 − D²));
 // the backbone at the same amplitude must give both.
 #include "frf/backbone.hpp"
+
 #include "identify/random_tests.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +21,7 @@ using joints::Term;
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using jointid::test::pi;
 
 // One mode, f_r = 5 Hz, ζ = 0.5 %, φ = 0.5 at 1:uy (modal mass 4 kg), with a spring k and a
 // Jenkins element (kt, fs) to ground at 1:uy: the joint's slider dominates the damping once it

@@ -8,6 +8,7 @@
 #include "frf/receptance.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/cantilever_substructure.hpp"
 #include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
@@ -23,7 +24,8 @@ using namespace jointid;
 using namespace jointid::identify;
 
 namespace {
-const fem::NodeDof tip{7, fem::Dof::uy};
+using jointid::test::cantilever;
+using jointid::test::tip;
 
 joints::Joint joint(double k, double k3 = 1.6e8) {
   joints::Joint j{
@@ -31,11 +33,6 @@ joints::Joint joint(double k, double k3 = 1.6e8) {
       {k, 20.0, k3}, {}, {}};
   j.fixed.assign(3, true);
   return j;
-}
-
-const frf::Substructure& cantilever() {
-  static const frf::Substructure s(test::paper_cantilever());
-  return s;
 }
 
 // A "measured" record: the model with this joint, band-limited random force at the tip

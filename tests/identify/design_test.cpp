@@ -25,7 +25,7 @@ joints::Joint tip_joint(std::vector<Term> terms, std::vector<double> values) {
   return j;
 }
 
-const fem::NodeDof tip{7, fem::Dof::uy};
+using jointid::test::tip;
 
 // The paper's model I.
 std::vector<joints::Joint> model_I() {

@@ -9,6 +9,7 @@
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
 #include "support/failing_substructure.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,7 +21,7 @@ using joints::Term;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 joints::Joint make_joint(std::string name, int node, int node_b, std::vector<Term> terms,
                          std::vector<double> values) {
@@ -116,8 +117,6 @@ void expect_values(const identify::FitResult& r, const std::vector<joints::Joint
                   rel * std::abs(truth[i].values[t]))
           << truth[i].name << "." << joints::term_name(truth[i].terms[t]);
 }
-
-} // namespace
 
 TEST_F(FitTest, PaperModelIFromTimeIntegrationFrequencySweep) {
   const std::vector<joints::Joint> truth{
@@ -462,7 +461,6 @@ TEST_F(FitTest, MissingJointChannelNamesTheRecordAndChannel) {
 //                                [−fc, fc]; and stick–slip integration is only first order
 //                                at the transitions)
 // Bounds: about 4 times the measured error, at least 1e-5 (2e-5 for k).
-namespace {
 
 struct TermCase {
   double value;               ///< the term's coefficient (SI)
@@ -492,8 +490,6 @@ std::string term_case_name(const ::testing::TestParamInfo<Term>& info) {
 }
 
 class EveryTermTest : public ::testing::TestWithParam<Term> {};
-
-} // namespace
 
 TEST_P(EveryTermTest, SimulatedByTimeIntegrationAndRecovered) {
   const Term T = GetParam();
@@ -742,3 +738,5 @@ TEST(FitWithSubstructure, AModalAnalysisThatFailsIsTheFitsStatus) {
   EXPECT_TRUE(r.joints.empty());
   EXPECT_THROW(r.identified({j}), std::invalid_argument);
 }
+
+} // namespace

@@ -1,5 +1,7 @@
 #include "identify/harmonics.hpp"
 
+#include "support/numbers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +12,7 @@ using namespace jointid::identify;
 using cd = std::complex<double>;
 
 namespace {
-constexpr double pi = std::numbers::pi;
+using jointid::test::pi;
 
 // x(t) = 0.3 + Re(X1 e^{iωt}) + Re(X3 e^{3iωt}) with known complex amplitudes.
 const cd X1 = std::polar(2.0, 0.4), X3 = std::polar(0.5, -1.0);

@@ -8,6 +8,7 @@
 #include "frf/receptance.hpp"
 #include "identify/spectra.hpp"
 #include "support/error_of.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,8 +20,8 @@ namespace jointid::identify {
 namespace {
 
 using cd = std::complex<double>;
+using jointid::test::two_pi;
 using test::error_of;
-constexpr double two_pi = 2.0 * std::numbers::pi;
 constexpr double fs = 256.0;
 
 // Three DOFs (uy at nodes 1, 2, 3), modes at 10, 14 and 25 Hz.

@@ -3,6 +3,9 @@
 // and against Monte Carlo), stepped-sine rows, errors and warnings.
 #include "identify/measurement.hpp"
 
+#include "support/cantilever.hpp"
+#include "support/numbers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -18,9 +21,11 @@ using cd = std::complex<double>;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 constexpr double f_hz = 2.5, omega = two_pi * f_hz;
-const fem::NodeDof tip{7, fem::Dof::uy}, mid{4, fem::Dof::uy}, root{2, fem::Dof::rz};
+using jointid::test::mid;
+using jointid::test::tip;
+const fem::NodeDof root{2, fem::Dof::rz};
 
 // The displacement x(t) = X0 + Re Σ_{k=1..3} X_k e^{ikωt} (m) and the force F0 sin ωt plus a
 // small third harmonic (N): harmonics known exactly.

@@ -5,6 +5,7 @@
 
 #include "frf/receptance.hpp"
 #include "support/error_of.hpp"
+#include "support/numbers.hpp"
 #include "support/synthesised_cantilever.hpp"
 
 #include <gtest/gtest.h>
@@ -16,7 +17,7 @@
 namespace jointid::identify {
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 using test::error_of;
 
 // Lines f0, f0 + df, … up to f1 (Hz).

@@ -1,6 +1,7 @@
 #include "identify/one_mode_fit.hpp"
 
 #include "frf/backbone.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,7 +17,7 @@ using Complex = std::complex<double>;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 } // namespace
 

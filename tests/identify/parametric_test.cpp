@@ -8,6 +8,7 @@
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
 #include "support/failing_substructure.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,8 +20,8 @@
 namespace jointid {
 namespace {
 
+using jointid::test::pi;
 using joints::Term;
-constexpr double pi = std::numbers::pi;
 
 // The paper's cantilever tip: k, c and one parametric term.
 joints::Joint tip(Term term, const std::vector<double>& parameters, bool fixed = false) {

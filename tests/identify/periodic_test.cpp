@@ -8,6 +8,8 @@
 #include "identify/output_error.hpp"
 #include "identify/random_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/cantilever_substructure.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,9 +23,10 @@ using namespace jointid::identify;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 using Complex = std::complex<double>;
-const fem::NodeDof tip{7, fem::Dof::uy};
+using jointid::test::cantilever;
+using jointid::test::tip;
 
 joints::Joint joint(std::string name, int node, int node_b, std::vector<joints::Term> terms,
                     std::vector<double> values) {
@@ -36,11 +39,6 @@ joints::Joint joint(std::string name, int node, int node_b, std::vector<joints::
 joints::Joint model_one() {
   return joint("tip", 7, 0, {joints::Term::k, joints::Term::c, joints::Term::c2, joints::Term::k3},
                {4800.0, 20.0, 500.0, 1.6e8});
-}
-
-const frf::Substructure& cantilever() {
-  static const frf::Substructure s(test::paper_cantilever());
-  return s;
 }
 
 // A multisine virtual test of the cantilever: force at `at`, 1–8 Hz, period 4 s, 256 Hz, from

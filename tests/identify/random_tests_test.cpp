@@ -5,6 +5,7 @@
 #include "fem/excitation.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/cantilever_substructure.hpp"
 #include "support/failing_substructure.hpp"
 
 #include <gtest/gtest.h>
@@ -17,9 +18,11 @@ using namespace jointid;
 using namespace jointid::identify;
 
 namespace {
-const fem::NodeDof tip{7, fem::Dof::uy}, mid{4, fem::Dof::uy};
+using jointid::test::cantilever;
+using jointid::test::mid;
+using jointid::test::tip;
 
-joints::Joint model_one() {
+joints::Joint random_model_one() {
   joints::Joint j{"tip",
                   7,
                   0,
@@ -30,11 +33,6 @@ joints::Joint model_one() {
                   {}};
   j.fixed.assign(4, true);
   return j;
-}
-
-const frf::Substructure& cantilever() {
-  static const frf::Substructure s(test::paper_cantilever());
-  return s;
 }
 
 ForceInput random_input() {
@@ -52,9 +50,9 @@ TEST(RandomTests, RecordLayoutAndRoutesAgree) {
   o.fade_in_s = 0.5;
   o.quantities = {Quantity::displacement, Quantity::velocity, Quantity::acceleration};
   o.route = TransientRoute::full;
-  const ForcedTest full = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const ForcedTest full = simulate_forced(cantilever(), {random_model_one()}, random_input(), o);
   o.route = TransientRoute::modal; // modes below 128 Hz (4 of 12) and a static correction
-  const ForcedTest modal = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const ForcedTest modal = simulate_forced(cantilever(), {random_model_one()}, random_input(), o);
   EXPECT_EQ(modal.modes_kept, 4);
   EXPECT_EQ(modal.static_columns, 2); // the force DOF and the joint DOF
   // force, then x v a at the joint DOF (7:uy) and at the force DOF (4:uy)
@@ -82,7 +80,7 @@ TEST(RandomTests, RecordLayoutAndRoutesAgree) {
     EXPECT_LT(error, tolerance) << full.record.channels[c].name();
   }
   o.modal_cutoff_hz = 1000.0;
-  const ForcedTest more = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const ForcedTest more = simulate_forced(cantilever(), {random_model_one()}, random_input(), o);
   const Eigen::VectorXd& a = full.record.channels[3].samples;
   const double error =
       (a - more.record.channels[3].samples).cwiseAbs().maxCoeff() / a.cwiseAbs().maxCoeff();
@@ -102,12 +100,12 @@ TEST(RandomTests, AModalCutoffBelowTheForcesBandWarns) {
   o.fade_in_s = 0.5;
   o.quantities = {Quantity::displacement, Quantity::velocity};
   o.route = TransientRoute::full;
-  const ForcedTest full = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const ForcedTest full = simulate_forced(cantilever(), {random_model_one()}, random_input(), o);
   o.route = TransientRoute::modal;
-  const ForcedTest whole = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const ForcedTest whole = simulate_forced(cantilever(), {random_model_one()}, random_input(), o);
   EXPECT_TRUE(whole.warnings.empty()) << whole.warnings.front();
   o.modal_cutoff_hz = 10.0;
-  const ForcedTest cut = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const ForcedTest cut = simulate_forced(cantilever(), {random_model_one()}, random_input(), o);
   ASSERT_EQ(cut.warnings.size(), 1u);
   EXPECT_EQ(cut.warnings[0].rfind("modal route: 1 mode between the modal cutoff, 10 Hz, and ", 0),
             0u)
@@ -132,7 +130,7 @@ TEST(RandomTests, ForceChannelsOfARecordDriveTheModel) {
   ForcedOptions o;
   o.route = TransientRoute::full;
   o.fade_in_s = 0.5;
-  const ForcedTest made = simulate_forced(cantilever(), {model_one()}, random_input(), o);
+  const ForcedTest made = simulate_forced(cantilever(), {random_model_one()}, random_input(), o);
   Record measured = made.record;
   measured.source = "made.csv";
   const ForceInput in = force_input(measured);
@@ -140,7 +138,7 @@ TEST(RandomTests, ForceChannelsOfARecordDriveTheModel) {
   EXPECT_EQ(in.at[0], mid);
   EXPECT_NEAR(in.sample_rate_hz, 256.0, 1e-9);
   o.fade_in_s = 0.0; // the record's force is already faded in
-  const ForcedTest again = simulate_forced(cantilever(), {model_one()}, in, o);
+  const ForcedTest again = simulate_forced(cantilever(), {random_model_one()}, in, o);
   const Eigen::VectorXd& a = made.record.channels[1].samples;
   EXPECT_LT((again.record.channels[1].samples - a).cwiseAbs().maxCoeff(),
             1e-9 * a.cwiseAbs().maxCoeff());
@@ -254,7 +252,7 @@ TEST(RandomTests, NumericalFailuresAreTheTestsStatusWithTheirReason) {
   // A softening cubic (k3 < 0) under 300 N RMS faded in over 0.2 s: the tip runs away, the
   // joint force overflows and its Newton iteration fails at a step (the command-line test's
   // case, `jointid simulate` fading in over 5 % of the 4 s).
-  joints::Joint soft = model_one();
+  joints::Joint soft = random_model_one();
   soft.values = {4800.0, 20.0, 0.0, -1.6e8};
   const ForceInput hard =
       generated_force({Excitation::random, 2.0, 10.0, 300.0, 1, 4.0, 128.0}, tip);

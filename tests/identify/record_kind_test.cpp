@@ -2,6 +2,9 @@
 // its force channel (or its comments); anything else refused, saying so.
 #include "identify/record_kind.hpp"
 
+#include "support/cantilever.hpp"
+#include "support/numbers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,8 +18,8 @@ using namespace jointid::identify;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
-const fem::NodeDof tip{7, fem::Dof::uy};
+using jointid::test::tip;
+using jointid::test::two_pi;
 
 // A record of n samples at `rate` Hz whose force is f(t) (plus white noise of `noise` × its
 // RMS) and whose response is the force scaled (the kind is told from the force alone).

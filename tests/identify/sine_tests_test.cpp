@@ -5,7 +5,9 @@
 #include "fem/modal.hpp"
 #include "frf/receptance.hpp"
 #include "support/cantilever.hpp"
+#include "support/cantilever_substructure.hpp"
 #include "support/failing_substructure.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -23,18 +25,14 @@ using cd = std::complex<double>;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
-const fem::NodeDof tip{7, fem::Dof::uy};
+using jointid::test::cantilever;
+using jointid::test::tip;
+using jointid::test::two_pi;
 
 joints::Joint make_joint(std::vector<Term> terms, std::vector<double> values) {
   joints::Joint j{"tip", 7, 0, fem::Dof::uy, std::move(terms), std::move(values), {}, {}};
   j.fixed.assign(j.terms.size(), true);
   return j;
-}
-
-const frf::Substructure& cantilever() {
-  static const frf::Substructure s(test::paper_cantilever());
-  return s;
 }
 
 // Harmonic k of samples over whole periods starting at t(0) (DFT; phase relative to t = 0).

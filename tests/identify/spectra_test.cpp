@@ -7,6 +7,7 @@
 #include "identify/random_tests.hpp"
 #include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +20,7 @@ using namespace jointid;
 using namespace jointid::identify;
 
 namespace {
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 Eigen::VectorXd sine(double amplitude, double f, double fs, int n, double phase = 0.3) {
   Eigen::VectorXd x(n);

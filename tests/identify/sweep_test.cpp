@@ -3,6 +3,9 @@
 // error they actually have.
 #include "identify/sweep.hpp"
 
+#include "support/cantilever.hpp"
+#include "support/numbers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,9 +21,9 @@ using namespace jointid::identify;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 using Complex = std::complex<double>;
-const fem::NodeDof tip{7, fem::Dof::uy};
+using jointid::test::tip;
 
 // One degree of freedom: m = 1 kg, 5 Hz, damping ratio ζ.
 struct Oscillator {

@@ -15,6 +15,7 @@
 #include "io/test_files.hpp"
 #include "io/uff58.hpp"
 #include "support/error_of.hpp"
+#include "support/numbers.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -30,7 +31,7 @@ using test::error_of;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 // The cantilever of DESIGN.md (joint at 7:uy) by finite elements, and its FRFs from a force at
 // 7:uy to 7:uy and 4:uy at lines 0, h, 2h, … f_max.

@@ -6,6 +6,7 @@
 #include "io/files.hpp"
 #include "io/model_file.hpp"
 #include "io/test_files.hpp"
+#include "support/numbers.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -16,7 +17,7 @@
 namespace jointid {
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 // FRFs of a modal model of three DOFs (uy at nodes 1, 2, 3; modes at 8, 12.5 and 21 Hz) from
 // the driving point 3:uy, measured as acceleration at node 2, and the fit of them.

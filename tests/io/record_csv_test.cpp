@@ -1,6 +1,7 @@
 #include "io/record_csv.hpp"
 
 #include "identify/fit.hpp"
+#include "support/numbers.hpp"
 
 #include "io/files.hpp"
 #include "io/test_files.hpp"
@@ -21,11 +22,9 @@
 namespace jointid::io {
 namespace {
 
-using identify::Quantity;
+using jointid::test::same_bits;
 
-bool same_bits(double a, double b) {
-  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
-}
+using identify::Quantity;
 
 identify::Record sample_record() {
   identify::Record r;

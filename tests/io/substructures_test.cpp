@@ -4,6 +4,7 @@
 // of a joint to ground and a joint between the beams, with the second beam given by its finite
 // elements or by its measured FRF.
 #include "frf/sweep.hpp"
+
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "identify/sine_tests.hpp"
@@ -13,6 +14,7 @@
 #include "io/model_file.hpp"
 #include "io/test_files.hpp"
 #include "support/error_of.hpp"
+#include "support/numbers.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -28,7 +30,7 @@ using test::error_of;
 
 namespace {
 
-constexpr double two_pi = 2.0 * std::numbers::pi;
+using jointid::test::two_pi;
 
 // A steel cantilever along x at height y (m), `length` m in 6 beam elements, nodes first …
 // first + 6, fixed at the first node, 1 % modal damping; the finite element tables only.

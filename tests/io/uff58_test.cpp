@@ -9,6 +9,7 @@
 #include "io/record_csv.hpp"
 #include "io/test_files.hpp"
 #include "support/cantilever.hpp"
+#include "support/numbers.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -22,11 +23,9 @@
 namespace jointid::io {
 namespace {
 
-using identify::Quantity;
+using jointid::test::same_bits;
 
-bool same_bits(double a, double b) {
-  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
-}
+using identify::Quantity;
 
 // A time response written by hand after the standard: real single precision (ordinate type 2),
 // 8 values evenly spaced at 12.5 ms, displacement in mm at node 7, +Y; the response entity name
@@ -172,7 +171,7 @@ TEST_F(Uff58Test, ReadsAHandWrittenFileFieldByField) {
 
 // A record with force, displacement and velocity whose values need all 17 digits, or none, or
 // sit at the edges of double precision.
-identify::Record sample_record() {
+identify::Record uff_sample_record() {
   identify::Record r;
   r.source = "sample.csv";
   const int n = 40;
@@ -237,7 +236,7 @@ void expect_same_function(const Uff58Function& a, const Uff58Function& b) {
 }
 
 TEST_F(Uff58Test, RecordRoundTripIsBitExactInAsciiAndBinary) {
-  const identify::Record r = sample_record();
+  const identify::Record r = uff_sample_record();
   const std::vector<Uff58Function> functions = uff58_from_record(r);
   ASSERT_EQ(functions.size(), 3u);
   EXPECT_EQ(functions[0].id_lines[0], "f@7:uy");

@@ -3,6 +3,8 @@
 // derivative against finite differences, and the clearance's force and slope.
 #include "joints/hysteresis.hpp"
 
+#include "support/numbers.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,7 +15,7 @@ using namespace jointid::joints;
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using jointid::test::pi;
 
 // y = a sin θ at N samples θ_n = 2πn/N (N a multiple of 4: the peaks ±a are samples).
 std::vector<double> sine(double a, int N) {

@@ -3,6 +3,7 @@
 #include "report/chart.hpp"
 
 #include "io/test_files.hpp"
+#include "support/display.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,13 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 using Style = Series::Style;
 
-bool have_display() {
-  const char* display = std::getenv("DISPLAY");
-  return display != nullptr && *display != '\0';
-}
-
-constexpr const char* no_display = "no X display: Debian's VTK renders through GLX; ctest runs "
-                                   "these tests as io_vtk_png under xvfb-run -a";
+using jointid::test::have_display;
+using jointid::test::no_display;
 
 /// A picture read back: width, height and RGB of each pixel, row 0 at the bottom (as VTK).
 struct Picture {

@@ -5,6 +5,7 @@
 #include "fem/assembly.hpp"
 #include "io/test_files.hpp"
 #include "report/vtk_models.hpp"
+#include "support/display.hpp"
 
 #include <gtest/gtest.h>
 
@@ -102,13 +103,8 @@ std::vector<std::string> pvd_files(const fs::path& pvd) {
   return files;
 }
 
-bool have_display() {
-  const char* display = std::getenv("DISPLAY");
-  return display != nullptr && *display != '\0';
-}
-
-constexpr const char* no_display = "no X display: Debian's VTK renders through GLX; ctest runs "
-                                   "these tests as io_vtk_png under xvfb-run -a";
+using jointid::test::have_display;
+using jointid::test::no_display;
 
 // ----- mesh.vtu and modes.vtu -----------------------------------------------------------------
 

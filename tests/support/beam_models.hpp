@@ -2,6 +2,7 @@
 // Small models built in code for the fem/, joints/ and frf/ tests: uniform beams along x and a
 // single-DOF spring–mass oscillator. Analytic references for these live in the tests.
 #include "fem/assembly.hpp"
+#include "fem/modal.hpp"
 #include "fem/model.hpp"
 
 #include <Eigen/Dense>
@@ -9,6 +10,14 @@
 #include <vector>
 
 namespace jointid::test {
+
+// Every mode of an assembled system (the dense engine): the modal references of the tests.
+inline fem::Modes all_modes(const fem::Assembled& s) {
+  fem::ModalOptions o;
+  o.num_modes = 0;
+  o.engine = fem::ModalEngine::dense;
+  return fem::modal_analysis(s, o);
+}
 
 /// Uniform beam properties (SI).
 struct BeamProperties {

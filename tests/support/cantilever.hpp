@@ -2,6 +2,7 @@
 // The paper's 6-element cantilever (METHOD.md), built in code for tests that must not depend
 // on the model-file reader: steel, L = 2 m, width 0.25 m, thickness 14.3623 mm (first mode
 // 3.000 Hz), clamped at node 1, 1 % modal damping.
+#include "fem/dof.hpp"
 #include "fem/model.hpp"
 
 namespace jointid::test {
@@ -21,5 +22,8 @@ inline fem::Model paper_cantilever(int elements = 6) {
   m.damping.modal_ratio = 0.01;
   return m;
 }
+
+// Its tip and mid-span deflections.
+inline const fem::NodeDof tip{7, fem::Dof::uy}, mid{4, fem::Dof::uy};
 
 } // namespace jointid::test
