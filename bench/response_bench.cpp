@@ -28,19 +28,54 @@ void BM_ResponseCurve(benchmark::State& state) {
   frf::ContinuationOptions o;
   o.hb.harmonics = static_cast<int>(state.range(0));
   o.stability = state.range(1) != 0;
-  std::size_t points = 0, folds = 0;
+  std::size_t points = 0, folds = 0, checked = 0;
   for (auto _ : state) {
     const frf::ResponseCurves c =
         frf::response_curves(sub, {j}, {7, fem::Dof::uy}, {80.0}, 15.0, 30.0, o);
     points = c.curves[0].points.size();
     folds = c.curves[0].folds.size();
+    checked = 0;
+    for (const auto& p : c.curves[0].points)
+      checked += p.stability_checked;
     benchmark::DoNotOptimize(c);
   }
   state.counters["points"] = static_cast<double>(points);
   state.counters["folds"] = static_cast<double>(folds);
+  state.counters["checked"] = static_cast<double>(checked);
   state.counters["per_point"] = benchmark::Counter(static_cast<double>(points),
                                                    benchmark::Counter::kIsIterationInvariantRate |
                                                        benchmark::Counter::kInvert);
+}
+
+// The same cantilever and band with each hysteretic or non-smooth joint kind at the tip (k = 4800
+// N/m, c = 2 N s/m beside it), K = 5: range(0) 0 a Jenkins element (kt 5000 N/m, fs 2 N) at
+// 20 N, 1 an Iwan (fs 5 N, kt 1e4 N/m, chi −0.5, beta 0.1: 100 sliders) at 20 N, 2 a gap
+// (delta 1 mm, kg 1e5 N/m) at 20 N; range(1): 1 with stability.
+void BM_ResponseCurveKind(benchmark::State& state) {
+  const frf::Substructure sub{test::paper_cantilever()};
+  const int kind = static_cast<int>(state.range(0));
+  const Term term = kind == 0 ? Term::jenkins : kind == 1 ? Term::iwan : Term::gap;
+  joints::Joint j{"tip", 7, 0, fem::Dof::uy, {Term::k, Term::c, term}, {4800.0, 2.0, 1.0}, {}, {}};
+  j.fixed.assign(3, true);
+  if (kind == 0) j.set_parameters(2, {5000.0, 2.0});
+  if (kind == 1) j.set_parameters(2, {5.0, 1.0e4, -0.5, 0.1});
+  if (kind == 2) j.set_parameters(2, {1e-3, 1e5});
+  frf::ContinuationOptions o;
+  o.hb.harmonics = 5;
+  o.stability = state.range(1) != 0;
+  std::size_t points = 0, checked = 0, unstable = 0;
+  for (auto _ : state) {
+    const frf::ResponseCurves c =
+        frf::response_curves(sub, {j}, {7, fem::Dof::uy}, {20.0}, 15.0, 30.0, o);
+    points = c.curves[0].points.size();
+    checked = unstable = 0;
+    for (const auto& p : c.curves[0].points)
+      checked += p.stability_checked, unstable += p.stable.has_value() && !*p.stable;
+    benchmark::DoNotOptimize(c);
+  }
+  state.counters["points"] = static_cast<double>(points);
+  state.counters["checked"] = static_cast<double>(checked);
+  state.counters["unstable"] = static_cast<double>(unstable);
 }
 
 // range(0): samples a period; range(1): 1 with the derivative. The deformation: a fundamental
@@ -71,4 +106,5 @@ BENCHMARK(BM_ResponseCurve)
     ->Args({9, 0})
     ->Args({9, 1})
     ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ResponseCurveKind)->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

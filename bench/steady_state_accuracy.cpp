@@ -18,8 +18,8 @@
 // relative to |X_1,ref|, the cross-check measure of the tests. Reference: see below (printed
 // with its own check).
 //
-//   bench_steady_state_accuracy [frequency Hz (4)] [amplitude N (80)]
-//   bench_steady_state_accuracy --profile CASE K Nt N   (CASE 0, 1, 2: the cases below in order)
+//   bench_steady_state_accuracy [frequency Hz (4)] [amplitude N (80)] [case name's start]
+//   bench_steady_state_accuracy --profile CASE K Nt N   (CASE 0 … 3: the cases below in order)
 //   bench_steady_state_accuracy --profile CASE 0 STEPS ε
 // The second form only solves one harmonic-balance point N times to 1e-5 (the bench's
 // tolerance at ε = 1e-4), for an instruction profile (valgrind --tool=callgrind) or perf;
@@ -72,6 +72,15 @@ template <class F> double time_of(F&& f, double min_s = 0.1, int batches = 5) {
   return best;
 }
 
+// k + c + a 100-slider iwan (issue 32's speed target): fs 60 N, kt 2e4 N/m, chi −0.5, beta 0.1.
+// At 80 N and 4 Hz (|X1| 11 mm, kt |X1| = 220 N > fs) it slides in macroslip every half cycle;
+// at 20 N it stays in microslip.
+joints::Joint iwan_joint() {
+  joints::Joint j = joint({Term::k, Term::c, Term::iwan}, {4800.0, 20.0, 1.0});
+  j.set_parameters(2, {60.0, 2.0e4, -0.5, 0.1});
+  return j;
+}
+
 struct Case {
   std::string name;
   joints::Joint joint;
@@ -117,8 +126,11 @@ int main(int argc, char** argv) {
       {"k + c + c2 + k3 (model I)",
        joint({Term::k, Term::c, Term::c2, Term::k3}, {4800.0, 20.0, 500.0, 1.6e8})},
       {"k + c + k3 + fc (exact friction)",
-       joint({Term::k, Term::c, Term::k3, Term::fc}, {4800.0, 20.0, 1.6e8, 3.0})}};
+       joint({Term::k, Term::c, Term::k3, Term::fc}, {4800.0, 20.0, 1.6e8, 3.0})},
+      {"k + c + iwan (100 sliders)", iwan_joint()}};
   const std::vector<double> targets{1e-3, 1e-4, 1e-6};
+  // argv[3], if given: only the case whose name starts with it (e.g. "k + c + iwan").
+  const std::string only = argc > 3 && !profile ? argv[3] : "";
   if (profile && std::atoi(argv[3]) == 0) { // time integration: --profile CASE 0 STEPS EPS
     const Case& c = cases.at(static_cast<std::size_t>(std::atoi(argv[2])));
     const std::vector<joints::Joint> js{c.joint};
@@ -159,6 +171,7 @@ int main(int argc, char** argv) {
   }
   std::printf("paper cantilever, joint at 7:uy, %.3g N at %.3g Hz\n", F0, f);
   for (const Case& c : cases) {
+    if (!c.name.starts_with(only)) continue;
     const std::vector<joints::Joint> js{c.joint};
     auto hb_solve = [&](int K, int Nt, double tol) {
       frf::HarmonicBalanceOptions o;
@@ -180,7 +193,8 @@ int main(int argc, char** argv) {
     // is ~1e-8). Exact friction: the harmonic balance converges slowly in K (the force jumps at
     // the stick–slip transitions: 3e-5 still at K = 120), so the reference is the time
     // integration at 32768 steps, checked against 16384 (its own convergence).
-    const bool friction = c.joint.term_index(Term::fc) >= 0;
+    // (Hysteretic joints likewise: their force has a kink wherever a slider starts to slip.)
+    const bool friction = c.joint.term_index(Term::fc) >= 0 || c.joint.has_hysteretic_terms();
     const Eigen::VectorXcd td_fine = td_harmonics(td_solve(32768, 1e-12), omega);
     Eigen::VectorXcd Xref = td_fine;
     double check = 0.0;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -178,6 +179,17 @@ public:
       throw std::invalid_argument("backbone: the substructure is given by measured FRFs, which "
                                   "have no modes to self-excite; give it by a model or [modal]");
     if (o.points < 2) throw std::invalid_argument("backbone: expected at least 2 points");
+    if (o.hb.exact_friction)
+      for (const joints::Joint& j : joints) {
+        const int t = j.term_index(joints::Term::fc);
+        if (t >= 0 && j.values[static_cast<std::size_t>(t)] != 0.0)
+          throw std::invalid_argument(
+              "backbone: joint '" + j.name +
+              "' has dry friction (fc): at small amplitudes it sticks and does not deform, so "
+              "its deformation cannot carry the backbone from the linear mode (that of the "
+              "joint held rigid); give the joint a stiffness in stick instead, a jenkins (kt, "
+              "fs) or iwan term");
+      }
     const int m = H.num_modes();
     if (mode < 1 || mode > m)
       throw std::invalid_argument("backbone: mode " + std::to_string(mode) +
@@ -199,8 +211,12 @@ public:
         P.transpose() * k.asDiagonal() * P;
     const Eigen::MatrixXd Cm =
         Eigen::MatrixXd(H.modal_damping().asDiagonal()) + P.transpose() * c.asDiagonal() * P;
+    P_ = P;
+    for (const joints::Joint& j : linear_joints_)
+      free_ = free_ && j.values[0] == 0.0 && j.values[1] == 0.0;
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Km);
     const Eigen::VectorXd v = eig.eigenvectors().col(mode - 1);
+    mode_vector_ = v;
     const Eigen::VectorXd y = P * v;
     Eigen::Index ref = 0;
     const double largest = y.cwiseAbs().maxCoeff(&ref);
@@ -229,8 +245,26 @@ public:
     Y.row(1) = shape0_.cast<Complex>().transpose();
     ModeState s;
     s.omega = omega0_, s.xi = xi0_;
-    s.z = lin.pack(Y, s.omega, s.xi);
     LinearMode out;
+    if (free_) {
+      // No joint has a linear term (a cubic spring alone, a gap with clearance, friction): the
+      // linear mode is the substructure's own, exactly (no joint force, so neither the
+      // residual flexibility nor the damping's coupling enters), and its (ω, ξ) is a pole of
+      // the receptance, where the EPMC's equations cannot be evaluated.
+      const std::array<int, 1> at{amplitude_equation_};
+      const double x = (H_.shapes(at) * mode_vector_)(0);
+      const double y = (P_ * mode_vector_)(reference_);
+      s.a = 1.0;
+      linear_state_ = s;
+      linear_Y_ = Y;
+      out.frequency_hz = omega0_ / two_pi;
+      out.damping_ratio = xi0_ / (2.0 * omega0_);
+      out.self_excitation = xi0_;
+      out.joint_shape = shape0_;
+      out.amplitude_ratio = amplitude_ratio_ = std::abs(x / y);
+      return out;
+    }
+    s.z = lin.pack(Y, s.omega, s.xi);
     if (!lin.solve(s, 1.0, why)) return out;
     linear_state_ = s;
     const BackbonePoint p = lin.point(s);
@@ -246,20 +280,36 @@ public:
   // The backbone over joint amplitudes a0 … a1 (linear() first).
   void trace(double a0, double a1, Backbone& out) const {
     const Epmc epmc(H_, joints_, dofs_, amplitude_equation_, reference_, o_.hb);
+    const int n = o_.points;
+    auto amplitude = [&](int i) {
+      return a0 * std::pow(a1 / a0, static_cast<double>(i) / (n - 1));
+    };
     ModeState s = *linear_state_;
-    s.z = epmc.pack(linear_Y_ * a0, s.omega, s.xi);
+    int i = 0;
+    if (free_) {
+      // From the pole: the describing functions' estimate (the joints' equivalent stiffness and
+      // damping in the linear mode's shape), in modal coordinates. Where the joints exert no
+      // force at all (a clearance not yet closed) the point is the linear mode itself.
+      std::optional<ModeState> start;
+      for (; i < n && !(start = equivalent_linear(epmc, amplitude(i))); ++i)
+        out.points.push_back(linear_point(amplitude(i)));
+      if (!start) return;
+      s = *start;
+    }
+    const double first = amplitude(i);
+    s.z = epmc.pack(linear_Y_ * first, s.omega, s.xi);
     std::string why;
-    if (!epmc.solve(s, a0, why)) {
+    if (!epmc.solve(s, first, why)) {
       out.status = fem::Status::failure(fem::Status::Code::not_converging,
-                                        "backbone: no solution at the first amplitude, " +
-                                            significant(a0, 4) + " (joint deformation): " + why);
+                                        "backbone: no solution at " +
+                                            std::string(i == 0 ? "the first amplitude, " : "") +
+                                            significant(first, 4) + " (joint deformation): " + why);
       return;
     }
     out.points.push_back(epmc.point(s));
     std::optional<ModeState> before;
-    const int n = o_.points;
-    for (int i = 1; i < n; ++i) {
-      const double a = a0 * std::pow(a1 / a0, static_cast<double>(i) / (n - 1));
+    for (++i; i < n; ++i) {
+      const double a = amplitude(i);
       if (!advance(epmc, s, before, a, 0, why)) {
         out.status = fem::Status::failure(
             fem::Status::Code::not_converging,
@@ -272,6 +322,51 @@ public:
   }
 
 private:
+  // The joints' describing functions N_j = G_1,j / Y_1,j at the linear mode's shape times a (the
+  // first harmonic of their forces, from the EPMC's equations slightly off the pole), taken as
+  // springs Re N and dampers Im N / ω in the modal coordinates of the linear mode: that mode's
+  // (ω, ξ). Empty when no joint exerts a force there.
+  std::optional<ModeState> equivalent_linear(const Epmc& epmc, double a) const {
+    const double w = omega0_ * (1.0 + 1e-3);
+    const ModeFrame f = epmc.frame(w, xi0_);
+    const Eigen::MatrixXcd Y = linear_Y_ * a;
+    const Eigen::VectorXd z = f.hb->first_guess(*f.eq, &Y);
+    const Eigen::MatrixXcd G = f.eq->forces(z);
+    const auto nj = static_cast<Eigen::Index>(joints_.size());
+    Eigen::VectorXd k = Eigen::VectorXd::Zero(nj), c = Eigen::VectorXd::Zero(nj);
+    for (Eigen::Index j = 0; j < nj; ++j)
+      if (std::abs(Y(1, j)) > 0.0) {
+        const Complex N = G(1, j) / Y(1, j);
+        k(j) = N.real(), c(j) = N.imag() / w;
+      }
+    if (k.isZero(0.0) && c.isZero(0.0)) return std::nullopt;
+    const Eigen::MatrixXd Km =
+        Eigen::MatrixXd(H_.natural_frequencies().array().square().matrix().asDiagonal()) +
+        P_.transpose() * k.asDiagonal() * P_;
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Km);
+    const Eigen::VectorXd v = eig.eigenvectors().col(mode_ - 1);
+    const Eigen::MatrixXd Cm =
+        Eigen::MatrixXd(H_.modal_damping().asDiagonal()) + P_.transpose() * c.asDiagonal() * P_;
+    ModeState s;
+    s.omega = std::sqrt(std::max(eig.eigenvalues()(mode_ - 1), 0.0));
+    s.xi = v.dot(Cm * v);
+    s.a = a;
+    if (!(s.omega > 0.0)) return std::nullopt;
+    return s;
+  }
+
+  // The linear mode at joint amplitude a (no joint has a linear term and none exerts a force).
+  BackbonePoint linear_point(double a) const {
+    BackbonePoint p;
+    p.amplitude = a * amplitude_ratio_;
+    p.joint_amplitude = a;
+    p.frequency_hz = omega0_ / two_pi;
+    p.self_excitation = xi0_;
+    p.damping_ratio = xi0_ / (2.0 * omega0_);
+    p.Y = linear_Y_ * a;
+    return p;
+  }
+
   // From s (and the point before it, for a secant prediction of ω and ξ in log amplitude) to
   // amplitude a; a failed step is halved (in log amplitude) up to max_refinements times.
   bool advance(const Epmc& epmc, ModeState& s, std::optional<ModeState>& before, double a,
@@ -304,6 +399,10 @@ private:
   int reference_ = 0;
   double omega0_ = 0.0, xi0_ = 0.0;
   Eigen::VectorXd shape0_;
+  Eigen::MatrixXd P_;            // the joints' deformations per mode
+  Eigen::VectorXd mode_vector_;  // the linear mode in the synthesis' modal coordinates
+  bool free_ = true;             // no joint has a linear term: the linear mode is a pole
+  double amplitude_ratio_ = 0.0; // the linear mode's, when free_
   std::optional<ModeState> linear_state_;
   Eigen::MatrixXcd linear_Y_;
 };

@@ -10,7 +10,12 @@
 /// ω and ξ; a phase (the reference joint's fundamental real) and the amplitude (its fundamental's
 /// modulus) close the system. The damping ratio is D = ξ / (2ω), the frequency ω / 2π. At small
 /// amplitude this is the linear mode of the structure with the joints' linear terms; ∂R/∂ω and
-/// ∂R/∂ξ are central differences (as the frequency continuation's ∂R/∂ω). SI units.
+/// ∂R/∂ξ are central differences (as the frequency continuation's ∂R/∂ω). Where no joint has a
+/// linear term the linear mode is the substructure's own (a pole of the receptance, taken in
+/// modal coordinates), the first point starts from the joints' describing functions, and the
+/// amplitudes where no joint exerts a force (a gap's clearance open) are that mode exactly.
+/// Exact dry friction is refused: it sticks at small amplitude, so the joint does not deform.
+/// SI units.
 #include "fem/dof.hpp"
 #include "fem/status.hpp"
 #include "frf/harmonic_balance.hpp"

@@ -167,8 +167,10 @@ Eigen::VectorXcd hysteretic_monodromy(const std::vector<joints::Joint>& joints,
   }
   const int dim = 2 * n + states;
   // The joints' force perturbation δg (nj × columns) at time t, grid sample i, for states X.
+  // (Work arrays sized once: nothing is allocated inside the steps.)
   Eigen::VectorXd gyt(nj);
-  Eigen::MatrixXd H0(nj, dim), dy(nj, dim), dg(nj, dim);
+  Eigen::MatrixXd H0(nj, dim), dy(nj, dim), dg(nj, dim), Pv(nj, dim), rhs(nj, dim), A(nj, nj);
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu(nj);
   auto perturbation = [&](double t, std::size_t i, const Eigen::MatrixXd& X, bool want_force) {
     sample(t);
     gyt = gy;
@@ -180,29 +182,36 @@ Eigen::VectorXcd hysteretic_monodromy(const std::vector<joints::Joint>& joints,
       for (std::size_t e = L.start[i]; e < L.start[i + 1]; ++e)
         H0.row(j) += L.weights[e].second * X.row(2 * n + L.weights[e].first);
     }
-    const Eigen::MatrixXd Pv = P * X.middleRows(n, n);
-    const Eigen::MatrixXd A =
-        Eigen::MatrixXd::Identity(nj, nj) + R * gyt.asDiagonal(); // I + R G_y'
-    dy = A.partialPivLu().solve(P * X.topRows(n) - R * (gv.asDiagonal() * Pv) - R * H0);
-    if (want_force) dg = gyt.asDiagonal() * dy + gv.asDiagonal() * Pv + H0;
+    Pv.noalias() = P * X.middleRows(n, n);
+    A.noalias() = R * gyt.asDiagonal(); // I + R G_y'
+    A.diagonal().array() += 1.0;
+    lu.compute(A);
+    rhs.noalias() = P * X.topRows(n);
+    H0 += gv.asDiagonal() * Pv; // (G_ẏ P δq̇ + h0, reused below)
+    rhs.noalias() -= R * H0;
+    dy.noalias() = lu.solve(rhs);
+    if (want_force) dg.noalias() = gyt.asDiagonal() * dy + H0;
   };
-  auto rate = [&](double t, std::size_t i, const Eigen::MatrixXd& X) {
+  auto rate = [&](double t, std::size_t i, const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) {
     perturbation(t, i, X, true);
-    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(dim, dim);
+    Y.setZero();
     const auto q = X.topRows(n), v = X.middleRows(n, n);
     Y.topRows(n) = v;
-    Y.middleRows(n, n) =
-        -(om.array().square().matrix().asDiagonal() * q) - d.asDiagonal() * v - P.transpose() * dg;
-    return Y;
+    Y.middleRows(n, n) = -(om.array().square().matrix().asDiagonal() * q) - d.asDiagonal() * v;
+    Y.middleRows(n, n).noalias() -= P.transpose() * dg;
   };
   Eigen::MatrixXd W = Eigen::MatrixXd::Identity(dim, dim);
+  Eigen::MatrixXd k1(dim, dim), k2 = k1, k3 = k1, k4 = k1, Wt = k1;
   for (long s = 0; s < steps; ++s) {
     const double t = static_cast<double>(s) * h;
     const auto i0 = static_cast<std::size_t>(s), i1 = static_cast<std::size_t>(s + 1) % N;
-    const Eigen::MatrixXd k1 = rate(t, i0, W);
-    const Eigen::MatrixXd k2 = rate(t + 0.5 * h, i1, W + 0.5 * h * k1);
-    const Eigen::MatrixXd k3 = rate(t + 0.5 * h, i1, W + 0.5 * h * k2);
-    const Eigen::MatrixXd k4 = rate(t + h, i1, W + h * k3);
+    rate(t, i0, W, k1);
+    Wt = W + 0.5 * h * k1;
+    rate(t + 0.5 * h, i1, Wt, k2);
+    Wt = W + 0.5 * h * k2;
+    rate(t + 0.5 * h, i1, Wt, k3);
+    Wt = W + h * k3;
+    rate(t + h, i1, Wt, k4);
     W += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
     // the anchors at the step's end take δy there
     bool any = false;
@@ -280,10 +289,12 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
   const double width = o.exact_friction ? 0.0 : o.friction_width;
   Eigen::VectorXd gy(nj), gv(nj);
   auto sample = [&](double t) {
+    const Complex e1 = std::polar(1.0, omega * t);
     for (int j = 0; j < nj; ++j) {
       double y = r.Y(0, j).real(), v = 0.0;
+      Complex e = 1.0;
       for (int k = 1; k <= K; ++k) {
-        const Complex e = std::polar(1.0, k * omega * t);
+        e *= e1; // e^{ikωt}
         y += (r.Y(k, j) * e).real();
         v += (Complex(0.0, k * omega) * r.Y(k, j) * e).real();
       }
@@ -291,13 +302,16 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
       detail::joint_force(joints[j], y, v, width, g, gy(j), gv(j));
     }
   };
-  Eigen::MatrixXd Sy(nj, nj), Sv(nj, nj);
+  Eigen::MatrixXd Sy(nj, nj), Sv(nj, nj), A(nj, nj), Ainv(nj, nj);
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu(nj);
   auto derivatives = [&](double t) {
     sample(t);
-    const Eigen::MatrixXd A = Eigen::MatrixXd::Identity(nj, nj) + gy.asDiagonal() * R; // I + Gy R
-    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(A);
-    Sy = lu.solve(Eigen::MatrixXd(gy.asDiagonal()));
-    Sv = lu.solve(Eigen::MatrixXd(gv.asDiagonal()));
+    A = gy.asDiagonal() * R; // I + Gy R
+    A.diagonal().array() += 1.0;
+    lu.compute(A);
+    Ainv = lu.inverse();
+    Sy.noalias() = Ainv * gy.asDiagonal();
+    Sv.noalias() = Ainv * gv.asDiagonal();
   };
   // Step: h ω_est ≤ 0.5 with ω_est² ≥ the largest stiffness over the period (Gershgorin-like
   // bound), and at least 16 steps per period of the highest harmonic.
@@ -329,7 +343,6 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
                std::to_string(steps) + " steps a period)";
     return out;
   }
-  const double h = T / static_cast<double>(steps);
   if (hysteretic) {
     out.multipliers = hysteretic_monodromy(joints, sliders, r, om, d, P, R, steps, sample, gy, gv);
     if (!out.multipliers.allFinite()) {
@@ -340,39 +353,122 @@ Stability floquet_stability(const ModalSynthesis& H, const std::vector<joints::J
     out.stable = out.multipliers.cwiseAbs().maxCoeff() < 1.0 + 1e-6;
     return out;
   }
-  // W = [δq; δq̇] for the 2n unit initial conditions; Ẇ = A(t) W.
+  // W = [δq; δq̇] for the 2n unit initial conditions; Ẇ = A(t) W. The joints' S_y, S_v are
+  // formed once per time — at the start, the middle and the end of each step, the end being the
+  // next step's start — and nothing is allocated inside the loop.
   Eigen::MatrixXd W = Eigen::MatrixXd::Identity(2 * n, 2 * n);
-  auto rate = [&](double t, const Eigen::MatrixXd& X) {
-    derivatives(t);
-    Eigen::MatrixXd Y(2 * n, 2 * n);
-    const auto q = X.topRows(n), v = X.bottomRows(n);
-    Y.topRows(n) = v;
-    Y.bottomRows(n) = -(om.array().square().matrix().asDiagonal() * q) - d.asDiagonal() * v -
-                      P.transpose() * (Sy * (P * q) + Sv * (P * v));
-    return Y;
+  struct Joints {
+    Eigen::MatrixXd Sy, Sv;
   };
-  for (long s = 0; s < steps; ++s) {
-    const double t = s * h;
-    const Eigen::MatrixXd k1 = rate(t, W);
-    const Eigen::MatrixXd k2 = rate(t + 0.5 * h, W + 0.5 * h * k1);
-    const Eigen::MatrixXd k3 = rate(t + 0.5 * h, W + 0.5 * h * k2);
-    const Eigen::MatrixXd k4 = rate(t + h, W + h * k3);
+  auto joints_at = [&](double t, Joints& j) {
+    derivatives(t);
+    j.Sy = Sy, j.Sv = Sv;
+  };
+  const Eigen::VectorXd om2 = om.array().square();
+  Eigen::MatrixXd Pq(nj, 2 * n), Pv(nj, 2 * n), G(nj, 2 * n);
+  // (lazy products for a few modes: there the blocked product's packing costs more than its
+  // arithmetic)
+  const bool small = n <= 16;
+  auto rate = [&](const Joints& j, const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) {
+    const auto q = X.topRows(n), v = X.bottomRows(n);
+    if (small) {
+      Pq.noalias() = P.lazyProduct(q), Pv.noalias() = P.lazyProduct(v);
+      G.noalias() = j.Sy.lazyProduct(Pq), G.noalias() += j.Sv.lazyProduct(Pv);
+    } else {
+      Pq.noalias() = P * q, Pv.noalias() = P * v;
+      G.noalias() = j.Sy * Pq, G.noalias() += j.Sv * Pv;
+    }
+    Y.topRows(n) = v;
+    Y.bottomRows(n) = -(om2.asDiagonal() * q) - d.asDiagonal() * v;
+    if (small)
+      Y.bottomRows(n).noalias() -= P.transpose().lazyProduct(G);
+    else
+      Y.bottomRows(n).noalias() -= P.transpose() * G;
+  };
+  // A half-wave symmetric orbit, y(t + T/2) = −y(t), of odd joint forces: their derivatives,
+  // even in (y, ẏ), repeat every half period, so the monodromy is the half period's squared
+  // (Φ(T) = Φ(T/2)²) and half the period is integrated.
+  bool half = true;
+  for (Eigen::Index k = 0; k <= K && half; k += 2)
+    half = r.Y.row(k).isZero(0.0);
+  for (const joints::Joint& j : joints)
+    for (std::size_t t = 0; t < j.terms.size() && half; ++t)
+      half = !joints::term_info(j.terms[t]).even || j.values[t] == 0.0;
+  const long span = half ? (steps + 1) / 2 : steps;
+  const double hs = (half ? 0.5 * T : T) / static_cast<double>(span);
+  Joints start{Sy, Sv}, middle = start, end = start;
+  Eigen::MatrixXd k1(2 * n, 2 * n), k2 = k1, k3 = k1, k4 = k1, Wt = k1;
+  joints_at(0.0, start);
+  for (long s = 0; s < span; ++s) {
+    const double h = hs, t = static_cast<double>(s) * h;
+    joints_at(t + 0.5 * h, middle);
+    joints_at(t + h, end);
+    rate(start, W, k1);
+    Wt = W + 0.5 * h * k1;
+    rate(middle, Wt, k2);
+    Wt = W + 0.5 * h * k2;
+    rate(middle, Wt, k3);
+    Wt = W + h * k3;
+    rate(end, Wt, k4);
     W += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    std::swap(start, end);
   }
   if (!W.allFinite()) {
     out.note = "not determined: the check diverged";
     return out;
   }
   out.multipliers = Eigen::EigenSolver<Eigen::MatrixXd>(W, false).eigenvalues();
+  if (half) out.multipliers = out.multipliers.array().square();
   out.stable = out.multipliers.cwiseAbs().maxCoeff() < 1.0 + 1e-6;
   return out;
 }
 
-ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
-                              const fem::DofMap& dofs, std::vector<int> force_equations,
-                              const Eigen::MatrixXcd& F, std::vector<int> outputs, double start_hz,
-                              double end_hz, const ContinuationOptions& o,
-                              const std::function<void(double)>& progress) {
+namespace {
+
+// The sign of the determinant of the even harmonics' block of the Jacobian of the equations
+// over all harmonics, at a half-wave symmetric solution z of the symmetric equations `eq`.
+// There the Jacobian is block-diagonal (odd, even): an even perturbation of a symmetric orbit
+// stays even. The even block is singular where a Floquet multiplier crosses +1 with an
+// asymmetric perturbation (a symmetry-breaking bifurcation), so its sign changes there.
+int even_block_sign(const HarmonicBalance& hb, const detail::Equations& eq,
+                    const Eigen::VectorXd& z, const std::vector<joints::Joint>& joints,
+                    const Eigen::MatrixXcd& F) {
+  const int blocks = eq.size() / eq.m();
+  // A start with even harmonics: the equations over all harmonics.
+  const Eigen::MatrixXcd asymmetric = Eigen::MatrixXcd::Ones(eq.K + 1, blocks);
+  const std::unique_ptr<detail::Equations> all = hb.equations(joints, F, &asymmetric);
+  Eigen::VectorXd za = Eigen::VectorXd::Zero(all->size());
+  all->pack(eq.unpack(z, blocks), za);
+  Eigen::MatrixXd J(all->size(), all->size());
+  all->residual(za, 1.0, &J);
+  std::vector<int> rows; // the even harmonics' unknowns, block by block
+  for (int b = 0; b < blocks; ++b) {
+    const int o = b * all->m();
+    rows.push_back(o); // the mean
+    for (int i = 1; i < all->count(); ++i)
+      if (all->harmonics[i] % 2 == 0)
+        rows.push_back(o + all->at(i)), rows.push_back(o + all->at(i) + 1);
+  }
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd E(n, n);
+  for (Eigen::Index r = 0; r < n; ++r)
+    for (Eigen::Index c = 0; c < n; ++c)
+      E(r, c) = J(rows[r], rows[c]);
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(E);
+  int sign = static_cast<int>(lu.permutationP().determinant());
+  for (Eigen::Index i = 0; i < n; ++i)
+    sign *= lu.matrixLU()(i, i) < 0.0 ? -1 : 1;
+  return sign;
+}
+
+// The branch's points without their stability, and per point the sign of the determinant of
+// the even harmonics' block of the all-harmonics Jacobian (`even`; empty unless the equations
+// are half-wave symmetric and stability is asked for).
+ResponseBranch trace_points(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
+                            const fem::DofMap& dofs, std::vector<int> force_equations,
+                            const Eigen::MatrixXcd& F, std::vector<int> outputs, double start_hz,
+                            double end_hz, const ContinuationOptions& o,
+                            const std::function<void(double)>& progress, std::vector<int>& even) {
   if (!(start_hz > 0.0) || !(end_hz > 0.0) || start_hz == end_hz)
     throw std::invalid_argument("response curve: the band needs two different frequencies > 0 "
                                 "Hz, got " +
@@ -487,11 +583,8 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
     p.hb.status = {};
     p.hb.iterations = st.iterations;
     p.hb.residual = st.residual;
-    if (o.stability && !exact_friction) {
-      const Stability stab = floquet_stability(H, joints, dofs, p.hb, o.hb);
-      p.stable = stab.stable;
-      if (stab.stable) p.max_multiplier = stab.multipliers.cwiseAbs().maxCoeff();
-    }
+    if (o.stability && !exact_friction && f.eq->symmetric())
+      even.push_back(even_block_sign(*f.hb, *f.eq, st.z, joints, F));
     branch.points.push_back(std::move(p));
   };
   // A fixed-frequency solve at ω from a guess (the last point at the band's end).
@@ -590,6 +683,74 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
     covered = std::max(covered, std::abs(s.omega - w0) / band);
     if (progress) progress(covered);
   }
+}
+
+// Each point's stability from Floquet multipliers computed at some of them (see
+// continuation.hpp): the first and last points, every `stride`-th, each fold and its
+// neighbours, both sides of each sign change of the even block's determinant; then every point
+// between two computed ones whose verdicts differ, until neighbouring computed points agree or
+// are adjacent. A point between two that agree takes their verdict.
+void assign_stability(ResponseBranch& branch, const std::vector<int>& even, int stride,
+                      const std::function<Stability(const HarmonicBalanceResult&)>& check) {
+  std::vector<ResponsePoint>& p = branch.points;
+  const std::size_t N = p.size();
+  if (N == 0) return;
+  std::vector<char> wanted(N, 0);
+  const auto want = [&](std::ptrdiff_t i) {
+    if (i >= 0 && static_cast<std::size_t>(i) < N) wanted[static_cast<std::size_t>(i)] = 1;
+  };
+  for (std::size_t i = 0; i < N; i += static_cast<std::size_t>(std::max(1, stride)))
+    want(static_cast<std::ptrdiff_t>(i));
+  want(static_cast<std::ptrdiff_t>(N) - 1);
+  for (int f : branch.folds)
+    want(f - 1), want(f), want(f + 1);
+  for (std::size_t i = 1; i < even.size() && i < N; ++i)
+    if (even[i] != even[i - 1])
+      want(static_cast<std::ptrdiff_t>(i) - 1), want(static_cast<std::ptrdiff_t>(i));
+  for (bool more = true; more;) {
+    for (std::size_t i = 0; i < N; ++i)
+      if (wanted[i] && !p[i].stability_checked) {
+        const Stability s = check(p[i].hb);
+        p[i].stable = s.stable;
+        if (s.stable) p[i].max_multiplier = s.multipliers.cwiseAbs().maxCoeff();
+        p[i].stability_checked = true;
+      }
+    more = false;
+    for (std::size_t a = 0, b = 1; b < N; ++b) {
+      if (!p[b].stability_checked) continue;
+      if (p[a].stable != p[b].stable && b > a + 1) {
+        for (std::size_t i = a + 1; i < b; ++i)
+          wanted[i] = 1;
+        more = true;
+      }
+      a = b;
+    }
+  }
+  for (std::size_t a = 0, b = 1; b < N; ++b) {
+    if (!p[b].stability_checked) continue;
+    for (std::size_t i = a + 1; i < b; ++i)
+      p[i].stable = p[a].stable;
+    a = b;
+  }
+}
+
+} // namespace
+
+ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints::Joint>& joints,
+                              const fem::DofMap& dofs, std::vector<int> force_equations,
+                              const Eigen::MatrixXcd& F, std::vector<int> outputs, double start_hz,
+                              double end_hz, const ContinuationOptions& o,
+                              const std::function<void(double)>& progress) {
+  if (o.stability_stride < 1)
+    throw std::invalid_argument("response curve: stability_stride must be at least 1");
+  std::vector<int> even;
+  ResponseBranch branch = trace_points(H, joints, dofs, std::move(force_equations), F,
+                                       std::move(outputs), start_hz, end_hz, o, progress, even);
+  if (o.stability && !has_exact_friction(joints, o.hb))
+    assign_stability(branch, even, o.stability_stride, [&](const HarmonicBalanceResult& r) {
+      return floquet_stability(H, joints, dofs, r, o.hb);
+    });
+  return branch;
 }
 
 ResponseCurves response_curves(const Substructure& sub, const std::vector<joints::Joint>& joints,

@@ -23,7 +23,9 @@
 ///     δq̈ + D δq̇ + Ω² δq + Pᵀ (S_y(t) P δq + S_v(t) P δq̇) = 0,   P = Bᵀ Φ_J,
 ///     [S_y, S_v] = (I + G_y R)⁻¹ [G_y, G_ẏ],   G = diag(∂g/∂y), diag(∂g/∂ẏ) on the orbit
 /// (the left-out modes' share of the joint's rate is neglected in the damping term), integrated
-/// over one period by the classical Runge–Kutta method (h ω_est ≤ 0.5). Stable when every
+/// over one period by the classical Runge–Kutta method (h ω_est ≤ 0.5) — over half of it when
+/// the orbit is half-wave symmetric and the joint forces odd: their derivatives then repeat
+/// every half period, and the monodromy is the half period's squared. Stable when every
 /// |μ| < 1 + 1e-6. On the tests' cantilever |μ|max at a fold is 1 to 6e-5 (1 − 2e-2 without R).
 /// With exact dry friction the force is set-valued and has no derivative while a joint sticks:
 /// stability is then not determined (reported as such, never guessed). A gap's force is
@@ -36,6 +38,20 @@
 /// undamped joint, 0.92, where the time integrator's perturbations decay by 0.42 a period). The
 /// loop is taken on the check's time steps, from rest over two periods (as the harmonic balance
 /// does on its samples).
+///
+/// Where the multipliers are computed. A point's stability changes only where a multiplier
+/// leaves the unit circle: at a fold (+1, located by the continuation), at a symmetry-breaking
+/// bifurcation (+1 with an asymmetric perturbation), at a period doubling (−1) or a torus
+/// bifurcation (a complex pair). The multipliers are computed at the first and last points, at
+/// every `stability_stride`-th point, at each fold and its two neighbours, and, when the
+/// equations are half-wave symmetric, on both sides of each sign change of the determinant of
+/// the even harmonics' block of the all-harmonics Jacobian (block-diagonal at a symmetric
+/// orbit; singular where an asymmetric perturbation has multiplier +1): every
+/// symmetry-breaking bifurcation is bracketed. Where two computed points disagree, every point
+/// between them is computed. A point between two computed points that agree takes their
+/// verdict (`stability_checked` false, `max_multiplier` NaN): only a period doubling or torus
+/// bifurcation and its return within fewer than `stability_stride` points could go unseen;
+/// `stability_stride = 1` computes every point.
 #include "frf/harmonic_balance.hpp"
 #include "frf/substructure.hpp"
 
@@ -53,13 +69,19 @@ struct ContinuationOptions {
   double max_step = 0.02;
   double min_step = 1e-7;
   int max_points = 4000;
-  bool stability = true; ///< compute each point's Floquet multipliers
+  bool stability = true; ///< each point's stability from Floquet multipliers
+  /// Floquet multipliers computed at least at every stability_stride-th point (see above; 1:
+  /// at every point)
+  int stability_stride = 8;
 };
 
 struct ResponsePoint {
   HarmonicBalanceResult hb;   ///< the steady state: frequency_hz, Y, G, X (outputs)
   std::optional<bool> stable; ///< empty: not determined (see notes)
   double max_multiplier = std::numeric_limits<double>::quiet_NaN(); ///< max |μ|
+  /// its multipliers were computed; else its stability is that of the computed points on both
+  /// sides, which agree (see above)
+  bool stability_checked = false;
 };
 
 struct ResponseBranch {

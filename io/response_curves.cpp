@@ -33,6 +33,7 @@ std::string response_json(const frf::ResponseCurves& c) {
       point["freq_hz"] = number(p.hb.frequency_hz);
       point["stable"] = p.stable ? Json(*p.stable) : Json(nullptr);
       point["max_multiplier"] = number(p.max_multiplier);
+      point["stability_checked"] = p.stability_checked;
       Json x = Json::object();
       for (std::size_t d = 0; d < c.dofs.size(); ++d) {
         Json harmonics = Json::array();

@@ -37,6 +37,12 @@ public:
         .add_option("--freq-range", freq_range_, "Band F0:F1 in Hz, traced from F0 to F1")
         ->required();
     add_balance_harmonics(options_.hb.harmonics, "Harmonics 0 … K of the harmonic balance", true);
+    app()
+        .add_option("--stability-stride", options_.stability_stride,
+                    "Floquet multipliers computed at least at every N-th point, and wherever the "
+                    "stability may change (folds, symmetry breaking, disagreeing neighbours); "
+                    "1: at every point")
+        ->capture_default_str();
     app().add_option("--plot-dof", plot_dof_,
                      "DOF drawn in response.png, NODE:DOF (default: the force DOF)");
     add_no_plot("response.png");
@@ -66,6 +72,10 @@ void Response::run() {
     throw io::Error(fmt::format(
         "--freq-range: expected two different frequencies > 0 Hz, got {} and {}", f0, f1));
   check_balance_harmonics(options_.hb.harmonics, 1);
+  if (options_.stability_stride < 1)
+    throw io::Error(fmt::format("--stability-stride: expected a whole number >= 1 (1: every "
+                                "point), got {}",
+                                options_.stability_stride));
   check_output_dir(output_dir_);
 
   // 2. The model.

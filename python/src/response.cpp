@@ -26,6 +26,7 @@ struct ResponseBranch {
   py::array_t<std::complex<double>> X;
   py::list stable;
   py::array_t<double> max_multiplier;
+  std::vector<bool> stability_checked;
   std::vector<int> folds;
   bool complete = false;
   std::vector<std::string> notes;
@@ -46,6 +47,7 @@ ResponseBranch branch_of(const frf::ResponseBranch& b, double amplitude, int har
     out.freq_hz.mutable_data()[i] = p.hb.frequency_hz;
     out.max_multiplier.mutable_data()[i] = p.max_multiplier;
     out.stable.append(p.stable ? py::object(py::bool_(*p.stable)) : py::object(py::none()));
+    out.stability_checked.push_back(p.stability_checked);
     for (py::ssize_t h = 0; h < k; ++h)
       for (py::ssize_t j = 0; j < d; ++j)
         X[(i * k + h) * d + j] =
@@ -59,7 +61,7 @@ ResponseBranch branch_of(const frf::ResponseBranch& b, double amplitude, int har
 
 ResponseCurves response(const ModelPtr& model, const std::string& force,
                         const std::vector<double>& amplitudes, const py::object& freq_range,
-                        const py::object& balance_harmonics) {
+                        const py::object& balance_harmonics, int stability_stride) {
   // 1. The arguments, as `jointid response` checks its options.
   check_amplitudes(amplitudes);
   if (std::set<double>(amplitudes.begin(), amplitudes.end()).size() != amplitudes.size())
@@ -73,6 +75,11 @@ ResponseCurves response(const ModelPtr& model, const std::string& force,
   frf::ContinuationOptions options;
   if (!balance_harmonics.is_none()) options.hb.harmonics = balance_harmonics.cast<int>();
   check_balance_harmonics(options.hb.harmonics, 1);
+  if (stability_stride < 1)
+    throw io::Error(
+        fmt::format("stability_stride: expected a whole number >= 1 (1: every point), got {}",
+                    stability_stride));
+  options.stability_stride = stability_stride;
   if (model->file.joints.empty()) {
     const std::string warning =
         model->name() + ": no [[joints]]: the response is the linear substructure's";
@@ -111,6 +118,10 @@ void bind_response(py::module_& m) {
                     "Each point's stability: True, False or None (not determined).")
       .def_readonly("max_multiplier", &ResponseBranch::max_multiplier,
                     "Each point's largest Floquet multiplier |μ| (NaN: not computed).")
+      .def_readonly("stability_checked", &ResponseBranch::stability_checked,
+                    "Whether each point's multipliers were computed (at least every "
+                    "stability_stride-th point and wherever the stability may change); a point "
+                    "not computed has the verdict of the computed points on both sides.")
       .def_readonly("folds", &ResponseBranch::folds, "Indices of the turning points in frequency.")
       .def_readonly("complete", &ResponseBranch::complete, "The branch reached the band's end.")
       .def_readonly("notes", &ResponseBranch::notes,
@@ -163,12 +174,13 @@ void bind_response(py::module_& m) {
   m.def(
       "response",
       [](const ModelPtr& model, const std::string& force, const py::object& amplitude,
-         const py::object& freq_range, const py::object& balance_harmonics) {
+         const py::object& freq_range, const py::object& balance_harmonics, int stability_stride) {
         return response(model, force, numbers(amplitude, "amplitude"), freq_range,
-                        balance_harmonics);
+                        balance_harmonics, stability_stride);
       },
       py::arg("model"), py::kw_only(), py::arg("force"), py::arg("amplitude"),
       py::arg("freq_range"), py::arg("balance_harmonics") = py::none(),
+      py::arg("stability_stride") = frf::ContinuationOptions{}.stability_stride,
       "Response curves of the model with its joints (as `jointid response`): the steady states "
       "under F sin ωt at `force` traced from F0 to F1 (freq_range, Hz) by continuation, one "
       "curve per amplitude, with folds and stability. Ctrl-C stops it.");

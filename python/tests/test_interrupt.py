@@ -85,7 +85,7 @@ def test_long_calls_release_the_gil(cantilever):
     counter.start()
     try:
         start = time.monotonic()
-        one_curve(cantilever, AMPLITUDES[:3])
+        one_curve(cantilever, AMPLITUDES[:12])  # about a quarter of a second
         end = time.monotonic()
     finally:
         running.clear()

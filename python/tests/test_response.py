@@ -21,6 +21,10 @@ def test_response_curves_as_the_cli(cantilever, tmp_path):
         assert branch.folds == c["folds"] and branch.X.shape == (len(c["points"]), 6, 1)
         np.testing.assert_array_equal(branch.freq_hz, [p["freq_hz"] for p in c["points"]])
         assert branch.stable == [p["stable"] for p in c["points"]]
+        assert branch.stability_checked == [p["stability_checked"] for p in c["points"]]
+        computed = np.array(branch.stability_checked)
+        assert computed[0] and computed[-1] and computed[::8].all()
+        assert np.isnan(branch.max_multiplier[~computed]).all()
         x = np.array([[complex(*h) for h in p["x"]["7:uy"]] for p in c["points"]])
         np.testing.assert_array_equal(branch.X[:, :, 0], x)
     # The joint hardens (k3 > 0): the larger force resonates at a higher frequency.

@@ -175,3 +175,82 @@ TEST(Backbone, RefusesBadInput) {
   }
   EXPECT_TRUE(frf::backbone(two, at_node, 1, {1, Dof::uy}, 1e-4, 1e-3, {.points = 2}).status.ok());
 }
+
+TEST(Backbone, ACubicSpringAloneStartsFromTheSubstructuresOwnMode) {
+  // g = k3 y³ alone on the oscillator: no linear term, so the linear mode is the oscillator's
+  // own, f_r and ζ exactly (a pole of the receptance, where the EPMC's equations cannot be
+  // evaluated: found in modal coordinates), and the backbone is the Duffing one of
+  // CubicSpringFollowsTheDuffingBackbone with ω0 = ω_r, within r⁴ ω0² and the tolerance.
+  const Oscillator o;
+  const double k3 = 4e6;
+  const std::vector<joints::Joint> js{make(1, {Term::k3}, {k3})};
+  const double w0sq = o.omega_r() * o.omega_r();
+  const double a_max = std::sqrt(0.05 * w0sq * o.m() / k3);
+  const frf::Backbone b =
+      frf::backbone(o.sub, js, 1, {1, Dof::uy}, a_max / 100.0, a_max, {.points = 12});
+  ASSERT_TRUE(b.status.ok()) << b.status.reason;
+  EXPECT_DOUBLE_EQ(b.linear.frequency_hz, o.f_r);
+  EXPECT_NEAR(b.linear.damping_ratio, o.zeta, 1e-15);
+  EXPECT_NEAR(b.linear.amplitude_ratio, 1.0, 1e-12);
+  ASSERT_EQ(b.points.size(), 12u);
+  for (const frf::BackbonePoint& p : b.points) {
+    const double a = p.joint_amplitude, w = two_pi * p.frequency_hz;
+    const double r = k3 / o.m() * a * a / w0sq;
+    const double series = 0.75 * r + 3.0 / 128.0 * r * r - 0.013916 * r * r * r;
+    EXPECT_NEAR(w * w / w0sq - 1.0, series, std::pow(r, 4) + 1e-9) << "r = " << a;
+    EXPECT_NEAR(p.self_excitation, 2.0 * o.zeta * o.omega_r(), 1e-8 * o.omega_r());
+  }
+}
+
+TEST(Backbone, AGapIsTheLinearModeUntilContactThenItsDescribingFunction) {
+  // A clearance δ with contact stiffness kg alone on the oscillator, the fundamental alone
+  // (K = 1): below δ the joint exerts no force and the point is the linear mode exactly; beyond
+  // it, ω² = ω_r² + N(a)/m with the dead-zone spring's describing function
+  //     N(a) = kg (1 − (2/π)(asin(δ/a) + (δ/a) √(1 − δ²/a²))).
+  // The force is transformed from Nt = 512 samples h = 2π/Nt apart; at each of the four contact
+  // instants a cycle ∂g/∂θ jumps by at most kg a, each leaving at most kg a h²/8 in ∫ g cos θ,
+  // so |ΔN| ≤ kg h² / (2π): the tolerance on m ω², with the Newton tolerance.
+  const Oscillator o;
+  const double delta = 1e-3, kg = 1e4;
+  joints::Joint j = make(1, {Term::gap}, {1.0});
+  j.set_parameters(0, {delta, kg});
+  const std::vector<joints::Joint> js{j};
+  frf::BackboneOptions opt{.points = 12};
+  opt.hb.harmonics = 1, opt.hb.time_samples = 512;
+  const frf::Backbone b = frf::backbone(o.sub, js, 1, {1, Dof::uy}, 0.2 * delta, 10.0 * delta, opt);
+  ASSERT_TRUE(b.status.ok()) << b.status.reason;
+  ASSERT_EQ(b.points.size(), 12u);
+  const double h = 2.0 * std::numbers::pi / 512;
+  int below = 0, beyond = 0;
+  for (const frf::BackbonePoint& p : b.points) {
+    const double a = p.joint_amplitude, w = two_pi * p.frequency_hz;
+    double N = 0.0;
+    if (a > delta) {
+      const double d = delta / a;
+      N = kg * (1.0 - 2.0 / std::numbers::pi * (std::asin(d) + d * std::sqrt(1.0 - d * d)));
+      ++beyond;
+    } else {
+      EXPECT_EQ(p.frequency_hz, o.f_r) << "a = " << a;
+      ++below;
+    }
+    EXPECT_NEAR(o.m() * (w * w - o.omega_r() * o.omega_r()), N,
+                kg * h * h / (2.0 * std::numbers::pi) + 1e-9 * o.m() * w * w)
+        << "a = " << a;
+  }
+  EXPECT_GE(below, 3);
+  EXPECT_GE(beyond, 6);
+}
+
+TEST(Backbone, RefusesExactDryFriction) {
+  // A joint with exact dry friction sticks at small amplitudes: it does not deform, so its
+  // deformation cannot parametrise the backbone from 0. Refused, saying what to use instead.
+  const Oscillator o;
+  const std::vector<joints::Joint> js{make(1, {Term::k, Term::fc}, {400.0, 1.0})};
+  try {
+    frf::backbone(o.sub, js, 1, {1, Dof::uy}, 1e-4, 1e-3);
+    ADD_FAILURE() << "exact dry friction was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("sticks"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("jenkins"), std::string::npos) << e.what();
+  }
+}
