@@ -107,6 +107,29 @@ const std::vector<identify::Measurement>& parametric_tests(int which) {
   return m;
 }
 
+// User and system time of every thread of the process, s.
+double process_cpu_seconds() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; };
+  return seconds(u.ru_utime) + seconds(u.ru_stime);
+}
+
+// A discovery's counters: every thread's CPU time (Google Benchmark's CPU column counts the
+// main thread only: on a shared machine, the time this run would take alone on one core), the
+// tests, steps and gaps; its label, the terms added in order.
+void describe(benchmark::State& state, const discover::Result& r, double cpu_before) {
+  state.counters["cpu_all_threads_s"] = process_cpu_seconds() - cpu_before;
+  state.counters["tests"] = r.tests;
+  state.counters["steps"] = static_cast<double>(r.steps.size());
+  state.counters["gap_start"] = r.gap.front();
+  state.counters["gap_final"] = r.gap.back();
+  std::string added;
+  for (const auto& s : r.steps)
+    added += (added.empty() ? "" : ", ") + s.added.name();
+  state.SetLabel(added);
+}
+
 // range(1): 1 every term of the library as a candidate, 0 the coefficient terms alone.
 void BM_DiscoverHiddenParametricTerm(benchmark::State& state) {
   const Data& d = data();
@@ -115,8 +138,11 @@ void BM_DiscoverHiddenParametricTerm(benchmark::State& state) {
   o.curve_points = 0;
   if (state.range(1) == 0)
     o.terms.assign(joints::coefficient_terms.begin(), joints::coefficient_terms.end());
+  discover::Result r;
+  const double cpu_before = process_cpu_seconds();
   for (auto _ : state)
-    benchmark::DoNotOptimize(discover::discover(d.sub, {d.start}, measured, o));
+    r = discover::discover(d.sub, {d.start}, measured, o);
+  describe(state, r, cpu_before);
 }
 
 // The bolted beam's stepped-sine table (tests/support/bolted_beam.hpp: a hidden softening
@@ -135,14 +161,6 @@ struct Table {
   }
   ~Table() { std::filesystem::remove(path); }
 };
-
-// User and system time of every thread of the process, s.
-double process_cpu_seconds() {
-  rusage u{};
-  ::getrusage(RUSAGE_SELF, &u);
-  auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; };
-  return seconds(u.ru_utime) + seconds(u.ru_stime);
-}
 
 const Table& table() {
   static const Table t;
@@ -164,17 +182,7 @@ void BM_DiscoverSteppedSineTable(benchmark::State& state) {
         identify::measure(io::read_tests({t.path}), {.harmonics = 3});
     r = discover::discover(t.sub, {test::bolt_start()}, measured, o);
   }
-  // Every thread's CPU time (Google Benchmark's CPU column counts the main thread only): on a
-  // shared machine, the time this run would take alone on one core.
-  state.counters["cpu_all_threads_s"] = process_cpu_seconds() - cpu_before;
-  state.counters["tests"] = r.tests;
-  state.counters["steps"] = static_cast<double>(r.steps.size());
-  state.counters["gap_start"] = r.gap.front();
-  state.counters["gap_final"] = r.gap.back();
-  std::string added;
-  for (const auto& s : r.steps)
-    added += (added.empty() ? "" : ", ") + s.added.name();
-  state.SetLabel(added);
+  describe(state, r, cpu_before);
 }
 
 // One steady state at 4 Hz, 80 N (near the joined structure's first mode) with the joint k + c

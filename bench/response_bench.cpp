@@ -20,6 +20,30 @@ using joints::Term;
 
 namespace {
 
+// Times the curve of joint j at the tip under `force` N over 15 → 30 Hz. Counters: its points,
+// folds, points whose multipliers were computed, unstable points, and the time per point.
+void time_curve(benchmark::State& state, const frf::Substructure& sub, const joints::Joint& j,
+                double force, const frf::ContinuationOptions& o) {
+  std::size_t points = 0, folds = 0, checked = 0, unstable = 0;
+  for (auto _ : state) {
+    const frf::ResponseCurves c =
+        frf::response_curves(sub, {j}, {7, fem::Dof::uy}, {force}, 15.0, 30.0, o);
+    points = c.curves[0].points.size();
+    folds = c.curves[0].folds.size();
+    checked = unstable = 0;
+    for (const auto& p : c.curves[0].points)
+      checked += p.stability_checked, unstable += p.stable.has_value() && !*p.stable;
+    benchmark::DoNotOptimize(c);
+  }
+  state.counters["points"] = static_cast<double>(points);
+  state.counters["folds"] = static_cast<double>(folds);
+  state.counters["checked"] = static_cast<double>(checked);
+  state.counters["unstable"] = static_cast<double>(unstable);
+  state.counters["per_point"] = benchmark::Counter(static_cast<double>(points),
+                                                   benchmark::Counter::kIsIterationInvariantRate |
+                                                       benchmark::Counter::kInvert);
+}
+
 void BM_ResponseCurve(benchmark::State& state) {
   const frf::Substructure sub{test::paper_cantilever()};
   joints::Joint j{"tip", 7, 0, fem::Dof::uy, {Term::k, Term::c, Term::k3}, {4800.0, 2.0, 1.6e8},
@@ -28,23 +52,7 @@ void BM_ResponseCurve(benchmark::State& state) {
   frf::ContinuationOptions o;
   o.hb.harmonics = static_cast<int>(state.range(0));
   o.stability = state.range(1) != 0;
-  std::size_t points = 0, folds = 0, checked = 0;
-  for (auto _ : state) {
-    const frf::ResponseCurves c =
-        frf::response_curves(sub, {j}, {7, fem::Dof::uy}, {80.0}, 15.0, 30.0, o);
-    points = c.curves[0].points.size();
-    folds = c.curves[0].folds.size();
-    checked = 0;
-    for (const auto& p : c.curves[0].points)
-      checked += p.stability_checked;
-    benchmark::DoNotOptimize(c);
-  }
-  state.counters["points"] = static_cast<double>(points);
-  state.counters["folds"] = static_cast<double>(folds);
-  state.counters["checked"] = static_cast<double>(checked);
-  state.counters["per_point"] = benchmark::Counter(static_cast<double>(points),
-                                                   benchmark::Counter::kIsIterationInvariantRate |
-                                                       benchmark::Counter::kInvert);
+  time_curve(state, sub, j, 80.0, o);
 }
 
 // The same cantilever and band with each hysteretic or non-smooth joint kind at the tip (k = 4800
@@ -63,19 +71,7 @@ void BM_ResponseCurveKind(benchmark::State& state) {
   frf::ContinuationOptions o;
   o.hb.harmonics = 5;
   o.stability = state.range(1) != 0;
-  std::size_t points = 0, checked = 0, unstable = 0;
-  for (auto _ : state) {
-    const frf::ResponseCurves c =
-        frf::response_curves(sub, {j}, {7, fem::Dof::uy}, {20.0}, 15.0, 30.0, o);
-    points = c.curves[0].points.size();
-    checked = unstable = 0;
-    for (const auto& p : c.curves[0].points)
-      checked += p.stability_checked, unstable += p.stable.has_value() && !*p.stable;
-    benchmark::DoNotOptimize(c);
-  }
-  state.counters["points"] = static_cast<double>(points);
-  state.counters["checked"] = static_cast<double>(checked);
-  state.counters["unstable"] = static_cast<double>(unstable);
+  time_curve(state, sub, j, 20.0, o);
 }
 
 // range(0): samples a period; range(1): 1 with the derivative. The deformation: a fundamental

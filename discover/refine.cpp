@@ -329,18 +329,27 @@ private:
   // balance (Problem::derivatives) over a forward step (backward where forward leaves the
   // physical models), else by re-simulating every test for that step; false where a column
   // cannot be formed.
+  // Parameter q moved by +step, then by −step: the moves that stay physical and in range, in
+  // that order (a parameter at its bound is differentiated from the side it can move to).
+  std::vector<std::pair<double, std::vector<joints::Joint>>> moves(Eigen::Index q) const {
+    std::vector<std::pair<double, std::vector<joints::Joint>>> out;
+    for (double h : {step_(q), -step_(q)}) {
+      Eigen::VectorXd bq = b_;
+      bq(q) += h;
+      std::vector<joints::Joint> jq = joints_with(bq);
+      if (physical_problem(jq).empty() && in_range(jq)) out.emplace_back(h, std::move(jq));
+    }
+    return out;
+  }
+
   bool jacobian() {
     std::vector<std::vector<joints::Joint>> moved;
     std::vector<double> steps;
     std::vector<Eigen::Index> column;
     for (Eigen::Index q = 0; q < size(); ++q)
-      for (double h : {step_(q), -step_(q)}) {
-        Eigen::VectorXd bq = b_;
-        bq(q) += h;
-        std::vector<joints::Joint> jq = joints_with(bq);
-        if (!physical_problem(jq).empty() || !in_range(jq)) continue;
-        moved.push_back(std::move(jq)), steps.push_back(h), column.push_back(q);
-        break;
+      if (auto m = moves(q); !m.empty()) {
+        steps.push_back(m.front().first), column.push_back(q);
+        moved.push_back(std::move(m.front().second));
       }
     const auto D = problem_.derivatives(current_, moved, steps, sim_);
     for (std::size_t m = 0; m < column.size(); ++m) {
@@ -362,11 +371,7 @@ private:
     }
     for (Eigen::Index q = 0; q < size(); ++q) {
       if (J_.col(q).allFinite()) continue;
-      for (double h : {step_(q), -step_(q)}) {
-        Eigen::VectorXd bq = b_;
-        bq(q) += h;
-        const std::vector<joints::Joint> jq = joints_with(bq);
-        if (!physical_problem(jq).empty() || !in_range(jq)) continue;
+      for (const auto& [h, jq] : moves(q)) {
         const State sq = problem_.evaluate(jq, sim_, &current_);
         if (!covers(sq)) continue;
         J_.col(q) = (residual(sq) - r_) / h;
