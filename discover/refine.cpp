@@ -59,8 +59,8 @@ public:
 
   // The tests the search compares: those the start re-simulated (a trial must re-simulate every
   // one of them too).
-  void compare_on(const State& begin) {
-    left_out_ = begin.failed;
+  void compare_on(const State& begin, const std::vector<int>& held_out) {
+    left_out_ = united(begin.failed, held_out);
     values_ = 0;
     for (const auto& e : compared_.entries)
       if (!std::binary_search(left_out_.begin(), left_out_.end(), e.test)) values_ += e.dof();
@@ -78,7 +78,7 @@ public:
   }
 
   // Minimises the weighted misfit from `begin`; returns the state reached.
-  State search(const State& start, const State& begin) {
+  State search(const State& start, const State& begin, int iterations) {
     const Eigen::Index p = size();
     b_.resize(p), step_.resize(p);
     joints_ = begin.joints;
@@ -107,7 +107,7 @@ public:
     cost_ = r_.squaredNorm();
     double mu = 1e-3;
     J_.resize(r_.size(), p);
-    for (int iteration = 0; iteration < 12; ++iteration) {
+    for (int iteration = 0; iteration < iterations; ++iteration) {
       J_.setConstant(nan);
       if (!jacobian()) break; // keep what was reached
       const Eigen::MatrixXd A = J_.transpose() * J_;
@@ -422,7 +422,8 @@ Eigen::MatrixXd covariance(const Eigen::MatrixXd& J, double s2) {
   return s2 * scale.asDiagonal() * (W * W.transpose()) * scale.asDiagonal();
 }
 
-static State refine_from(const Problem& problem, const State& start, const Simulator& sim);
+static State refine_from(const Problem& problem, const State& start, const Simulator& sim,
+                         const RefineScope& scope);
 
 Eigen::MatrixXd covariance_without(const Eigen::MatrixXd& J, double s2, int nulls) {
   const Eigen::Index p = J.cols();
@@ -513,22 +514,24 @@ std::optional<std::vector<joints::Joint>> nested_start(const Candidate& c, const
   return js;
 }
 
-State refine(const Problem& problem, const State& start, const Simulator& sim) {
+State refine(const Problem& problem, const State& start, const Simulator& sim,
+             const RefineScope& scope) {
   try {
-    return refine_from(problem, start, sim);
+    return refine_from(problem, start, sim, scope);
   } catch (const std::invalid_argument&) {
     return start; // a model the simulators refuse (out of range): the start stands
   }
 }
 
-State refine_from(const Problem& problem, const State& start, const Simulator& sim) {
+State refine_from(const Problem& problem, const State& start, const Simulator& sim,
+                  const RefineScope& scope) {
   OutputError search(problem, sim, start);
   if (search.size() == 0) return start;
   const State begin = search.begin(start);
   if (!std::isfinite(begin.criterion) || !physical_problem(begin.joints).empty()) return start;
-  search.compare_on(begin);
-  State refined = search.search(start, begin);
-  refined.fit = search.fit(begin.fit);
+  search.compare_on(begin, scope.held_out);
+  State refined = search.search(start, begin, scope.iterations);
+  if (scope.intervals) refined.fit = search.fit(begin.fit);
   return refined;
 }
 

@@ -11,14 +11,23 @@
 #include "discover/problem.hpp"
 
 #include <optional>
+#include <vector>
 
 namespace jointid::discover::detail {
 
-/// The state refined from `start` (its fit replaced by the output-error one); `start` itself
-/// when nothing is identified, or its values are not physical and cannot be brought back. The
-/// tests the start could not re-simulate stay out of the search, and every trial must
-/// re-simulate all the others.
-State refine(const Problem& problem, const State& start, const Simulator& sim);
+/// What a refinement compares and how far it goes.
+struct RefineScope {
+  std::vector<int> held_out; ///< tests left out of the search too (ascending): a fold's
+  int iterations = 12;       ///< Levenberg–Marquardt iterations at most
+  bool intervals = true;     ///< the fit's intervals (one more Jacobian)
+};
+
+/// The state refined from `start` (its fit replaced by the output-error one, when
+/// scope.intervals); `start` itself when nothing is identified, or its values are not physical
+/// and cannot be brought back. The tests the start could not re-simulate and those held out stay
+/// out of the search, and every trial must re-simulate all the others.
+State refine(const Problem& problem, const State& start, const Simulator& sim,
+             const RefineScope& scope = {});
 
 /// The second start of a candidate `c` that adds a coefficient term: the candidate's joints with
 /// the values and parameters of the model `now` and the added term at 0. Refined from there,

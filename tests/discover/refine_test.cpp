@@ -95,5 +95,31 @@ TEST(Refine, AnAddedTermsSecondStartIsTheModelNowWithTheTermAtZero) {
   EXPECT_FALSE(nested_start(c, problem.evaluate({two}, sim), now).has_value());
 }
 
+TEST(Refine, HeldOutTestsStayOutOfTheSearch) {
+  // Six exact tests and a seventh measured as if k were 1.5 k: refined with the seventh held out
+  // (a cross-validation fold's training set), the values reached are the truth to the search's
+  // tolerance; with it in, they are pulled off the truth. The iterations are bounded by the scope.
+  const test::OneMode m;
+  const frf::Substructure sub = m.substructure();
+  auto tests = m.tests({2.5, 2.8, 3.0, 3.2, 3.5, 4.0}, 10.0, 1e-4);
+  const std::complex<double> F1(0.0, -10.0);
+  const double f = 3.1, sd = 1e-4 * std::abs(m.receptance(f, m.k, m.c) * F1);
+  tests.push_back(test::measurement("corrupted", f, F1, {0.0, m.receptance(f, 1.5 * m.k, m.c) * F1},
+                                    {sd * sd, sd * sd}, false));
+  Problem problem(sub, {m.joint(0.0, 0.0)}, tests, test::fundamental_only());
+  const Simulator& sim = problem.simulator(1.0);
+  const discover::State start = problem.evaluate({m.joint(300.0, 3.0)}, sim);
+  const discover::State held =
+      refine(problem, start, sim, {.held_out = {6}, .iterations = 12, .intervals = false});
+  EXPECT_NEAR(held.joints[0].values[0], m.k, 1e-4 * m.k);
+  EXPECT_NEAR(held.joints[0].values[1], m.c, 1e-4 * m.c);
+  EXPECT_TRUE(held.fit.joints.empty()); // no intervals asked: no output-error fit
+  const discover::State all = refine(problem, start, sim);
+  EXPECT_GT(std::abs(all.joints[0].values[0] - m.k), 1e-2 * m.k);
+  // One iteration from the start does not reach the truth.
+  const discover::State one = refine(problem, start, sim, {.held_out = {6}, .iterations = 1});
+  EXPECT_GT(std::abs(one.joints[0].values[0] - m.k), 1e-3 * m.k);
+}
+
 } // namespace
 } // namespace jointid
