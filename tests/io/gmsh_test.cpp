@@ -1,6 +1,7 @@
 #include "io/gmsh.hpp"
 
 #include "io/files.hpp"
+#include "io/test_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +12,12 @@ using namespace jointid;
 
 namespace {
 
+// A directory of this process's own: ctest runs the tests of this file in parallel processes,
+// and a shared directory let one test read another's half-written file.
 std::filesystem::path write_temp(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / "jointid_gmsh_test";
-  std::filesystem::create_directories(dir);
+  static const test::TempDir dir;
   const auto path = dir / name;
-  std::ofstream(path) << text;
+  test::write_text(path, text);
   return path;
 }
 
