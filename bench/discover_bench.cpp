@@ -15,6 +15,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
@@ -128,6 +130,17 @@ void describe(benchmark::State& state, const discover::Result& r, double cpu_bef
   for (const auto& s : r.steps)
     added += (added.empty() ? "" : ", ") + s.added.name();
   state.SetLabel(added);
+  // JOINTID_BENCH_RANKINGS=1: each step's candidates, best first, on standard error.
+  if (!std::getenv("JOINTID_BENCH_RANKINGS")) return;
+  auto print = [](const std::string& what, const std::vector<discover::Candidate>& ranking) {
+    std::fprintf(stderr, "%s\n", what.c_str());
+    for (const auto& c : ranking)
+      std::fprintf(stderr, "  %-28s gap %.4g criterion %.6g cv %.4g %s\n", c.name().c_str(),
+                   c.gap, c.criterion, c.cv_gap, c.rejected.c_str());
+  };
+  for (std::size_t i = 0; i < r.steps.size(); ++i)
+    print("step " + std::to_string(i + 1) + ": + " + r.steps[i].added.name(), r.steps[i].ranking);
+  print("last: " + r.stop_reason, r.last_ranking);
 }
 
 // range(1): 1 every term of the library as a candidate, 0 the coefficient terms alone.

@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,9 @@ struct Simulator {
   frf::ModalSynthesis synthesis;
   std::vector<frf::HarmonicBalance> balance;
 };
+
+/// An even spread of at most `taken` of n items, ascending (the first and last among them).
+std::vector<int> even_spread(std::size_t n, std::size_t taken);
 
 class Problem {
 public:
@@ -96,13 +100,16 @@ public:
   /// does not converge (solve(), then from the nearest tests already re-simulated: a stepped
   /// sweep's neighbours) is left out (State::failed); past max_left_out the rest are not
   /// tried (the state is not compared: its criterion is +∞).
+  /// Tests in `skip` (ascending) are not simulated (X NaN, Y empty; not failed) and the state is
+  /// scored on the others alone: its gap and criterion compare only with states that skipped
+  /// the same tests (a refinement's first stage: refine.hpp).
   State evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim,
-                 const State* warm = nullptr) const;
+                 const State* warm = nullptr, std::span<const int> skip = {}) const;
   /// The same with test i's joints `per_test[i]` where given (the state holds `joints` and
   /// counts, for the criterion, one parameter per test for the term that varies).
   State evaluate_each(const std::vector<joints::Joint>& joints,
                       const std::vector<std::vector<joints::Joint>>& per_test, const Simulator& sim,
-                      const State* warm = nullptr) const;
+                      const State* warm = nullptr, std::span<const int> skip = {}) const;
   /// The derivatives of every test's simulated harmonics at `at` (State::X: rows(i) + 1 ×
   /// responses) with respect to moves of its joints, `moved[p]` by steps[p], by implicit
   /// differentiation of each test's harmonic balance (frf::HarmonicBalance::output_derivatives):
@@ -137,7 +144,7 @@ private:
   /// not possible, and for the tests beyond the first max_time_integrated of an even spread).
   std::vector<Eigen::MatrixXcd> time_integrated(const State& state) const;
   /// The tests integrated in time for the simulation's error at most: each settles over
-  /// hundreds of periods at 512 steps a period (about 0.3 s for a beam with a 100-slider
+  /// hundreds of periods at 256 steps a period (about 0.1 s for a beam with a 100-slider
   /// iwan), so a table of hundreds of tests takes an even spread of them; the others take the
   /// harmonic balance with twice the harmonics (estimate_simulation_error).
   static constexpr std::size_t max_time_integrated = 24;

@@ -57,10 +57,13 @@ public:
 
   Eigen::Index size() const { return static_cast<Eigen::Index>(params_.size()); }
 
+  // Tests not simulated at all (ascending; set before compare_on): a first stage's.
+  void skip(std::vector<int> tests) { skip_ = std::move(tests); }
+
   // The tests the search compares: those the start re-simulated (a trial must re-simulate every
   // one of them too).
   void compare_on(const State& begin, const std::vector<int>& held_out) {
-    left_out_ = united(begin.failed, held_out);
+    left_out_ = united(united(begin.failed, held_out), skip_);
     values_ = 0;
     for (const auto& e : compared_.entries)
       if (!std::binary_search(left_out_.begin(), left_out_.end(), e.test)) values_ += e.dof();
@@ -122,7 +125,7 @@ public:
           if (dissipative[q]) nb(q) = std::max(nb(q), 0.0);
         const std::vector<joints::Joint> nj = joints_with(nb);
         if (!nb.allFinite() || !physical_problem(nj).empty() || !in_range(nj)) continue;
-        State sn = problem_.evaluate(nj, sim_, &current_);
+        State sn = problem_.evaluate(nj, sim_, &current_, skip_);
         if (!covers(sn)) continue;
         const Eigen::VectorXd rn = residual(sn);
         if (rn.squaredNorm() < cost_) {
@@ -372,7 +375,7 @@ private:
     for (Eigen::Index q = 0; q < size(); ++q) {
       if (J_.col(q).allFinite()) continue;
       for (const auto& [h, jq] : moves(q)) {
-        const State sq = problem_.evaluate(jq, sim_, &current_);
+        const State sq = problem_.evaluate(jq, sim_, &current_, skip_);
         if (!covers(sq)) continue;
         J_.col(q) = (residual(sq) - r_) / h;
         break;
@@ -388,6 +391,7 @@ private:
   std::vector<Param> params_;
   std::vector<double> weight_;
   std::vector<int> left_out_;         // tests the start could not re-simulate, ascending
+  std::vector<int> skip_;             // tests not simulated, ascending
   int values_ = 0;                    // real values compared (of the other tests)
   std::vector<joints::Joint> joints_; // the layout and fixed values the parameters go into
   Eigen::VectorXd b_, step_, r_;
@@ -529,8 +533,26 @@ State refine_from(const Problem& problem, const State& start, const Simulator& s
   if (search.size() == 0) return start;
   const State begin = search.begin(start);
   if (!std::isfinite(begin.criterion) || !physical_problem(begin.joints).empty()) return start;
-  search.compare_on(begin, scope.held_out);
-  State refined = search.search(start, begin, scope.iterations);
+  State from = begin;
+  const int n = static_cast<int>(problem.tests().size());
+  if (scope.spread > 0 && n > scope.spread) {
+    // First stage: an even spread of the tests (those the start re-simulated, not held out).
+    std::vector<int> skip;
+    const std::vector<int> spread = even_spread(problem.tests().size(), scope.spread);
+    for (int i = 0; i < n; ++i)
+      if (!std::binary_search(spread.begin(), spread.end(), i)) skip.push_back(i);
+    OutputError first(problem, sim, start);
+    first.skip(skip);
+    first.compare_on(begin, scope.held_out);
+    const State reached = first.search(start, begin, scope.iterations);
+    // Every test at the values reached; kept where it is no worse than the start on them.
+    State all = problem.evaluate(reached.joints, sim, &begin);
+    all.fit = begin.fit;
+    if (all.failed == begin.failed && std::isfinite(all.criterion) && all.gap < begin.gap)
+      from = std::move(all);
+  }
+  search.compare_on(from, scope.held_out);
+  State refined = search.search(start, from, scope.iterations);
   if (scope.intervals) refined.fit = search.fit(begin.fit);
   return refined;
 }

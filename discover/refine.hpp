@@ -18,8 +18,14 @@ namespace jointid::discover::detail {
 /// What a refinement compares and how far it goes.
 struct RefineScope {
   std::vector<int> held_out; ///< tests left out of the search too (ascending): a fold's
-  int iterations = 12;       ///< Levenberg–Marquardt iterations at most
+  int iterations = 12;       ///< Levenberg–Marquardt iterations at most (each stage)
   bool intervals = true;     ///< the fit's intervals (one more Jacobian)
+  /// With more tests than this, the search first runs on an even spread of this many of them
+  /// (the others not simulated), then goes on from there with all of them: a stepped-sine
+  /// table's hundreds of tests determine a few parameters far beyond what the first stage needs
+  /// to get near the minimum, and the second then takes one or two iterations instead of all.
+  /// 0: one stage. The result is that of all the tests either way.
+  int spread = 96;
 };
 
 /// The state refined from `start` (its fit replaced by the output-error one, when

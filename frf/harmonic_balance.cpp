@@ -558,13 +558,17 @@ HarmonicBalance::output_derivatives(const std::vector<joints::Joint>& joints,
   JOINTID_ASSERT(moved.size() == steps.size(), "a step per move");
   const std::unique_ptr<Equations> P = equations(joints, F, &start);
   Eigen::VectorXd z = first_guess(*P, &start);
-  int iterations = 0;
-  double residual = 0.0;
-  if (!detail::newton(*P, z, 1.0, options_, iterations, residual)) return {};
   const int n = P->size();
   Eigen::VectorXd r0(n), r(n);
   Eigen::MatrixXd J(n, n);
   P->residual(z, 1.0, r0, &J);
+  // `start` is usually the steady state already solved: solved again only where it is not.
+  if (!(r0.norm() / std::max(P->norm(z), 1e-300) < options_.tolerance)) {
+    int iterations = 0;
+    double residual = 0.0;
+    if (!detail::newton(*P, z, 1.0, options_, iterations, residual)) return {};
+    P->residual(z, 1.0, r0, &J);
+  }
   detail::SmallLU<double> lu;
   lu.compute(J);
   if (!(lu.min_pivot > 1e-13 * std::max(1.0, J.lpNorm<Eigen::Infinity>()))) return {};

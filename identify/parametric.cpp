@@ -53,27 +53,85 @@ bool interval_determines(const joints::ParameterInfo& info, double value, double
 }
 
 Complex describing_function(const joints::Joint& j, std::size_t t, double a, int samples) {
+  const double amplitude[1] = {a};
+  return describing_functions(j, t, amplitude, 0, samples).front();
+}
+
+std::vector<Complex> describing_functions(const joints::Joint& j, std::size_t t,
+                                          std::span<const double> amplitudes, int per_efold,
+                                          int samples) {
+  std::vector<Complex> out(amplitudes.size());
+  if (amplitudes.empty()) return out;
   const auto n = static_cast<std::size_t>(samples);
-  std::vector<double> y(n), g(n);
-  for (std::size_t s = 0; s < n; ++s)
-    y[s] = a * std::cos(2.0 * std::numbers::pi * static_cast<double>(s) / samples);
-  if (j.terms[t] == joints::Term::gap) {
-    for (std::size_t s = 0; s < n; ++s)
-      g[s] = joints::gap_force(j.parameter(t, "delta"), j.parameter(t, "kg"), y[s]);
-  } else {
-    const joints::Sliders sliders =
-        j.terms[t] == joints::Term::jenkins
-            ? joints::jenkins_sliders(j.parameter(t, "kt"), j.parameter(t, "fs"))
-            : joints::iwan_sliders(j.parameter(t, "fs"), j.parameter(t, "kt"),
-                                   j.parameter(t, "chi"), j.parameter(t, "beta"), j.iwan_sliders);
-    joints::LoopWork work;
-    joints::steady_loop(sliders, y, false, g, nullptr, work);
+  std::vector<double> cosine(n), sine(n), y(n), g(n);
+  for (std::size_t s = 0; s < n; ++s) {
+    const double theta = 2.0 * std::numbers::pi * static_cast<double>(s) / samples;
+    cosine[s] = std::cos(theta), sine[s] = std::sin(theta);
   }
-  Complex G1 = 0.0; // g = Re(G₁ e^{iθ}) + …
-  for (std::size_t s = 0; s < n; ++s)
-    G1 += g[s] *
-          std::polar(2.0 / samples, -2.0 * std::numbers::pi * static_cast<double>(s) / samples);
-  return G1 / a;
+  const bool gap = j.terms[t] == joints::Term::gap;
+  joints::Sliders sliders;
+  double delta = 0.0, kg = 0.0;
+  if (gap) {
+    delta = j.parameter(t, "delta"), kg = j.parameter(t, "kg");
+  } else {
+    sliders = j.terms[t] == joints::Term::jenkins
+                  ? joints::jenkins_sliders(j.parameter(t, "kt"), j.parameter(t, "fs"))
+                  : joints::iwan_sliders(j.parameter(t, "fs"), j.parameter(t, "kt"),
+                                         j.parameter(t, "chi"), j.parameter(t, "beta"),
+                                         j.iwan_sliders);
+  }
+  // The amplitudes N is computed at: every one, or a grid in ln a with the onsets of the
+  // term's kinks among its nodes (where a slider of at least 5 % of the stiffness starts to
+  // slip, or the gap closes: N's slope jumps there).
+  std::vector<double> at(amplitudes.begin(), amplitudes.end());
+  const auto [lo, hi] = std::minmax_element(amplitudes.begin(), amplitudes.end());
+  if (per_efold > 0 && *lo > 0.0 && *hi > *lo) {
+    const double span = std::log(*hi / *lo);
+    const auto points = static_cast<std::size_t>(std::ceil(per_efold * span)) + 1;
+    std::vector<double> nodes;
+    for (std::size_t g = 0; g < points; ++g)
+      nodes.push_back(*lo *
+                      std::exp(span * static_cast<double>(g) / static_cast<double>(points - 1)));
+    nodes.back() = *hi;
+    const double total = gap ? 0.0 : sliders.stiffness_sum();
+    if (gap && delta > *lo && delta < *hi) nodes.push_back(delta);
+    for (int i = 0; i < sliders.size(); ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      if (sliders.stiffness[u] >= 0.05 * total && sliders.reach[u] > *lo && sliders.reach[u] < *hi)
+        nodes.push_back(sliders.reach[u]);
+    }
+    std::sort(nodes.begin(), nodes.end());
+    if (nodes.size() < amplitudes.size()) at = std::move(nodes);
+  }
+  joints::LoopWork work;
+  std::vector<Complex> N(at.size());
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    const double a = at[i];
+    for (std::size_t s = 0; s < n; ++s)
+      y[s] = a * cosine[s];
+    if (gap) {
+      for (std::size_t s = 0; s < n; ++s)
+        g[s] = joints::gap_force(delta, kg, y[s]);
+    } else {
+      joints::steady_loop(sliders, y, false, g, nullptr, work);
+    }
+    Complex G1 = 0.0; // g = Re(G₁ e^{iθ}) + …: G₁ = (2/n) Σ g e^{−iθ}
+    for (std::size_t s = 0; s < n; ++s)
+      G1 += g[s] * Complex(cosine[s], -sine[s]);
+    N[i] = G1 * (2.0 / samples) / a;
+  }
+  if (at.size() == amplitudes.size()) return N;
+  // Linear in ln a between the grid's nodes.
+  for (std::size_t i = 0; i < amplitudes.size(); ++i) {
+    const auto above = std::upper_bound(at.begin(), at.end(), amplitudes[i]);
+    const auto k = std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(
+                                above - at.begin() - 1, 0)),
+                            at.size() - 2);
+    const double w =
+        std::clamp(std::log(amplitudes[i] / at[k]) / std::log(at[k + 1] / at[k]), 0.0, 1.0);
+    out[i] = (1.0 - w) * N[k] + w * N[k + 1];
+  }
+  return out;
 }
 
 double joint_amplitude(const Measurement& m, const joints::Joint& j) {
@@ -128,6 +186,9 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
   for (std::size_t p = 0; p < info.size(); ++p)
     free[p] = !(J.parameters.size() > T && J.parameters[T].size() == info.size() &&
                 J.parameters[T][p].fixed);
+  std::vector<double> amplitudes;
+  for (const Point& P : points)
+    amplitudes.push_back(P.amplitude);
   joints::Joint trial = J;
   if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
     trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
@@ -143,11 +204,10 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
       return false;
     }
     const auto n = static_cast<Eigen::Index>(points.size());
+    const std::vector<Complex> N = describing_functions(trial, T, amplitudes, 24);
     Eigen::VectorXcd e(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const Point& P = points[static_cast<std::size_t>(i)];
-      e(i) = P.Z - describing_function(trial, T, P.amplitude);
-    }
+    for (Eigen::Index i = 0; i < n; ++i)
+      e(i) = points[static_cast<std::size_t>(i)].Z - N[static_cast<std::size_t>(i)];
     // The joint's own k and c by least squares (each point weighted by 1/|Z|).
     double kw = 0.0, w = 0.0, cw = 0.0, wc = 0.0;
     for (Eigen::Index i = 0; i < n; ++i) {

@@ -19,6 +19,7 @@
 #include "identify/measurement.hpp"
 
 #include <complex>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,19 @@ namespace jointid::identify {
 /// N(a) of term t of the joint (its parameters checked): G₁/a under y = a cos θ.
 std::complex<double> describing_function(const joints::Joint& joint, std::size_t term,
                                          double amplitude, int samples = 128);
+/// The same at every amplitude of `amplitudes` (m, > 0), the term's sliders built once. With
+/// `per_efold` > 0 and more amplitudes than that grid needs, N is computed on a grid evenly
+/// spaced in ln a (`per_efold` points per factor e, spanning the amplitudes, with the onsets of
+/// the term's kinks added: where a slider of 5 % of its stiffness or more starts to slip, where
+/// the gap closes) and interpolated linearly in ln a. Between kinks N is smooth in ln a and the
+/// error falls as the square of the spacing h; just past a slider's onset its in-phase part
+/// falls as x^{3/2} (x = ln a/φ), which costs 0.25 k h^{3/2}, and a smaller slider's kink a
+/// quarter of h times its slope's jump: about 2e-3 of the stiffness at 24 points per e-fold.
+/// For a fit's start, not for a result.
+std::vector<std::complex<double>> describing_functions(const joints::Joint& joint,
+                                                       std::size_t term,
+                                                       std::span<const double> amplitudes,
+                                                       int per_efold = 0, int samples = 128);
 
 /// The amplitude of joint j's deformation fundamental in a test (|Y₁|, m), NaN when a DOF of
 /// the joint is not measured.

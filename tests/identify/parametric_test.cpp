@@ -6,6 +6,7 @@
 
 #include "identify/output_error.hpp"
 #include "identify/sine_tests.hpp"
+#include "joints/hysteresis.hpp"
 #include "support/cantilever.hpp"
 #include "support/failing_substructure.hpp"
 #include "support/numbers.hpp"
@@ -16,6 +17,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 namespace jointid {
 namespace {
@@ -54,6 +56,36 @@ TEST(DescribingFunction, JenkinsDissipationAndGapStiffnessFollowTheirClosedForms
     const auto n = identify::describing_function(gap, 2, a, N);
     EXPECT_NEAR(n.real(), exact, tol * 2e4) << a;
     EXPECT_NEAR(n.imag(), 0.0, 1e-9 * 2e4) << a;
+  }
+}
+
+TEST(DescribingFunction, OnAGridInLnAIsTheExactOneToTheInterpolationError) {
+  // 300 amplitudes over a factor 49 around each term's onset (slip, the Dirac's slider, contact),
+  // on a grid of h = 1/24 in ln a with the onset a node. Just past a slider's onset at φ its
+  // in-phase part is k (1 − (16/3π) x^{3/2}), x = ln(a/φ), whose linear interpolation over the
+  // first step errs by (4/27)(16/3π) k h^{3/2} = 2.1e-3 k at most; elsewhere by h²/8 |N''|, a
+  // few 1e-4 of the stiffness s (kt, kg). A grid without the onset as a node errs by a quarter
+  // step of the slope's jump, (4/π) s h/4 = 1.3e-2 s.
+  const std::vector<std::tuple<joints::Joint, double, double>> terms{
+      {tip(Term::jenkins, {1.0e4, 3.0}, true), 1.0e4, 3.0 / 1.0e4},
+      {tip(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}, true), 1.0e4,
+       joints::iwan_density(3.0, 1.0e4, -0.5, 0.1).phi_max},
+      {tip(Term::gap, {5e-3, 2e4}, true), 2e4, 5e-3}};
+  for (const auto& [joint, s, onset] : terms) {
+    std::vector<double> a;
+    for (int i = 0; i < 300; ++i)
+      a.push_back(onset / 7.0 * std::pow(49.0, i / 299.0));
+    const auto exact = identify::describing_functions(joint, 2, a);
+    const auto grid = identify::describing_functions(joint, 2, a, 24);
+    ASSERT_EQ(grid.size(), a.size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(exact[i], identify::describing_function(joint, 2, a[i]));
+      worst = std::max(worst, std::abs(grid[i] - exact[i]));
+    }
+    const std::string name(joints::term_name(joint.terms[2]));
+    EXPECT_LT(worst, 2.5e-3 * s) << name;
+    EXPECT_GT(worst, 0.0) << name << ": not interpolated";
   }
 }
 
