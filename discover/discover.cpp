@@ -18,11 +18,14 @@
 #include "fem/parallel.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,7 +41,56 @@ public:
   Result run() {
     Result out = begin();
     State state = start(out);
-    double simulation_gap = -1.0; // of `state`, once estimated
+    const Result at_start = out;
+    const State start_state = state;
+    const bool fitted = values_fitted_;
+    double simulation_gap = follow(out, state); // of `state`, once estimated (else < 0)
+    // A parametric term added first can stand in for two coefficient terms at once (an iwan's
+    // softening and its damping that grows with amplitude, for k3 and c3), and the forward
+    // search never takes a term back out: the path that starts from the best coefficient term
+    // is followed too, and the one that ends with the lower criterion kept.
+    if (!out.steps.empty() && out.steps.front().added.term &&
+        joints::has_parameters(*out.steps.front().added.term) && first_) {
+      Result other = at_start;
+      State other_state = start_state;
+      values_fitted_ = fitted;
+      coefficients_first_ = true;
+      avoid_ = out.steps.front().added;
+      const double other_gap = follow(other, other_state);
+      coefficients_first_ = false;
+      values_fitted_ = true;
+      simulation_gap = -1.0; // the problem's error estimates are the second path's now
+      // A second path that adds the first path's parametric term after all only puts terms
+      // before it that the first path found no need for beside it: the first path stands.
+      if (!other.steps.empty() && !added(other, *avoid_)) {
+        const double a = criterion_on_measurement_noise(problem_.compared(), state),
+                     b = criterion_on_measurement_noise(problem_.compared(), other_state);
+        const bool second = b < a;
+        const std::string said = fmt::format(
+            "The first addition, {}, is a parametric term: it can stand in for two coefficient "
+            "terms at once, and the forward search cannot take it back out. So the search also "
+            "started from the best coefficient term. Judged on the measurement's own noise, the "
+            "path {} ends at a criterion of {} (gap {}), the path {} at {} (gap {}): the {} is "
+            "kept.",
+            out.steps.front().added.name(), path(out), number(a), number(state.gap), path(other),
+            number(b), number(other_state.gap), second ? "second" : "first");
+        if (second) {
+          out = std::move(other);
+          state = std::move(other_state);
+          simulation_gap = other_gap;
+        }
+        out.diagnosis.findings.push_back(said);
+      }
+    }
+    finish(out, state, simulation_gap);
+    return out;
+  }
+
+private:
+  // The steps from `state` until the loop stops; the simulation's error of the state reached
+  // if it was estimated there (else < 0).
+  double follow(Result& out, State& state) {
+    double simulation_gap = -1.0;
     for (int step = 0; step < o_.max_steps; ++step) {
       simulation_gap = problem_.estimate_simulation_error(state);
       identify_again_if_simulation_error_matters(state, out, simulation_gap);
@@ -51,12 +103,26 @@ public:
       }
       if (!add_the_best(step, state, out)) break;
       simulation_gap = -1.0;
+      if (avoid_ && added(out, *avoid_)) break; // a second path that is moot (run())
     }
-    finish(out, state, simulation_gap);
-    return out;
+    return simulation_gap;
   }
 
-private:
+  // Some step of `r` added the term of `c` at its joint.
+  static bool added(const Result& r, const Candidate& c) {
+    return std::any_of(r.steps.begin(), r.steps.end(), [&](const Step& s) {
+      return s.added.joint == c.joint && s.added.term == c.term;
+    });
+  }
+
+  // "(k3 at 'tip', then c3 at 'tip')".
+  static std::string path(const Result& r) {
+    std::vector<std::string> names;
+    for (const Step& s : r.steps)
+      names.push_back(s.added.name());
+    return "(" + fmt::format("{}", fmt::join(names, ", then ")) + ")";
+  }
+
   Result begin() const {
     Result out;
     out.tests = static_cast<int>(problem_.tests().size());
@@ -218,25 +284,39 @@ private:
   // loop stops (the reason said in `out`).
   bool add_the_best(int step, State& state, Result& out) {
     const Simulator& current = problem_.simulator(state.damping_scale);
-    const auto jobs = candidate_jobs(problem_, state, current, values_fitted_);
-    if (jobs.empty()) {
-      out.stop_reason = "no candidate is left to try: every joint already has every term "
-                        "asked for, and the substructure's damping is not tried";
-      return false;
-    }
     std::vector<Candidate> ranking;
     std::vector<State> states;
-    try_candidates(jobs, state, current, ranking, states);
-    const std::vector<std::size_t> order = screen(ranking, state, o_.min_explained);
+    std::vector<std::size_t> order;
+    const bool cached = step == 0 && first_.has_value();
+    if (cached) { // the first step of a second path: its candidates are the first path's
+      ranking = first_->ranking, states = first_->states, order = first_->order;
+    } else {
+      const auto jobs = candidate_jobs(problem_, state, current, values_fitted_);
+      if (jobs.empty()) {
+        out.stop_reason = "no candidate is left to try: every joint already has every term "
+                          "asked for, and the substructure's damping is not tried";
+        return false;
+      }
+      try_candidates(jobs, state, current, ranking, states);
+      order = screen(ranking, state, o_.min_explained);
+    }
+    if (step == 0 && !first_) first_ = FirstStep{ranking, states, order, {}};
+    std::vector<std::size_t> open = order;
+    if (step == 0 && coefficients_first_)
+      std::erase_if(open, [&](std::size_t i) {
+        return ranking[i].term && joints::has_parameters(*ranking[i].term);
+      });
     std::map<std::vector<int>, CrossValidation> cv_now;
     const Choice choice = choose(
-        ranking, order,
+        ranking, open,
         [&](std::size_t i) { return cross_validated_now(state, states[i], cv_now); },
         [&](std::size_t i) {
           return cross_validated(problem_, states[i].joints, states[i].damping_scale,
                                  united(state.failed, states[i].failed));
         });
-    if (step == 0) {
+    if (cached) {
+      out.diagnosis = first_->diagnosis;
+    } else if (step == 0) {
       std::vector<Candidate> additions;
       for (const auto& c : ranking)
         if (!c.varies) additions.push_back(c);
@@ -251,6 +331,7 @@ private:
         if (!b.finding.empty()) out.diagnosis.findings.push_back(b.finding);
         out.diagnosis.behaviour.push_back(std::move(b));
       }
+      first_->diagnosis = out.diagnosis;
     }
     Step s;
     for (std::size_t i : order)
@@ -365,9 +446,21 @@ private:
     out.diagnosis.findings.push_back(summary(out, compared));
   }
 
+  // The first step's candidates, before any was chosen, and the diagnosis made there: a second
+  // path starts from them.
+  struct FirstStep {
+    std::vector<Candidate> ranking;
+    std::vector<State> states;
+    std::vector<std::size_t> order;
+    Diagnosis diagnosis;
+  };
+
   Problem& problem_;
   const Options& o_;
-  bool values_fitted_ = false; // the model's values were identified (not all given)
+  bool values_fitted_ = false;      // the model's values were identified (not all given)
+  std::optional<FirstStep> first_;  // once the first step's candidates were tried
+  bool coefficients_first_ = false; // the first step takes a coefficient term only
+  std::optional<Candidate> avoid_;  // a second path stops when it adds this term
 };
 
 } // namespace

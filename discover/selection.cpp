@@ -31,6 +31,14 @@ double information_criterion(const Compared& compared, const Misfit& misfit, int
              : N * std::log(std::max(misfit.squared, 1e-300 * measured2) / N) + penalty;
 }
 
+double criterion_on_measurement_noise(const Compared& compared, const State& state) {
+  if (!comparable(compared, state)) return inf;
+  Compared own = compared;
+  for (Entry& e : own.entries)
+    e.simulation = e.force = 0.0;
+  return information_criterion(own, misfit(own, state.X, state.failed), state.parameters, true);
+}
+
 void score(State& state, const Compared& compared) {
   if (!comparable(compared, state)) { // too many tests left out: not compared at all
     state.gap = state.criterion = inf;

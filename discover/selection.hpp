@@ -24,6 +24,11 @@ class Problem;
 /// values compared); +∞ for a model whose re-simulations did not all converge.
 double information_criterion(const Compared& compared, const Misfit& misfit, int parameters,
                              bool converged);
+/// The criterion of a state judged on the measurement's own noise alone (the responses'
+/// variances; without the simulation's error and the force's noise, which depend on the model
+/// and would favour the model whose simulation is less exact); on the misfit alone where the
+/// noise is unknown. +∞ for a state that left out more tests than max_left_out.
+double criterion_on_measurement_noise(const Compared& compared, const State& state);
 /// A simulated state's gap, χ² (NaN when the noise is unknown) and information criterion, over
 /// the tests it re-simulated; +∞ (gap and criterion) when it left out more than max_left_out.
 void score(State& state, const Compared& compared);
