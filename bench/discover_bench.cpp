@@ -135,8 +135,8 @@ void describe(benchmark::State& state, const discover::Result& r, double cpu_bef
   auto print = [](const std::string& what, const std::vector<discover::Candidate>& ranking) {
     std::fprintf(stderr, "%s\n", what.c_str());
     for (const auto& c : ranking)
-      std::fprintf(stderr, "  %-28s gap %.4g criterion %.6g cv %.4g %s\n", c.name().c_str(),
-                   c.gap, c.criterion, c.cv_gap, c.rejected.c_str());
+      std::fprintf(stderr, "  %-28s gap %.4g criterion %.6g cv %.4g %s\n", c.name().c_str(), c.gap,
+                   c.criterion, c.cv_gap, c.rejected.c_str());
   };
   for (std::size_t i = 0; i < r.steps.size(); ++i)
     print("step " + std::to_string(i + 1) + ": + " + r.steps[i].added.name(), r.steps[i].ranking);

@@ -308,8 +308,7 @@ private:
       });
     std::map<std::vector<int>, CrossValidation> cv_now;
     const Choice choice = choose(
-        ranking, open,
-        [&](std::size_t i) { return cross_validated_now(state, states[i], cv_now); },
+        ranking, open, [&](std::size_t i) { return cross_validated_now(state, states[i], cv_now); },
         [&](std::size_t i) {
           return cross_validated(problem_, states[i].joints, states[i].damping_scale,
                                  united(state.failed, states[i].failed));

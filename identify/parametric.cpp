@@ -74,11 +74,11 @@ std::vector<Complex> describing_functions(const joints::Joint& j, std::size_t t,
   if (gap) {
     delta = j.parameter(t, "delta"), kg = j.parameter(t, "kg");
   } else {
-    sliders = j.terms[t] == joints::Term::jenkins
-                  ? joints::jenkins_sliders(j.parameter(t, "kt"), j.parameter(t, "fs"))
-                  : joints::iwan_sliders(j.parameter(t, "fs"), j.parameter(t, "kt"),
-                                         j.parameter(t, "chi"), j.parameter(t, "beta"),
-                                         j.iwan_sliders);
+    sliders =
+        j.terms[t] == joints::Term::jenkins
+            ? joints::jenkins_sliders(j.parameter(t, "kt"), j.parameter(t, "fs"))
+            : joints::iwan_sliders(j.parameter(t, "fs"), j.parameter(t, "kt"),
+                                   j.parameter(t, "chi"), j.parameter(t, "beta"), j.iwan_sliders);
   }
   // The amplitudes N is computed at: every one, or a grid in ln a with the onsets of the
   // term's kinks among its nodes (where a slider of at least 5 % of the stiffness starts to
@@ -124,9 +124,9 @@ std::vector<Complex> describing_functions(const joints::Joint& j, std::size_t t,
   // Linear in ln a between the grid's nodes.
   for (std::size_t i = 0; i < amplitudes.size(); ++i) {
     const auto above = std::upper_bound(at.begin(), at.end(), amplitudes[i]);
-    const auto k = std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(
-                                above - at.begin() - 1, 0)),
-                            at.size() - 2);
+    const auto k =
+        std::min(static_cast<std::size_t>(std::max<std::ptrdiff_t>(above - at.begin() - 1, 0)),
+                 at.size() - 2);
     const double w =
         std::clamp(std::log(amplitudes[i] / at[k]) / std::log(at[k + 1] / at[k]), 0.0, 1.0);
     out[i] = (1.0 - w) * N[k] + w * N[k + 1];

@@ -37,8 +37,7 @@ std::complex<double> describing_function(const joints::Joint& joint, std::size_t
 /// falls as x^{3/2} (x = ln a/φ), which costs 0.25 k h^{3/2}, and a smaller slider's kink a
 /// quarter of h times its slope's jump: about 2e-3 of the stiffness at 24 points per e-fold.
 /// For a fit's start, not for a result.
-std::vector<std::complex<double>> describing_functions(const joints::Joint& joint,
-                                                       std::size_t term,
+std::vector<std::complex<double>> describing_functions(const joints::Joint& joint, std::size_t term,
                                                        std::span<const double> amplitudes,
                                                        int per_efold = 0, int samples = 128);
 
