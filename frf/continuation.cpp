@@ -691,7 +691,8 @@ ResponseBranch trace_points(const ModalSynthesis& H, const std::vector<joints::J
 // between two computed ones whose verdicts differ, until neighbouring computed points agree or
 // are adjacent. A point between two that agree takes their verdict.
 void assign_stability(ResponseBranch& branch, const std::vector<int>& even, int stride,
-                      const std::function<Stability(const HarmonicBalanceResult&)>& check) {
+                      const std::function<Stability(const HarmonicBalanceResult&)>& check,
+                      const std::function<void(double)>& progress) {
   std::vector<ResponsePoint>& p = branch.points;
   const std::size_t N = p.size();
   if (N == 0) return;
@@ -707,6 +708,11 @@ void assign_stability(ResponseBranch& branch, const std::vector<int>& even, int 
   for (std::size_t i = 1; i < even.size() && i < N; ++i)
     if (even[i] != even[i - 1])
       want(static_cast<std::ptrdiff_t>(i) - 1), want(static_cast<std::ptrdiff_t>(i));
+  // Progress: the points computed of those wanted so far (more may be wanted later), never
+  // going back.
+  double reported = 0.0;
+  std::size_t done = 0, undetermined = 0;
+  std::string first_note; // of the first point whose stability could not be determined
   for (bool more = true; more;) {
     for (std::size_t i = 0; i < N; ++i)
       if (wanted[i] && !p[i].stability_checked) {
@@ -714,6 +720,15 @@ void assign_stability(ResponseBranch& branch, const std::vector<int>& even, int 
         p[i].stable = s.stable;
         if (s.stable) p[i].max_multiplier = s.multipliers.cwiseAbs().maxCoeff();
         p[i].stability_checked = true;
+        if (!s.stable && undetermined++ == 0)
+          first_note =
+              hz(p[i].hb.frequency_hz) + ": " + (s.note.empty() ? "no reason given" : s.note);
+        ++done;
+        if (progress) {
+          const auto total = static_cast<double>(std::count(wanted.begin(), wanted.end(), 1));
+          reported = std::max(reported, static_cast<double>(done) / total);
+          progress(reported);
+        }
       }
     more = false;
     for (std::size_t a = 0, b = 1; b < N; ++b) {
@@ -732,6 +747,12 @@ void assign_stability(ResponseBranch& branch, const std::vector<int>& even, int 
       p[i].stable = p[a].stable;
     a = b;
   }
+  if (undetermined > 0)
+    branch.notes.push_back("the stability of " + std::to_string(undetermined) + " of the " +
+                           std::to_string(done) +
+                           " points whose Floquet multipliers were computed could not be "
+                           "determined (the first at " +
+                           first_note + ")");
 }
 
 } // namespace
@@ -744,12 +765,21 @@ ResponseBranch trace_response(const ModalSynthesis& H, const std::vector<joints:
   if (o.stability_stride < 1)
     throw std::invalid_argument("response curve: stability_stride must be at least 1");
   std::vector<int> even;
+  const bool stability = o.stability && !has_exact_friction(joints, o.hb);
+  // Tracing reports the first half of the fraction, the stability the second (if checked).
+  const auto half = [&](double offset) -> std::function<void(double)> {
+    if (!progress) return {};
+    if (!stability) return progress;
+    return [&progress, offset](double fraction) { progress(offset + 0.5 * fraction); };
+  };
   ResponseBranch branch = trace_points(H, joints, dofs, std::move(force_equations), F,
-                                       std::move(outputs), start_hz, end_hz, o, progress, even);
-  if (o.stability && !has_exact_friction(joints, o.hb))
-    assign_stability(branch, even, o.stability_stride, [&](const HarmonicBalanceResult& r) {
-      return floquet_stability(H, joints, dofs, r, o.hb);
-    });
+                                       std::move(outputs), start_hz, end_hz, o, half(0.0), even);
+  if (stability)
+    assign_stability(
+        branch, even, o.stability_stride,
+        [&](const HarmonicBalanceResult& r) { return floquet_stability(H, joints, dofs, r, o.hb); },
+        half(0.5));
+  if (progress) progress(1.0);
   return branch;
 }
 

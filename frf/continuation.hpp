@@ -96,7 +96,9 @@ struct ResponseBranch {
 /// `start_hz` to `end_hz` (either order). Throws std::invalid_argument for bad arguments
 /// (frequencies not > 0 or equal, bad options); a branch that cannot be continued is returned
 /// with complete = false and a note saying where and why. `progress(fraction)` is called after
-/// each point with the fraction of the band covered.
+/// each point: the fraction of the band covered, then, with stability, after each point whose
+/// multipliers are computed (tracing takes the first half of the fraction, the Floquet checks
+/// the second: each is about half of a curve's time).
 ResponseBranch trace_response(const ModalSynthesis& synthesis,
                               const std::vector<joints::Joint>& joints, const fem::DofMap& dofs,
                               std::vector<int> force_equations, const Eigen::MatrixXcd& F,

@@ -87,7 +87,8 @@ ResponseCurves response(const ModelPtr& model, const std::string& force,
   }
   const fem::NodeDof force_at = model->dof("force", force);
 
-  // 2. The curves; Ctrl-C is looked for after every point.
+  // 2. The curves; Ctrl-C is looked for after every point traced and every point whose
+  // stability is computed.
   return released([&](InterruptCheck& check) {
     const std::lock_guard<std::mutex> lock(model->busy);
     const std::function<void(std::size_t, double)> each = [&check](std::size_t, double) {

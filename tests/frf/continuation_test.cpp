@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -205,6 +207,40 @@ TEST(Continuation, HardeningCubicFoldsAndStability) {
   ASSERT_TRUE(s.status.ok());
   const Complex T1 = harmonic(s.u.col(0), s.t, w, 1);
   EXPECT_LT(std::abs(T1 - three[0].X(1, 0)), 1e-4 * std::abs(three[0].X(1, 0)));
+}
+
+TEST(Continuation, ProgressRisesToTheEndThroughTracingAndThenTheStabilityChecks) {
+  // With stability, tracing reports the first half of the fraction and the Floquet checks the
+  // second: the fraction never falls, passes 0.5 once the band is covered, is reported once for
+  // each point whose multipliers are computed after that, and ends at 1. Without stability the
+  // band's coverage is the fraction (it reaches 1 when the branch ends).
+  const PaperCantilever c;
+  const std::vector<joints::Joint> js{make("tip", 7, {Term::k3}, {1.6e8})};
+  for (const bool stability : {true, false}) {
+    frf::ContinuationOptions o;
+    o.stability = stability;
+    std::vector<double> seen;
+    const frf::ResponseBranch b =
+        frf::trace_response(c.H, js, c.system.dofs, {c.eq(7)}, frf::sine_force(0.5), {c.eq(7)}, 2.5,
+                            4.5, o, [&](double fraction) { seen.push_back(fraction); });
+    ASSERT_TRUE(b.complete);
+    ASSERT_FALSE(seen.empty());
+    for (std::size_t i = 1; i < seen.size(); ++i)
+      EXPECT_GE(seen[i], seen[i - 1]) << i;
+    EXPECT_EQ(seen.back(), 1.0);
+    std::size_t computed = 0;
+    for (const auto& p : b.points)
+      computed += p.stability_checked ? 1 : 0;
+    // Reports after tracing ended at the half: one per point computed, and the final 1.
+    const auto first_after = std::find(seen.begin(), seen.end(), 0.5);
+    if (stability) {
+      ASSERT_NE(first_after, seen.end());
+      EXPECT_EQ(static_cast<std::size_t>(seen.end() - first_after) - 1, computed + 1);
+      EXPECT_GT(computed, 0u);
+    } else {
+      EXPECT_EQ(computed, 0u);
+    }
+  }
 }
 
 TEST(Continuation, SofteningTracedUpAndDownAlike) {

@@ -3,6 +3,9 @@
 // MeasuredFrf::validate refuses.
 #include "frf/measured_frf.hpp"
 
+#include "frf/continuation.hpp"
+#include "frf/harmonic_balance.hpp"
+
 #include "frf/receptance.hpp"
 #include "frf/substructure.hpp"
 #include "support/error_of.hpp"
@@ -189,4 +192,37 @@ TEST(MeasuredFrf, TheSubstructureHasNoModesToScaleOrIntegrate) {
   const frf::ModalSynthesis only_7 = sub.synthesis({1}, 40.0);
   const int r[] = {0}, c[] = {1};
   EXPECT_THROW((void)only_7.receptance(two_pi * 5.0, r, c), std::invalid_argument);
+}
+
+TEST(MeasuredFrf, AResponseCurveSaysOnceThatItsStabilityCannotBeDetermined) {
+  // Floquet's method needs modes, which measured FRFs do not have: a response curve of a
+  // non-linear joint on them has no point with a verdict, and its notes say so once, with the
+  // number of points tried and the first one's reason.
+  const frf::Substructure sub(sampled(0.0, 0.05, 801));
+  const frf::ModalSynthesis H = sub.synthesis({1}, 40.0);
+  joints::Joint j{"tip", 7, 0, Dof::uy, {joints::Term::k, joints::Term::k3}, {1000.0, 1e7}, {}, {}};
+  j.fixed.assign(2, true);
+  frf::ContinuationOptions o;
+  o.hb.harmonics = 3; // 3 × 12 Hz within the measured 40 Hz
+  const frf::ResponseBranch b =
+      frf::trace_response(H, {j}, sub.dofs(), {1}, frf::sine_force(1.0), {1}, 8.0, 12.0, o);
+  ASSERT_TRUE(b.complete);
+  ASSERT_FALSE(b.points.empty());
+  std::size_t computed = 0;
+  for (const auto& p : b.points) {
+    EXPECT_FALSE(p.stable.has_value());
+    computed += p.stability_checked ? 1 : 0;
+  }
+  EXPECT_GT(computed, 1u);
+  std::size_t said = 0;
+  for (const auto& n : b.notes)
+    if (n.find("could not be determined") != std::string::npos) {
+      ++said;
+      EXPECT_NE(n.find("the stability of " + std::to_string(computed) + " of the " +
+                       std::to_string(computed) + " points"),
+                std::string::npos)
+          << n;
+      EXPECT_NE(n.find("measured FRFs have no modes"), std::string::npos) << n;
+    }
+  EXPECT_EQ(said, 1u);
 }
