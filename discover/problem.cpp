@@ -383,12 +383,14 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
 
 std::vector<std::vector<Eigen::MatrixXcd>>
 Problem::derivatives(const State& at, const std::vector<std::vector<joints::Joint>>& moved,
-                     const std::vector<double>& steps, const Simulator& sim) const {
+                     const std::vector<double>& steps, const Simulator& sim,
+                     std::span<const int> skip) const {
   std::vector<std::vector<Eigen::MatrixXcd>> out(tests_.size());
   for (std::size_t i = 0; i < tests_.size(); ++i) {
     const int t = static_cast<int>(i);
     if (i >= at.Y.size() || at.Y[i].size() == 0 ||
-        std::binary_search(at.failed.begin(), at.failed.end(), t))
+        std::binary_search(at.failed.begin(), at.failed.end(), t) ||
+        std::binary_search(skip.begin(), skip.end(), t))
       continue;
     if (o_.checkpoint) o_.checkpoint();
     out[i] = sim.balance[i].output_derivatives(at.joints, drive_[i], at.Y[i], moved, steps);

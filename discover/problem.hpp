@@ -114,10 +114,12 @@ public:
   /// responses) with respect to moves of its joints, `moved[p]` by steps[p], by implicit
   /// differentiation of each test's harmonic balance (frf::HarmonicBalance::output_derivatives):
   /// [test][p], no entries for a test `at` left out, an empty matrix where a derivative could
-  /// not be formed (the caller re-simulates for it).
+  /// not be formed (the caller re-simulates for it). No entries either for the tests in `skip`
+  /// (ascending: those the caller does not compare).
   std::vector<std::vector<Eigen::MatrixXcd>>
   derivatives(const State& at, const std::vector<std::vector<joints::Joint>>& moved,
-              const std::vector<double>& steps, const Simulator& sim) const;
+              const std::vector<double>& steps, const Simulator& sim,
+              std::span<const int> skip = {}) const;
   /// Test i's steady state: from `warm` or the measured deformation first, else from the linear
   /// response with load continuation.
   frf::HarmonicBalanceResult solve(const Simulator& sim, int i,

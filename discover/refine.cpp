@@ -354,7 +354,7 @@ private:
         steps.push_back(m.front().first), column.push_back(q);
         moved.push_back(std::move(m.front().second));
       }
-    const auto D = problem_.derivatives(current_, moved, steps, sim_);
+    const auto D = problem_.derivatives(current_, moved, steps, sim_, left_out_);
     for (std::size_t m = 0; m < column.size(); ++m) {
       Eigen::Index n = 0;
       const Eigen::Index q = column[m];
