@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <stdexcept>
 
 namespace jointid::discover::detail {
@@ -168,9 +169,10 @@ Outcome consider_variation(const Problem& problem, const State& state, const Sim
     if (std::string why = friction_problem(per_test.back()); !why.empty())
       return refused(std::move(c), state, tests[i].source + ": " + why);
     v.tests.push_back(tests[i].source);
-    v.amplitude.push_back(
-        std::abs(problem.measured_deformation(i)(1, static_cast<Eigen::Index>(jj))));
-    v.frequency_hz.push_back(tests[i].frequency_hz);
+    // (a periodic test's lines as one sine: identify::joint_equivalent_sine)
+    const auto [a, omega] = identify::joint_equivalent_sine(tests[i], state.joints[jj]);
+    v.amplitude.push_back(a);
+    v.frequency_hz.push_back(omega / (2.0 * std::numbers::pi));
   }
   State s = problem.evaluate_each(state.joints, per_test, sim, &state);
   judge_variation(c, std::move(v), s, state.joints[jj]);

@@ -108,7 +108,9 @@ struct Options {
 struct Variation {
   std::vector<std::string> tests;
   std::vector<double> value, std; ///< per test: the term from that test alone (SI)
-  std::vector<double> amplitude;  ///< per test: |Y_1| of the joint's deformation (m or rad)
+  /// per test: |Y_1| of the joint's deformation (m or rad), and the test's frequency; a
+  /// periodic test's lines as one sine of the same RMS (identify::joint_equivalent_sine)
+  std::vector<double> amplitude;
   std::vector<double> frequency_hz;
   double chi2 = 0.0;                  ///< of the values about their weighted mean
   int dof = 0;                        ///< tests − 1
@@ -218,8 +220,10 @@ struct ResponseCurve {
 struct JointBehaviour {
   std::string joint;
   std::vector<std::string> tests;
-  std::vector<double> amplitude;    ///< |Y₁| of the deformation, m (rad)
-  std::vector<double> frequency_hz; ///< of the test
+  /// |Y₁| of the deformation, m (rad); a periodic test's lines as one sine of the same RMS, at
+  /// the frequency of the same RMS rate (identify::joint_equivalent_sine)
+  std::vector<double> amplitude;
+  std::vector<double> frequency_hz; ///< of the test (a periodic test: that sine's)
   std::vector<double> dissipation;  ///< D per cycle, J
   std::vector<double> stiffness;    ///< k_eq, N/m (N m/rad)
   /// D fitted as π c ω a² + A a^s (c, A ≥ 0, s from a scan): the power s of the part that is not

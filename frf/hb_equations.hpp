@@ -3,11 +3,15 @@
 /// frequency, shared by HarmonicBalance::solve() and the frequency continuation.
 #include "frf/harmonic_balance.hpp"
 
+#include "fem/fft.hpp"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 #include <new>
 #include <numbers>
 #include <span>
@@ -158,6 +162,12 @@ struct Equations {
   // symmetric) until it closes; its exact derivative with respect to the samples is kept for
   // jacobian().
   std::vector<joints::Sliders> sliders{};
+
+  // From this many unknowns per block (a periodic test's hundreds of lines) the transforms
+  // between samples and harmonics run by FFT (below: forward, trig_sums, samples), and so does
+  // the hysteretic loop's derivative, O(m Nt log Nt) instead of the forward table's O(m² Nt).
+  // A variable so that the tests can compare the two routes.
+  static inline int fft_from = 96;
 
   bool symmetric() const { return harmonics.front() != 0; }
   int count() const { return static_cast<int>(harmonics.size()); }
@@ -322,9 +332,71 @@ struct Equations {
     }
   }
 
+  // The transforms between samples and harmonics: by the tables (O(Nt m) a transform), or from
+  // fft_from unknowns a block by FFT of the whole period (O(Nt log Nt)): a symmetric problem's
+  // kept samples are the first half, the second half the first negated (odd harmonics) or
+  // repeated (a weight of even harmonics).
+  bool by_fft() const { return m() >= fft_from; }
+  int period_samples() const { return symmetric() ? 2 * Nt : Nt; }
+  static fem::RealFft& fft(int n) {
+    thread_local std::map<int, std::unique_ptr<fem::RealFft>> plans;
+    auto& plan = plans[n];
+    if (!plan) plan = std::make_unique<fem::RealFft>(n);
+    return *plan;
+  }
+  // Packed harmonics (m) of the signal sampled at the kept samples `x` (Nt): forward · x.
+  void forward(const double* x, double* out) const {
+    if (!by_fft()) {
+      multiply_transposed(forward_t, x, out);
+      return;
+    }
+    const int N = period_samples();
+    Eigen::VectorXd full(N);
+    const Eigen::Map<const Eigen::VectorXd> kept(x, Nt);
+    full.head(Nt) = kept;
+    if (symmetric()) full.tail(Nt) = -kept;
+    const Eigen::VectorXcd S = fft(N).forward(full);
+    if (!symmetric()) out[0] = S(0).real() / N;
+    for (int i = first(); i < count(); ++i) {
+      const Complex v = 2.0 * S(harmonics[i]) / static_cast<double>(N);
+      out[at(i)] = v.real(), out[at(i) + 1] = v.imag();
+    }
+  }
+  // trigᵀ w: the cosine and sine sums of the weight w at the kept samples (Nt), Σ w cos pθ_n
+  // then Σ w sin pθ_n for the p tabulated (0, s, 2s, … 2 max(harmonics)).
+  void trig_sums(const double* w, double* out) const {
+    if (!by_fft()) {
+      multiply_transposed(trig, w, out);
+      return;
+    }
+    // Over the kept samples θ_n = 2πn / period_samples(): when symmetric, p = 2q and the sums
+    // are bin q of the FFT of the Nt samples.
+    const Eigen::Index np = trig.cols() / 2;
+    const Eigen::VectorXcd S = fft(Nt).forward(Eigen::Map<const Eigen::VectorXd>(w, Nt));
+    for (Eigen::Index q = 0; q < np; ++q) { // (past Nyquist, a real signal's bins fold back)
+      const Eigen::Index b = q % Nt;
+      const Complex Sq = b <= Nt / 2 ? S(b) : std::conj(S(Nt - b));
+      out[q] = Sq.real(), out[np + q] = -Sq.imag();
+    }
+  }
+
   // y and ẏ at the samples (2 Nt: y, then ẏ) from the packed harmonics `x` of one block.
   void samples(const double* x, double* yv) const {
-    multiply(dyv_unit, x, yv);
+    if (!by_fft()) {
+      multiply(dyv_unit, x, yv);
+    } else {
+      const int N = period_samples();
+      Eigen::VectorXcd Y = Eigen::VectorXcd::Zero(N / 2 + 1), V = Y;
+      if (!symmetric()) Y(0) = x[0];
+      for (int i = first(); i < count(); ++i) {
+        const int k = harmonics[i];
+        const Complex h(x[at(i)], x[at(i) + 1]);
+        Y(k) = 0.5 * h, V(k) = Complex(0.0, 0.5 * k) * h;
+      }
+      fem::RealFft& plan = fft(N);
+      Eigen::Map<Eigen::VectorXd>(yv, Nt) = plan.inverse(Y).head(Nt);
+      Eigen::Map<Eigen::VectorXd>(yv + Nt, Nt) = plan.inverse(V).head(Nt);
+    }
     for (int n = Nt; n < 2 * Nt; ++n)
       yv[n] *= omega;
   }
@@ -344,7 +416,7 @@ struct Equations {
                           s.loop_force, &s.loop[u], s.loop_work);
       g.col(0) += Eigen::Map<const Eigen::VectorXd>(s.loop_force.data(), Nt);
     }
-    multiply_transposed(forward_t, g.data(), harmonics_out);
+    forward(g.data(), harmonics_out);
   }
 
   // Harmonics of the joints' forces (K+1) × nj at z, into G: the smooth forces (their samples
@@ -453,8 +525,8 @@ struct Equations {
     J.setIdentity(size(), size());
     for (int b = 0; b < nj; ++b) {
       const Scratch::Matrix& g = s.g[static_cast<std::size_t>(b)];
-      multiply_transposed(trig, g.col(1).data(), s.weights.col(0).data());
-      multiply_transposed(trig, g.col(2).data(), s.weights.col(1).data());
+      trig_sums(g.col(1).data(), s.weights.col(0).data());
+      trig_sums(g.col(2).data(), s.weights.col(1).data());
       s.D.setZero();
       add_product(s.weights.col(0), false, s.D);
       add_product(s.weights.col(1), true, s.D);
@@ -464,7 +536,15 @@ struct Equations {
         s.loop_dy.setZero();
         for (const joints::LoopEntry& e : s.loop[u])
           s.loop_dy.row(e.n) += e.value * dy.row(e.m);
-        s.D.noalias() += forward_t.transpose() * s.loop_dy;
+        if (by_fft()) {
+          Eigen::VectorXd column(m());
+          for (Eigen::Index c = 0; c < s.loop_dy.cols(); ++c) {
+            forward(s.loop_dy.col(c).data(), column.data());
+            s.D.col(c) += column;
+          }
+        } else {
+          s.D.noalias() += forward_t.transpose() * s.loop_dy;
+        }
       }
       for (int a = 0; a < nj; ++a)
         add_coupling(J, a, b, b * m(), s.D);
@@ -553,15 +633,27 @@ struct Equations {
 /// allocating once sized. At the 10–60 unknowns of a harmonic-balance point Eigen's
 /// PartialPivLU spends most of its time in blocking and dispatch (6 500 instructions for an
 /// 11 × 11 matrix, 45 000 for 30 × 30, against n³/3 multiply-adds); this is the textbook
-/// right-looking elimination, column-major, the trailing update a column at a time.
+/// right-looking elimination, column-major, the trailing update a column at a time. Above
+/// `blocked_from` unknowns (a periodic test's hundreds of lines) that elimination streams the
+/// whole trailing matrix through memory at every column, and Eigen's blocked PartialPivLU
+/// (matrix-matrix kernels) takes over, with the same pivoting and the same least pivot.
 template <class Scalar> struct SmallLU {
   using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  static constexpr Eigen::Index blocked_from = 160;
   Matrix lu;
   std::vector<int> pivots; // row k was swapped with row pivots[k]
   double min_pivot = 0.0;  // least |U_kk|: 0 (or rounding level) where the matrix is singular
+  Eigen::PartialPivLU<Matrix> blocked; // used when n >= blocked_from
+  bool is_blocked = false;
 
   template <class Source> void compute(const Source& A) {
+    is_blocked = A.rows() >= blocked_from;
+    if (is_blocked) {
+      blocked.compute(A);
+      min_pivot = blocked.matrixLU().diagonal().cwiseAbs().minCoeff();
+      return;
+    }
     lu = A;
     const Eigen::Index n = lu.rows();
     pivots.resize(static_cast<std::size_t>(n));
@@ -594,6 +686,10 @@ template <class Scalar> struct SmallLU {
 
   /// b ← A⁻¹ b; only meaningful where min_pivot > 0.
   template <class Rhs> void solve_in_place(Rhs& b) const {
+    if (is_blocked) {
+      b = blocked.solve(b).eval();
+      return;
+    }
     const Eigen::Index n = lu.rows();
     const Scalar* a = lu.data();
     for (Eigen::Index k = 0; k < n; ++k) // P b: the swaps in order (L's rows were swapped too)

@@ -22,32 +22,6 @@ namespace jointid::identify {
 
 namespace {
 
-// Lines 0 … K of a joint's basis functions on one period of its deformation y and rate ẏ (N
-// samples each). A broadband deformation makes basis functions with kinks (ẏ|ẏ|, sign ẏ) rich
-// far above the band, and sampled at the record's rate their content above its Nyquist
-// frequency would fold onto the lines (by 1e-4 of a term's force for ẏ|ẏ| of a 1–8 Hz multisine
-// at 256 Hz): y and ẏ are interpolated to four times the samples (their spectra zero-padded,
-// exact for a band-limited signal) before the basis functions see them.
-Eigen::MatrixXcd basis_lines(const joints::Joint& joint, const Eigen::VectorXd& y,
-                             const Eigen::VectorXd& ydot, double t0, double omega, int K) {
-  constexpr int oversampling = 4;
-  const auto N = static_cast<int>(y.size()), M = oversampling * N;
-  fem::RealFft coarse(N), fine(M);
-  auto interpolate = [&](const Eigen::VectorXd& x) {
-    const Eigen::VectorXcd S = coarse.forward(x);
-    Eigen::VectorXcd padded = Eigen::VectorXcd::Zero(M / 2 + 1);
-    const Eigen::Index keep = (N - 1) / 2; // below Nyquist (its bin is ambiguous: left out)
-    padded.head(keep + 1) = S.head(keep + 1);
-    return Eigen::VectorXd(fine.inverse(padded) / N);
-  };
-  const Eigen::VectorXd yu = interpolate(y), vu = interpolate(ydot);
-  Eigen::MatrixXd g(M, static_cast<Eigen::Index>(joint.terms.size()));
-  for (std::size_t term = 0; term < joint.terms.size(); ++term)
-    for (Eigen::Index r = 0; r < M; ++r)
-      g(r, static_cast<Eigen::Index>(term)) = joints::basis(joint.terms[term], yu(r), vu(r));
-  return period_harmonics(g, t0, omega, K);
-}
-
 // The force of parametric term t of joint j (parameters checked) at the samples y: a gap's
 // directly, a hysteretic term's steady loop over the samples taken as one period. Its
 // derivative ∂g/∂y at the samples (the stuck elements' stiffness for sliders) into `slope` if
@@ -81,6 +55,40 @@ void parametric_force(const joints::Joint& j, std::size_t t, const Eigen::Vector
   if (slope)
     for (const joints::LoopEntry& e : entries)
       if (e.n == e.m) (*slope)(e.n) += e.value;
+}
+
+// Lines 0 … K of a joint's basis functions on one period of its deformation y and rate ẏ (N
+// samples each). A broadband deformation makes basis functions with kinks (ẏ|ẏ|, sign ẏ) rich
+// far above the band, and sampled at the record's rate their content above its Nyquist
+// frequency would fold onto the lines (by 1e-4 of a term's force for ẏ|ẏ| of a 1–8 Hz multisine
+// at 256 Hz): y and ẏ are interpolated to four times the samples (their spectra zero-padded,
+// exact for a band-limited signal) before the basis functions see them. A term with named
+// parameters (held at its values) gives its force there: a hysteretic term's steady loop over
+// the interpolated period.
+Eigen::MatrixXcd basis_lines(const joints::Joint& joint, const Eigen::VectorXd& y,
+                             const Eigen::VectorXd& ydot, double t0, double omega, int K) {
+  constexpr int oversampling = 4;
+  const auto N = static_cast<int>(y.size()), M = oversampling * N;
+  fem::RealFft coarse(N), fine(M);
+  auto interpolate = [&](const Eigen::VectorXd& x) {
+    const Eigen::VectorXcd S = coarse.forward(x);
+    Eigen::VectorXcd padded = Eigen::VectorXcd::Zero(M / 2 + 1);
+    const Eigen::Index keep = (N - 1) / 2; // below Nyquist (its bin is ambiguous: left out)
+    padded.head(keep + 1) = S.head(keep + 1);
+    return Eigen::VectorXd(fine.inverse(padded) / N);
+  };
+  const Eigen::VectorXd yu = interpolate(y), vu = interpolate(ydot);
+  Eigen::MatrixXd g(M, static_cast<Eigen::Index>(joint.terms.size()));
+  for (std::size_t term = 0; term < joint.terms.size(); ++term) {
+    const auto c = static_cast<Eigen::Index>(term);
+    if (joints::has_parameters(joint.terms[term])) {
+      parametric_force(joint, term, yu, g.col(c));
+      continue;
+    }
+    for (Eigen::Index r = 0; r < M; ++r)
+      g(r, c) = joints::basis(joint.terms[term], yu(r), vu(r));
+  }
+  return period_harmonics(g, t0, omega, K);
 }
 
 } // namespace
@@ -188,13 +196,6 @@ TestSpectrum spectrum(const Measurement& m, const fem::DofMap& dofs,
             " of the record; the Coulomb basis sign(ydot) does not describe the force while stuck");
     }
     if (periodic) {
-      for (const joints::Term t : j.terms)
-        if (joints::has_parameters(t))
-          throw std::invalid_argument(
-              m.source + ": joint '" + j.name + "' has the term '" +
-              std::string(joints::term_name(t)) +
-              "' (named parameters): periodic broadband tests are identified with the "
-              "coefficient terms only; give sine tests or stepped-sine tables");
       s.G.push_back(basis_lines(j, y, ydot, m.t(0), omega, K));
     } else {
       Eigen::MatrixXd g(n, static_cast<Eigen::Index>(j.terms.size()));

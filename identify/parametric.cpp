@@ -134,16 +134,27 @@ std::vector<Complex> describing_functions(const joints::Joint& j, std::size_t t,
   return out;
 }
 
-double joint_amplitude(const Measurement& m, const joints::Joint& j) {
+EquivalentSine joint_equivalent_sine(const Measurement& m, const joints::Joint& j) {
   const int r = m.response_index({j.node, j.dof});
-  if (r < 0 || !m.has_harmonic(1)) return nan;
-  Complex Y = m.X(1, r);
-  if (!j.to_ground()) {
-    const int rb = m.response_index({j.node_b, j.dof});
-    if (rb < 0) return nan;
-    Y -= m.X(1, rb);
+  const int rb = j.to_ground() ? -1 : m.response_index({j.node_b, j.dof});
+  if (r < 0 || (!j.to_ground() && rb < 0)) return {nan, nan};
+  auto deformation = [&](int k) { return rb < 0 ? m.X(k, r) : m.X(k, r) - m.X(k, rb); };
+  const double w0 = 2.0 * std::numbers::pi * m.frequency_hz;
+  if (m.kind != RecordKind::periodic) {
+    if (!m.has_harmonic(1)) return {nan, nan};
+    return {std::abs(deformation(1)), w0};
   }
-  return std::abs(Y);
+  double power = 0.0, rate = 0.0;
+  for (const int l : m.lines) {
+    const double p = std::norm(deformation(l));
+    power += p, rate += p * (w0 * l) * (w0 * l);
+  }
+  if (!(power > 0.0)) return {0.0, nan};
+  return {std::sqrt(power), std::sqrt(rate / power)};
+}
+
+double joint_amplitude(const Measurement& m, const joints::Joint& j) {
+  return joint_equivalent_sine(m, j).amplitude;
 }
 
 std::vector<joints::Joint> with_parametric_fixed(std::vector<joints::Joint> joints) {
@@ -392,7 +403,7 @@ DescribingFunctionStart describing_function_start(const frf::Substructure& sub,
     fem::Status refused;  // the first per-test fit's status that was not ok
     std::string left_out; // the first per-test fit refused as input, why
     for (const Measurement& m : tests) {
-      const double a = joint_amplitude(m, J);
+      const auto [a, omega] = joint_equivalent_sine(m, J);
       if (!(a > 0.0)) continue;
       ++measured;
       try {
@@ -401,7 +412,6 @@ DescribingFunctionStart describing_function_start(const frf::Substructure& sub,
           if (refused.ok()) refused = r.status.within(m.source + ": ");
           continue;
         }
-        const double omega = 2.0 * std::numbers::pi * m.frequency_hz;
         const double k = r.joints[jj].terms[0].value, c = r.joints[jj].terms[1].value;
         points.push_back({a, omega, Complex(k - k_fixed, omega * (c - c_fixed))});
       } catch (const std::invalid_argument& e) {

@@ -41,8 +41,17 @@ std::vector<std::complex<double>> describing_functions(const joints::Joint& join
                                                        std::span<const double> amplitudes,
                                                        int per_efold = 0, int samples = 128);
 
-/// The amplitude of joint j's deformation fundamental in a test (|Y₁|, m), NaN when a DOF of
-/// the joint is not measured.
+/// The sine that stands for joint j's deformation in a test: a sine test's fundamental (|Y₁|
+/// in m, ω = 2π f); a periodic test's lines (Measurement::lines) as one sine of the same RMS,
+/// amplitude sqrt(Σ|Y_l|²), at the frequency of the same RMS rate, ω = sqrt(Σ ω_l² |Y_l|² /
+/// Σ |Y_l|²) — the amplitude and frequency a describing function of the joint is evaluated at
+/// for a broadband test (an approximation: a multisine's peaks exceed its RMS sine's). NaN
+/// amplitude when a DOF of the joint is not measured.
+struct EquivalentSine {
+  double amplitude = 0.0, omega = 0.0;
+};
+EquivalentSine joint_equivalent_sine(const Measurement& m, const joints::Joint& joint);
+/// Its amplitude (m).
 double joint_amplitude(const Measurement& m, const joints::Joint& joint);
 
 /// Coordinates the fits move a parameter in: u = log p for a positive parameter (> 0 or >= 0

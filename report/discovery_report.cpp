@@ -201,12 +201,13 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     gap.label = "gap";
     gap.style = Series::Style::line_points;
     for (std::size_t i = 0; i < r.gap.size(); ++i)
-      if (r.gap[i] > 0.0) gap.x.push_back(static_cast<double>(i + 1)), gap.y.push_back(r.gap[i]);
+      if (r.gap[i] > 0.0 && std::isfinite(r.gap[i])) // (not a model that simulated no test)
+        gap.x.push_back(static_cast<double>(i + 1)), gap.y.push_back(r.gap[i]);
     if (gap.x.size() == 1) { // one point: draw it as a short flat segment
       gap.x.push_back(1.25);
       gap.y.push_back(gap.y.front());
     }
-    c.series.push_back(gap);
+    if (!gap.x.empty()) c.series.push_back(gap);
     const double right = std::max(2.0, static_cast<double>(r.gap.size()));
     if (r.noise_gap > 0.0) {
       Series noise;

@@ -239,6 +239,33 @@ TEST(JointBehaviour, AJenkinsSlidingIsMacroslip) {
   EXPECT_NE(b.finding.find("macroslip"), std::string::npos);
 }
 
+TEST(JointBehaviour, AStiffnessNearZeroAtSmallAmplitudesChangesInNewtonsPerMetreNotPerCent) {
+  // A substructure fitted to a low-level test holds the stuck joint's stiffness: the joint is a
+  // correction, k = -kt beside its Jenkins element, about 0 at small amplitudes. Its change is
+  // said from one value to the other (a per cent of about 0 would be anything).
+  joints::Joint j{"tip",
+                  7,
+                  0,
+                  fem::Dof::uy,
+                  {Term::k, Term::c, Term::jenkins},
+                  {-5000.0, 0.0, 1.0},
+                  {false, false, false},
+                  {}};
+  j.parameters.resize(3);
+  j.set_parameters(2, {5000.0, 5.0});
+  std::vector<identify::EquivalentStiffness> points;
+  std::vector<std::string> names;
+  for (int i = 0; i < 8; ++i) {
+    const double a = 5e-4 * std::pow(40.0, i / 7.0), w = 2.0 * std::numbers::pi * 3.0;
+    points.push_back({a, w, joint_describing_function(j, a, w)});
+    names.push_back(std::to_string(i));
+  }
+  const auto b = behaviour("tip", points, names);
+  EXPECT_LT(std::abs(b.stiffness.front()), 1e-6 * 5000.0) << b.finding; // stuck at 0.5 mm
+  EXPECT_NE(b.finding.find("stiffness falls from"), std::string::npos) << b.finding;
+  EXPECT_EQ(b.finding.find("stiffness falls by"), std::string::npos) << b.finding;
+}
+
 TEST(JointBehaviour, AnIwanInMicroslipGrowsAsThreePlusChi) {
   // fs 100 N, kt 3000 N/m, beta 0.1: phi_max = 8.5 cm, beyond every amplitude; chi = −0.5, so
   // D ∝ a^2.5 (Segalman), against viscous damping's a².

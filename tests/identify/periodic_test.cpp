@@ -6,6 +6,7 @@
 #include "fem/excitation.hpp"
 #include "identify/fit.hpp"
 #include "identify/output_error.hpp"
+#include "identify/parametric.hpp"
 #include "identify/random_tests.hpp"
 #include "support/cantilever.hpp"
 #include "support/cantilever_substructure.hpp"
@@ -338,6 +339,79 @@ TEST(PeriodicIdentification, TwoJointsFromMultisineTests) {
       EXPECT_NEAR(r.joints[j].terms[t].value, truth[j].values[t], tolerance * truth[j].values[t])
           << truth[j].name << "." << joints::term_name(truth[j].terms[t]);
     }
+}
+
+// A joint whose force is partly known — a clearance (gap) and a slipping contact (jenkins) with
+// their parameters given and held — and whose k and c are fitted beside them, from multisine
+// tests at three levels without noise (time integration with exact stick–slip). The known
+// forces enter the equations at the lines through the measured deformation, interpolated four
+// times finer (a hysteretic term: its steady loop over the period): k and c to 1e-3 (found:
+// 6e-5 and 4e-4), the interpolation at the loop's reversals and the gap's kinks beside the
+// coefficient terms' round trip above (5e-4).
+TEST(PeriodicIdentification, KnownClearanceAndSlipForcesWithTheLinearTermsFittedBeside) {
+  joints::Joint truth = joint(
+      "tip", 7, 0, {joints::Term::k, joints::Term::c, joints::Term::gap, joints::Term::jenkins},
+      {4800.0, 20.0, 1.0, 1.0});
+  truth.set_parameters(2, {4e-3, 2.0e4}); // delta, kg: contact beyond 4 mm
+  truth.set_parameters(3, {1.0e4, 3.0});  // kt, fs: slips beyond 0.3 mm
+  std::vector<SineTest> tests;
+  for (double rms : {10.0, 40.0, 80.0})
+    tests.push_back(multisine_test({truth}, tip, rms, 10, 0.0, 1));
+  const FitOptions fo{.harmonics = {1, 2, 3}};
+  const std::vector<Measurement> measured = measure(tests, measure_options(fo));
+  // The largest deformation passes the gap (and so slips: beyond fs / kt = 0.3 mm).
+  double largest = 0.0;
+  for (const auto& m : measured) {
+    ASSERT_EQ(m.kind, RecordKind::periodic);
+    largest = std::max(largest, m.x.col(m.response_index(tip)).cwiseAbs().maxCoeff());
+  }
+  EXPECT_GT(largest, 4e-3);
+  joints::Joint model = truth;
+  model.values[0] = model.values[1] = 0.0; // k and c unknown
+  const FitResult r = fit(cantilever(), {model}, measured, fo);
+  ASSERT_TRUE(r.status.ok()) << r.status.reason;
+  EXPECT_NEAR(r.joints[0].terms[0].value, 4800.0, 1e-3 * 4800.0);
+  EXPECT_NEAR(r.joints[0].terms[1].value, 20.0, 1e-3 * 20.0);
+  // Without the known forces, k and c cannot stand for them: far off.
+  joints::Joint linear = joint("tip", 7, 0, {joints::Term::k, joints::Term::c}, {0.0, 0.0});
+  const FitResult without = fit(cantilever(), {linear}, measured, fo);
+  ASSERT_TRUE(without.status.ok()) << without.status.reason;
+  EXPECT_GT(std::abs(without.joints[0].terms[1].value - 20.0), 0.2 * 20.0);
+}
+
+// The sine that stands for a periodic test's joint deformation has its RMS and its rate's RMS:
+// checked against the RMS of the deformation's samples over a period (a 4096-sample sum, exact
+// for the lines' sines).
+TEST(PeriodicIdentification, AJointsEquivalentSineHasTheDeformationsRmsAndItsRatesRms) {
+  Measurement m;
+  m.kind = RecordKind::periodic;
+  m.frequency_hz = 0.25;
+  m.harmonics = 9;
+  m.lines = {3, 4, 7, 9};
+  m.response_at = {{7, fem::Dof::uy}, {3, fem::Dof::uy}};
+  m.X = Eigen::MatrixXcd::Zero(10, 2);
+  m.X(3, 0) = Complex(2e-3, 1e-3), m.X(4, 0) = Complex(-1e-3, 0.5e-3);
+  m.X(7, 0) = Complex(0.0, -3e-4), m.X(9, 0) = Complex(1e-4, 1e-4);
+  m.X(3, 1) = Complex(1e-4, 0.0), m.X(4, 1) = Complex(0.0, 2e-4), m.X(7, 1) = Complex(5e-5, 0.0);
+  m.X(5, 0) = Complex(1.0, 0.0); // not a line: left out
+  const joints::Joint j = joint("link", 7, 3, {joints::Term::k}, {1.0});
+  const EquivalentSine s = joint_equivalent_sine(m, j);
+  const int n = 4096;
+  const double w0 = two_pi * m.frequency_hz;
+  double y2 = 0.0, v2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double t = i / (n * m.frequency_hz);
+    double y = 0.0, v = 0.0;
+    for (const int l : m.lines) {
+      const Complex Y = m.X(l, 0) - m.X(l, 1), e = std::polar(1.0, l * w0 * t);
+      y += (Y * e).real();
+      v += (Complex(0.0, l * w0) * Y * e).real();
+    }
+    y2 += y * y / n, v2 += v * v / n;
+  }
+  EXPECT_NEAR(s.amplitude, std::sqrt(2.0 * y2), 1e-12 * s.amplitude);
+  EXPECT_NEAR(s.amplitude * s.omega, std::sqrt(2.0 * v2), 1e-12 * s.amplitude * s.omega);
+  EXPECT_DOUBLE_EQ(joint_amplitude(m, j), s.amplitude);
 }
 
 // Output error re-simulates each test by the harmonic balance of one excitation frequency: a
