@@ -41,7 +41,9 @@
 ///  3. it lowers the Bayesian information criterion — with known noise χ² + p ln N, else
 ///     N ln(S/N) + p ln N (S the squared gap, N real compared values, p identified
 ///     parameters) — so an extra term must buy more than ln N in χ²,
-///  4. it explains at least min_explained (5 %) of the squared gap, and
+///  4. it explains at least min_explained (5 %) of the squared gap or, with the noise known, of
+///     χ² (tests at levels far apart weigh in the gap as their amplitudes squared, the largest
+///     deciding; in χ² each as its own noise), and
 ///  5. it predicts held-out tests better: the cross-validated gap (leave one test out, or
 ///     `folds` folds above 30 tests) falls.
 /// Besides these additions, every non-fixed term of the model is tried with a value per test
@@ -143,7 +145,11 @@ struct Candidate {
   double gap = 0.0;       ///< after adding it
   double criterion = 0.0; ///< information criterion after adding it
   double explained = 0.0; ///< share of the squared gap it removes (negative: worse)
-  bool converged = true;  ///< every re-simulation converged
+  /// With the noise known: its χ² (NaN otherwise), the model's before it on the same tests
+  /// (< 0: the model's own), and the share of that χ² it removes (NaN: not known).
+  double chi2 = std::numeric_limits<double>::quiet_NaN(), chi2_now = -1.0;
+  double chi2_explained = std::numeric_limits<double>::quiet_NaN();
+  bool converged = true; ///< every re-simulation converged
   /// Tests whose re-simulation with it did not converge, even from the measured response:
   /// left out of its comparison with the model before it, which is compared on the same tests
   /// (`gap` and `gap_now` are over those; its criterion is the model's plus the difference).

@@ -75,6 +75,7 @@ void compare_on_common_tests(Candidate& candidate, const State& state, const Sta
   const Misfit mc = misfit(compared, state.X, out), mn = misfit(compared, now.X, out);
   candidate.gap = gap(compared, mc);
   candidate.gap_now = gap(compared, mn);
+  candidate.chi2 = mc.chi2, candidate.chi2_now = mn.chi2;
   candidate.criterion = now.criterion +
                         information_criterion(compared, mc, state.parameters, true) -
                         information_criterion(compared, mn, now.parameters, true);
@@ -108,6 +109,7 @@ void clamp_dissipative(std::vector<joints::Joint>& joints) {
 
 void fill(Candidate& candidate, const State& state) {
   candidate.gap = state.gap;
+  candidate.chi2 = state.chi2;
   candidate.criterion = state.criterion;
   candidate.converged = state.converged;
   if (!std::isfinite(state.criterion)) candidate.rejected = "a re-simulation did not converge";
@@ -167,6 +169,12 @@ double explained(double gap, double gap_now) {
 
 std::string explained_problem(const Candidate& candidate, double min_explained) {
   if (!(candidate.explained < min_explained)) return {};
+  // With the noise known, its χ² share counts too: tests at levels far apart weigh in the gap
+  // as their amplitudes squared (the largest decides), in χ² each as its own noise.
+  if (candidate.chi2_explained >= min_explained) return {};
+  if (std::isfinite(candidate.chi2_explained))
+    return fmt::format("explains too little: {} of the gap and {} of χ² (at least {} needed)",
+                       pct(candidate.explained), pct(candidate.chi2_explained), pct(min_explained));
   return fmt::format("explains too little: {} of the gap (at least {} needed)",
                      pct(candidate.explained), pct(min_explained));
 }
@@ -194,6 +202,10 @@ std::vector<std::size_t> screen(std::vector<Candidate>& ranking, const State& no
     order[i] = i;
     Candidate& c = ranking[i];
     c.explained = explained(c.gap, c.gap_now >= 0.0 ? c.gap_now : now.gap);
+    const double chi2_now = c.chi2_now >= 0.0 ? c.chi2_now : now.chi2;
+    c.chi2_explained = std::isfinite(c.chi2) && chi2_now > 0.0
+                           ? 1.0 - c.chi2 / chi2_now
+                           : std::numeric_limits<double>::quiet_NaN();
     if (c.rejected.empty()) c.rejected = criterion_problem(c, now.criterion);
     if (c.rejected.empty()) c.rejected = explained_problem(c, min_explained);
   }

@@ -64,7 +64,8 @@ std::string interval_problem(const Candidate& candidate);
 // Rule 3: the information criterion falls.
 std::string criterion_problem(const Candidate& candidate, double criterion_now);
 
-// Rule 4: the candidate explains at least `min_explained` of the squared gap.
+// Rule 4: the candidate explains at least `min_explained` of the squared gap or, with the
+// noise known, of χ² (Candidate::chi2_explained).
 /// The share of the squared gap that a state with `gap` removes from one with `gap_now`.
 double explained(double gap, double gap_now);
 std::string explained_problem(const Candidate& candidate, double min_explained);

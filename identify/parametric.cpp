@@ -203,6 +203,15 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
   joints::Joint trial = J;
   if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
     trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+  // Each point's misfit relative to its |Z|, but not below a tenth of the largest: a joint that
+  // is a correction to a substructure fitted at low level (its stiffness there in the
+  // substructure) has Z near 0 at small amplitudes, where relative errors would be its noise.
+  double largest = 0.0;
+  for (const Point& P : points)
+    largest = std::max(largest, std::abs(P.Z));
+  const auto misfit_scale = [&](const Point& P) {
+    return std::max({std::abs(P.Z), 0.1 * largest, 1e-300});
+  };
   const auto residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) -> bool {
     for (Eigen::Index p = 0; p < np; ++p) {
       joints::Parameter& P = trial.parameters[T][static_cast<std::size_t>(p)];
@@ -223,7 +232,7 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
     double kw = 0.0, w = 0.0, cw = 0.0, wc = 0.0;
     for (Eigen::Index i = 0; i < n; ++i) {
       const Point& P = points[static_cast<std::size_t>(i)];
-      const double wi = 1.0 / std::max(std::norm(P.Z), 1e-300);
+      const double wi = 1.0 / std::pow(misfit_scale(P), 2);
       kw += wi * e(i).real(), w += wi;
       cw += wi * P.omega * e(i).imag(), wc += wi * P.omega * P.omega;
     }
@@ -231,7 +240,7 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
     r.resize(2 * n);
     for (Eigen::Index i = 0; i < n; ++i) {
       const Point& P = points[static_cast<std::size_t>(i)];
-      const Complex d = (e(i) - Complex(k, P.omega * c)) / std::max(std::abs(P.Z), 1e-300);
+      const Complex d = (e(i) - Complex(k, P.omega * c)) / misfit_scale(P);
       r(2 * i) = d.real(), r(2 * i + 1) = d.imag();
     }
     return r.allFinite();
@@ -242,7 +251,12 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
   double dissipation = 0.0; // π a² Im Z: the dissipation per cycle, largest
   for (const Point& P : points)
     dissipation = std::max(dissipation, std::numbers::pi * P.amplitude * P.amplitude * P.Z.imag());
-  const double lost = lo.Z.real() - hi.Z.real(), gained = -lost;
+  // The stiffness lost by slip and gained by contact: from the smallest amplitude's to the
+  // least and the largest over the points (a joint can first slip, then close a clearance).
+  double least = lo.Z.real(), most = lo.Z.real();
+  for (const Point& P : points)
+    least = std::min(least, P.Z.real()), most = std::max(most, P.Z.real());
+  const double lost = lo.Z.real() - least, gained = most - lo.Z.real();
   const double k_small = std::max(k_open ? lost : lo.Z.real(), 1e-3 * std::abs(lo.Z));
   std::vector<std::vector<double>> starts;
   if (J.parameters.size() > T && J.parameters[T].size() == info.size() &&

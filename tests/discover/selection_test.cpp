@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -151,6 +152,31 @@ TEST(Rule4, ACandidateThatExplainsLessThanTheMinimumIsRejected) {
   ranking[0].rejected.clear();
   screen(ranking, now, 0.01);
   EXPECT_EQ(ranking[0].rejected, "") << "1.99 % is enough when 1 % is asked";
+}
+
+TEST(Rule4, WithTheNoiseKnownAShareOfChi2IsEnoughWhereTheGapsIsNot) {
+  // Tests at levels far apart: the largest decides the gap (it falls by 1.99 %), each its own
+  // noise in χ² (it falls from 1000 to 600: 40 %). With χ² known the candidate is admitted; its
+  // χ² on the same tests as the model's (chi2_now) is the one compared where set.
+  State now = current(0.2, 100.0);
+  now.chi2 = 1000.0;
+  std::vector<discover::Candidate> ranking{candidate(Term::jenkins, 0.198, 90.0)};
+  ranking[0].chi2 = 600.0;
+  screen(ranking, now, 0.05);
+  EXPECT_NEAR(ranking[0].chi2_explained, 0.4, 1e-14);
+  EXPECT_EQ(ranking[0].rejected, "");
+  // 3 % of χ² on the common tests (chi2_now 620 there): too little either way, both said.
+  ranking[0].rejected.clear();
+  ranking[0].chi2_now = 620.0;
+  screen(ranking, now, 0.05);
+  EXPECT_NEAR(ranking[0].chi2_explained, 1.0 - 600.0 / 620.0, 1e-14);
+  EXPECT_EQ(ranking[0].rejected,
+            "explains too little: 1.99 % of the gap and 3.23 % of χ² (at least 5 % needed)");
+  // Without known noise (χ² NaN), the gap's share alone, as before.
+  ranking[0].rejected.clear();
+  ranking[0].chi2 = std::numeric_limits<double>::quiet_NaN(), ranking[0].chi2_now = -1.0;
+  screen(ranking, now, 0.05);
+  EXPECT_EQ(ranking[0].rejected, "explains too little: 1.99 % of the gap (at least 5 % needed)");
 }
 
 TEST(Rule5, ACandidateThatPredictsHeldOutTestsWorseIsRejectedAndTheNextChosen) {

@@ -228,6 +228,39 @@ TEST(ParametricIdentification, EquationErrorTakesAParametricTermOnlyFixed) {
   EXPECT_NO_THROW(identify::check_identifiable({tip(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}, true)}));
 }
 
+TEST(DescribingFunction, AJointThatCorrectsASubstructureFittedAtLowLevelIsStartedFromItsPoints) {
+  // A substructure fitted to a low-level test holds the stuck joint's stiffness: the joint is
+  // k = -kt beside its Jenkins element (kt 4e4 N/m, fs 4 N), its equivalent stiffness 0 while
+  // stuck (below 0.1 mm) and falling as it slips. Exact points at 0.05 … 0.4 mm recover kt and
+  // fs to 1 %: the stuck points' Z of 0 must not weigh as relative misfits would (each point's
+  // misfit is scaled by its |Z| but not below a tenth of the largest).
+  joints::Joint truth{"mount",
+                      10,
+                      5,
+                      fem::Dof::uy,
+                      {Term::k, Term::c, Term::jenkins},
+                      {-4.0e4, 0.0, 1.0},
+                      {false, false, false},
+                      {}};
+  truth.parameters.resize(3);
+  truth.set_parameters(2, {4.0e4, 4.0});
+  std::vector<identify::EquivalentStiffness> points;
+  const double w = 2.0 * pi * 21.0;
+  for (int i = 0; i < 12; ++i) {
+    const double a = 5e-5 * std::pow(8.0, i / 11.0);
+    points.push_back({a, w, -4.0e4 + identify::describing_function(truth, 2, a)});
+  }
+  EXPECT_LT(std::abs(points.front().Z), 1e-6 * 4.0e4); // stuck
+  joints::Joint model = truth;
+  model.values[0] = 0.0;
+  model.parameters[2].assign(2, joints::Parameter{});
+  std::string note;
+  const joints::Joint fitted =
+      identify::fit_describing_function(model, 2, points, true, true, note);
+  EXPECT_NEAR(fitted.parameter(2, "kt"), 4.0e4, 0.01 * 4.0e4) << note;
+  EXPECT_NEAR(fitted.parameter(2, "fs"), 4.0, 0.01 * 4.0) << note;
+}
+
 TEST(ParametricIdentification, AFailedDescribingFunctionFitIsAStatusNamingTheJointAndTerm) {
   // A substructure whose modal analysis fails (a numerical outcome, not bad input): no test gives
   // the joint's equivalent stiffness, so the start fails. That is a status whose reason names the
