@@ -9,6 +9,7 @@
 #include "joints/basis.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -51,6 +52,23 @@ void check_output_file(const fs::path& file, const std::string& option) {
   if (!parent.empty() && !fs::is_directory(parent, ec))
     throw io::Error(fmt::format("{} {}: the directory {} does not exist", option, file.string(),
                                 parent.string()));
+}
+
+void require_values(const io::ModelFile& file, const std::string& command) {
+  for (std::size_t i = 0; i < file.joints.size(); ++i) {
+    const joints::Joint& j = file.joints[i];
+    std::vector<std::string> missing;
+    for (std::size_t t = 0; t < j.terms.size(); ++t)
+      if (!j.has_value(t)) missing.emplace_back(joints::term_name(j.terms[t]));
+    if (missing.empty()) continue;
+    const int line = i < file.joint_lines.size() ? file.joint_lines[i] : 0;
+    const std::string where =
+        line > 0 ? fmt::format("{}:{}", file.path.string(), line) : file.path.string();
+    throw io::Error(fmt::format(
+        "{}: joint '{}': {} {} no value in 'values': {} runs the model with its joints at their "
+        "values (identify or discover finds them from tests)",
+        where, j.name, fmt::join(missing, ", "), missing.size() == 1 ? "has" : "have", command));
+  }
 }
 
 void check_time_simulation(const io::ModelFile& file, const std::string& alternative) {

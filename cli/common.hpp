@@ -60,6 +60,10 @@ identify::TransientRoute parse_route(const std::string& text);
 /// which have no time-domain model: io::Error naming the model file and the part's file, and
 /// `alternative` after the reason ("or simulate by harmonic balance, --method hb").
 void check_time_simulation(const io::ModelFile& file, const std::string& alternative = "");
+/// Every joint term has its value in the model file (a command that runs the model with its
+/// joints at their values: simulate, compare); else io::Error naming the file, the joint's line,
+/// the joint and the terms without one, never a term taken as 0 unsaid.
+void require_values(const io::ModelFile& file, const std::string& command);
 
 /// The model file, its substructure (modes of a large model by the chosen engine), and the
 /// NODE:DOF options resolved against it.

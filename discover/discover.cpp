@@ -148,15 +148,21 @@ private:
     return join(names);
   }
 
-  // A state's tests whose re-simulation did not converge, in a warning.
+  // A state's tests whose re-simulation did not converge, in a warning, with the harmonic
+  // balance's reason for the first of them.
   void warn_left_out(Result& out, const State& state, const std::string& model) const {
     if (state.failed.empty()) return;
+    std::string why;
+    if (!state.failed_why.empty() && !state.failed_why.front().empty())
+      why = fmt::format(" ({}: {})", problem_.sources({state.failed.front()}).front(),
+                        state.failed_why.front());
     out.warnings.push_back(fmt::format(
         "the re-simulation of {} test{} with {} did not converge, even from the measured "
-        "response and from the nearest tests: {}; left out of its gap{}",
+        "response and from the nearest tests: {}; left out of its gap{}{}",
         state.failed.size(), state.failed.size() == 1 ? "" : "s", model, named(state.failed),
         comparable(problem_.compared(), state) ? std::string()
-                                               : " (too many: the model could not be compared)"));
+                                               : " (too many: the model could not be compared)",
+        why));
   }
 
   // 1. The starting model: values not given are identified from all tests.

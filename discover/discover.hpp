@@ -36,7 +36,8 @@
 /// error (identify::fit, METHOD.md), all tests re-simulated; the best `finalists` by the
 /// criterion are identified again by output error (Levenberg–Marquardt on the weighted
 /// re-simulation residual). A candidate may be added only if
-///  1. every re-simulation converged and its value is physical (no negative damping),
+///  1. every re-simulation converged and its value is physical (no negative damping; a stable
+///     state at rest with the joints slipping and their gaps open: Problem::stability_problem),
 ///  2. its 95 % interval is known and excludes 0 (the damping scale: 1),
 ///  3. it lowers the Bayesian information criterion — with known noise χ² + p ln N, else
 ///     N ln(S/N) + p ln N (S the squared gap, N real compared values, p identified
@@ -172,6 +173,11 @@ struct State {
   /// re-simulated test and the linear response), ascending: left out of the gap, χ² and
   /// criterion. More than a tenth of the tests: not compared at all (criterion +∞).
   std::vector<int> failed;
+  /// Why each of `failed` did not converge: the harmonic balance's last status
+  /// ("load steps stalled at step 13 of 20, residual 6.5e-05"; "" where it gave none).
+  std::vector<std::string> failed_why;
+  /// Why the model has no stable state at rest, or "" (Problem::stability_problem): rule 1.
+  std::string unstable;
   std::vector<Eigen::MatrixXcd> X; ///< per test: simulated harmonics 0 … K at its responses
   std::vector<Eigen::MatrixXcd> Y; ///< per test: the joints' deformation harmonics (all solved)
   identify::FitResult fit;         ///< the identification that gave the values (if any)

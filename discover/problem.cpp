@@ -1,10 +1,13 @@
 #include "discover/problem.hpp"
 
 #include "discover/selection.hpp"
+#include "discover/text.hpp"
 #include "fem/constants.hpp"
 #include "identify/parametric.hpp"
 
 #include <fmt/format.h>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -68,6 +71,7 @@ Problem::Problem(const frf::Substructure& sub, const std::vector<joints::Joint>&
   // status's reason (a numerical outcome, not bad input).
   if (!base_->status().ok())
     throw std::runtime_error("discover: the substructure: " + base_->status().reason);
+  set_up_static_flexibility();
   compared_ = compared_values(tests, K_);
   preconditions_ = detail::preconditions(tests, compared_, o_, base_->num_modes() > 0);
   for (const auto& m : tests) {
@@ -321,6 +325,52 @@ std::vector<int> even_spread(std::size_t n, std::size_t taken) {
   return out;
 }
 
+void Problem::set_up_static_flexibility() {
+  const frf::ModalSynthesis& H = *base_;
+  if (H.measured() || H.num_modes() == 0) return;
+  const Eigen::VectorXd& w = H.natural_frequencies();
+  if (!(w.minCoeff() > 1e-6 * w.maxCoeff())) return; // a rigid-body mode: no static flexibility
+  const std::vector<int> set2 = joints::joint_dof_set(layout_, dofs_);
+  const Eigen::MatrixXd B = joints::joint_coordinates_on(layout_, dofs_, set2);
+  const Eigen::MatrixXd G = B.transpose() * H.receptance(0.0, set2, set2).real() * B;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (G + G.transpose()));
+  if (eig.info() != Eigen::Success) return;
+  const Eigen::VectorXd& g = eig.eigenvalues();
+  if (!(g.minCoeff() > 1e-12 * g.maxCoeff())) return; // joints whose ends cannot move apart
+  flexibility_root_ =
+      eig.eigenvectors() * g.cwiseSqrt().asDiagonal() * eig.eigenvectors().transpose();
+  stiffness_held_ = G.diagonal().cwiseInverse();
+}
+
+std::string Problem::stability_problem(const std::vector<joints::Joint>& joints) const {
+  if (flexibility_root_.size() == 0 || joints.size() != layout_.size()) return {};
+  const auto n = static_cast<Eigen::Index>(joints.size());
+  Eigen::VectorXd k = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const joints::Joint& J = joints[static_cast<std::size_t>(j)];
+    if (const int t = J.term_index(joints::Term::k); t >= 0)
+      k(j) = J.values[static_cast<std::size_t>(t)];
+  }
+  if (k.minCoeff() >= 0.0) return {};
+  // (Bᵀ H(0) B)⁻¹ + diag(k) positive definite ⇔ I + S diag(k) S positive definite, S its root.
+  const Eigen::MatrixXd A =
+      Eigen::MatrixXd::Identity(n, n) + flexibility_root_ * k.asDiagonal() * flexibility_root_;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A, Eigen::EigenvaluesOnly);
+  if (eig.eigenvalues().minCoeff() > 0.0) return {};
+  std::vector<std::string> which;
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (k(j) < 0.0) {
+      const joints::Joint& J = joints[static_cast<std::size_t>(j)];
+      const std::string_view unit = joints::term_unit(joints::Term::k);
+      which.push_back(fmt::format("'{}' keeps k = {} {} where the substructure holds {} {}", J.name,
+                                  number(k(j)), unit, number(stiffness_held_(j)), unit));
+    }
+  return fmt::format("not physical: with its friction slipping and its gaps open, {}: the "
+                     "structure has no stable state at rest (its response to any force that "
+                     "makes the joint slip grows without bound)",
+                     join(which));
+}
+
 State Problem::evaluate(const std::vector<joints::Joint>& joints, const Simulator& sim,
                         const State* warm, std::span<const int> skip) const {
   return evaluate_each(joints, {}, sim, warm, skip);
@@ -365,10 +415,13 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
       solved.push_back(t);
     } else {
       s.failed.push_back(t);
+      s.failed_why.push_back(r.status.ok() ? std::string("the response is not finite")
+                                           : r.status.reason);
       if (static_cast<int>(s.failed.size()) > limit) break; // not compared: the rest not tried
     }
   }
   s.converged = s.failed.empty();
+  s.unstable = stability_problem(joints);
   if (skip.empty()) {
     score(s);
   } else { // on the tests simulated

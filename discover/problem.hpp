@@ -110,6 +110,15 @@ public:
   State evaluate_each(const std::vector<joints::Joint>& joints,
                       const std::vector<std::vector<joints::Joint>>& per_test, const Simulator& sim,
                       const State* warm = nullptr, std::span<const int> skip = {}) const;
+  /// Why the joined structure has no stable state at rest with these joints, or "": with
+  /// every friction element slipping and every gap open (a joint's tangent stiffness then its
+  /// linear k alone; k2 and k3 add none at zero deformation), the static stiffness between the
+  /// joints' ends, (Bᵀ H(0) B)⁻¹ + diag(k), must be positive definite. A harmonic balance finds
+  /// periodic solutions of an unstable model too, so the fits can reach one (a slipping joint
+  /// that takes away more stiffness than the substructure has there); a time simulation of it
+  /// grows without bound. Not judged (""): measured FRFs, or a substructure with a rigid-body
+  /// mode or a singular static flexibility at the joints.
+  std::string stability_problem(const std::vector<joints::Joint>& joints) const;
   /// The derivatives of every test's simulated harmonics at `at` (State::X: rows(i) + 1 ×
   /// responses) with respect to moves of its joints, `moved[p]` by steps[p], by implicit
   /// differentiation of each test's harmonic balance (frf::HarmonicBalance::output_derivatives):
@@ -165,6 +174,11 @@ private:
   double f_max_ = 0.0;
   std::vector<std::string> notes_;
   std::unique_ptr<frf::ModalSynthesis> base_;
+  /// The static flexibility between the joints' ends, Bᵀ H(0) B, as V diag(g) Vᵀ: its square
+  /// root V diag(√g) Vᵀ (empty: not judged; stability_problem).
+  Eigen::MatrixXd flexibility_root_;
+  Eigen::VectorXd stiffness_held_; ///< 1 / (Bᵀ H(0) B)_jj: what the substructure holds at joint j
+  void set_up_static_flexibility();
   std::vector<std::unique_ptr<Simulator>> simulators_;
   Compared compared_;
   std::vector<Eigen::MatrixXcd> measured_start_;  // per test: (K_hb+1) × joints

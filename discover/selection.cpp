@@ -134,6 +134,7 @@ void judge(Candidate& candidate, const State& state) {
   if (candidate.term) take_fit(candidate, state.fit, candidate.joint, *candidate.term);
   fill(candidate, state);
   if (candidate.rejected.empty()) candidate.rejected = physical_problem(state.joints);
+  if (candidate.rejected.empty()) candidate.rejected = state.unstable;
   if (candidate.rejected.empty() && !candidate.refit)
     candidate.rejected = interval_problem(candidate);
 }

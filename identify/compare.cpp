@@ -101,6 +101,20 @@ Comparison compare_spectra(const frf::Substructure& sub, const std::vector<joint
           "{}: channel {}: zero in every sample after the first {} s: nothing was measured there "
           "to compare",
           name, c->name(), static_cast<double>(first) / fs));
+    // A model that is unstable under this force (a joint whose net stiffness is negative: a
+    // slipping joint that takes away more than the stiffness beside it) gives a prediction that
+    // grows without bound: said so, not compared as a spectrum far above the measured one.
+    const auto rms = [&](const Eigen::VectorXd& v) {
+      return std::sqrt(v.tail(kept).squaredNorm() / static_cast<double>(kept));
+    };
+    const double measured_rms = rms(c->samples), predicted_rms = rms(p->samples);
+    if (!std::isfinite(predicted_rms) || predicted_rms > 1e6 * measured_rms)
+      throw std::invalid_argument(fmt::format(
+          "{}: channel {}: the predicted response grows without bound (RMS {:.3g} against the "
+          "measured {:.3g}{}): the model is unstable under this force — e.g. a joint whose net "
+          "stiffness is negative, where a slipping joint's kt exceeds the stiffness beside it",
+          name, c->name(), predicted_rms, measured_rms,
+          std::isfinite(predicted_rms) ? "" : ", not finite"));
     Eigen::MatrixXd both(kept, 2);
     both << c->samples.tail(kept), p->samples.tail(kept);
     const WelchSpectra s = welch(both, fs, welch_options);

@@ -73,6 +73,7 @@ void Compare::run() {
   // 2. The inputs.
   const io::ModelFile file = io::read_model(model_);
   check_time_simulation(file); // the prediction is a time simulation
+  require_values(file, "compare");
   if (file.joints.empty())
     warn(model_.string() + ": no [[joints]]: the prediction is the linear substructure's");
   const identify::Record record = io::read_record(record_);

@@ -158,6 +158,7 @@ void Simulate::run_sine() {
 
   // 2. The model and the tests.
   const Model model(model_, engine());
+  require_values(model.file, "simulate");
   if (options.method == identify::SimulationMethod::time_integration)
     check_time_simulation(model.file, "or simulate by harmonic balance (--method hb)");
   const fem::NodeDof force_at = model.dof("--force", force_);
@@ -320,6 +321,7 @@ void Simulate::run_signal() {
 
   // 3. The model and the simulation.
   const Model model(model_, engine());
+  require_values(model.file, "simulate");
   check_time_simulation(model.file);
   if (!from_record) input.at = {model.dof("--force", force_)};
   for (const auto& at : input.at) // a record's force channel is its fault, not the model's

@@ -508,6 +508,24 @@ TEST_F(CliTest, SimulateChecksEverythingBeforeWriting) {
                                  "--amplitude", "10", "--method", "magic", "-o", out.string()},
                                 dir()),
                         "--method");
+  // A joint term without a value is not taken as 0: the file, the joint's line and the term.
+  const fs::path unvalued = dir() / "k3_unvalued.toml";
+  test::write_text(unvalued, test::replaced(test::cantilever_toml(),
+                                            "values = { k = 4800.0, c = 20.0, k3 = 1.6e8 }",
+                                            "values = { k = 4800.0, c = 20.0 }"));
+  const std::string no_value = "joint 'tip': k3 has no value in 'values': ";
+  expect_one_line_error(jointid({"simulate", unvalued.string(), "--force", "7:uy", "--freq", "3",
+                                 "--amplitude", "10", "-o", out.string()},
+                                dir()),
+                        "k3_unvalued.toml:");
+  expect_one_line_error(jointid({"simulate", unvalued.string(), "--force", "7:uy", "--freq", "3",
+                                 "--amplitude", "10", "-o", out.string()},
+                                dir()),
+                        no_value + "simulate runs the model with its joints at their values");
+  expect_one_line_error(
+      jointid({"compare", unvalued.string(), (dir() / "none.csv").string(), "-o", out.string()},
+              dir()),
+      no_value + "compare runs the model with its joints at their values");
   EXPECT_EQ(files_in_out(), 1);
   EXPECT_EQ(test::read_text(out / "keep.txt"), "keep\n");
   // A missing output directory is not created when the input is bad.
@@ -2715,6 +2733,11 @@ TEST_F(SteppedSineCli, ATestTheModelCannotReSimulateIsLeftOutAndNamed) {
       "nearest tests: " +
       named + "; left out of its gap";
   EXPECT_NE(run.err.find(warning), std::string::npos) << warning << "\n" << run.err;
+  // With the harmonic balance's reason for the first of them.
+  const std::string why = " (" + left_out[0].get<std::string>() + ": ";
+  const std::size_t at = run.err.find(warning + why);
+  ASSERT_NE(at, std::string::npos) << run.err;
+  EXPECT_NE(run.err[at + warning.size() + why.size()], ')') << run.err;
   // The gap is over the other tests: a number.
   EXPECT_TRUE(std::isfinite(j["gap"][0].get<double>()));
 }

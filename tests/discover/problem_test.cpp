@@ -2,12 +2,14 @@
 // re-simulation of every test against the exact receptance, its gap and criterion, and the
 // set-up's refusals.
 #include "discover/problem.hpp"
+#include "discover/selection.hpp"
 
 #include "one_mode.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace jointid {
@@ -102,6 +104,54 @@ TEST(Problem, RefusesWhatCannotBeCompared) {
   auto silent = tests;
   silent[0].X.setZero();
   EXPECT_EQ(refused(silent, {m.joint(0.0, 0.0)}, o), "discover: every response is zero");
+}
+
+} // namespace
+} // namespace jointid
+
+namespace jointid {
+namespace {
+
+using namespace discover::detail;
+
+// Rule 1's stability: the one mode's static stiffness at 7:uy is ω₀²/φ² (3 Hz, φ = 0.25 /√kg:
+// 5685 N/m). A joint to ground whose linear stiffness is below minus that has no stable state
+// at rest — with a Jenkins element beside it too, once that slips — whatever the harmonic
+// balance finds at the tests; above it, the model stands.
+TEST(Problem, AModelWithoutAStableStateAtRestIsNotPhysical) {
+  const test::OneMode m;
+  const frf::Substructure sub = m.substructure();
+  const auto tests = m.tests({2.5, 3.0, 3.5, 4.0}, 10.0);
+  Problem problem(sub, {m.joint(0.0, 0.0)}, tests, test::fundamental_only());
+  const double w0 = 2.0 * std::numbers::pi * m.f0, held = w0 * w0 / (m.phi * m.phi);
+  EXPECT_EQ(problem.stability_problem({m.joint(-0.99 * held, m.c)}), "");
+  EXPECT_EQ(problem.stability_problem({m.joint(1e6, m.c)}), "");
+  const std::string why = problem.stability_problem({m.joint(-1.01 * held, m.c)});
+  EXPECT_EQ(why.rfind("not physical: with its friction slipping and its gaps open, 'tip' keeps "
+                      "k = -5742 N/m where the substructure holds 5685 N/m",
+                      0),
+            0u)
+      << why;
+  // A Jenkins element that holds it while stuck does not: it slips.
+  joints::Joint slipping{"tip",
+                         7,
+                         0,
+                         fem::Dof::uy,
+                         {joints::Term::k, joints::Term::c, joints::Term::jenkins},
+                         {-2.0 * held, m.c, 1.0},
+                         {false, false, false},
+                         {}};
+  slipping.parameters.resize(3);
+  slipping.set_parameters(2, {3.0 * held, 1.0});
+  EXPECT_NE(problem.stability_problem({slipping}), "");
+  // The state carries it, and rule 1 rejects a candidate with it.
+  const discover::State s = problem.evaluate({m.joint(-2.0 * held, m.c)}, problem.simulator(1.0));
+  EXPECT_EQ(s.unstable, problem.stability_problem({m.joint(-2.0 * held, m.c)}));
+  discover::Candidate c;
+  c.joint = "tip";
+  c.refit = true;
+  judge(c, s);
+  EXPECT_EQ(c.rejected, s.unstable);
 }
 
 } // namespace

@@ -219,6 +219,40 @@ TEST(Compare, APredictionThatFailsIsTheComparisonsStatus) {
   EXPECT_TRUE(c.channels.empty());
 }
 
+// A model that is unstable under the force predicts a response that grows without bound: said
+// so, naming the record and channel, never compared as a spectrum far above the measured one.
+// The tip joint: k = -6500 N/m beside a Jenkins element of kt = 56 500 N/m, fs = 1 N — stable
+// while it sticks, a net stiffness of -6500 N/m once it slips (a joint fitted with kt and the
+// stiffness it takes away both too large), more than the cantilever's own stiffness at the tip
+// holds, and nothing non-linear to stop the growth: the response grows by orders of magnitude
+// over the record (from -5000 to -9000 N/m here; beyond, the time integration's Newton iteration
+// fails first, and the simulation's status says so; below, the model is stable).
+TEST(Compare, AnUnstableModelIsNamedNotCompared) {
+  const Record r = measured(4800.0, TransientRoute::modal);
+  joints::Joint slipping{"tip",
+                         7,
+                         0,
+                         fem::Dof::uy,
+                         {joints::Term::k, joints::Term::c, joints::Term::jenkins},
+                         {-6500.0, 20.0, 1.0},
+                         {},
+                         {}};
+  slipping.fixed.assign(3, true);
+  slipping.parameters.resize(3);
+  slipping.set_parameters(2, {56500.0, 1.0});
+  try {
+    const Comparison c = compare_spectra(cantilever(), {slipping}, r, band_2_40());
+    FAIL() << "accepted: " << c.status.reason;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("measured.csv: channel x@7:uy: the predicted response "
+                                         "grows without bound"),
+              std::string::npos)
+        << e.what();
+  }
+  // The same record with the model it came from is compared (the check is not too tight).
+  EXPECT_NO_THROW(compare_spectra(cantilever(), {joint(4800.0)}, r, band_2_40()));
+}
+
 // Degenerate records (issue 31): a force zero in every sample, a response channel zero in every
 // sample or constant, are refused naming the record and channel; lines where a spectrum is at
 // the arithmetic's floor are no differences (never thousands of dB).
