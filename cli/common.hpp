@@ -61,8 +61,8 @@ identify::TransientRoute parse_route(const std::string& text);
 /// `alternative` after the reason ("or simulate by harmonic balance, --method hb").
 void check_time_simulation(const io::ModelFile& file, const std::string& alternative = "");
 /// Every joint term has its value in the model file (a command that runs the model with its
-/// joints at their values: simulate, compare); else io::Error naming the file, the joint's line,
-/// the joint and the terms without one, never a term taken as 0 unsaid.
+/// joints at their values: simulate, compare, response, backbone); else io::Error naming the
+/// file, the joint's line, the joint and the terms without one, never a term taken as 0 unsaid.
 void require_values(const io::ModelFile& file, const std::string& command);
 
 /// The model file, its substructure (modes of a large model by the chosen engine), and the

@@ -86,6 +86,7 @@ void Backbone::run() {
 
   // 2. The model and the DOF of the amplitude.
   const Model model(model_, engine());
+  require_values(model.file, "backbone");
   if (model.file.joints.empty())
     throw io::Error(model.name() + ": no [[joints]]: the structure is linear, its modes do not "
                                    "change with amplitude (see `jointid modes`)");

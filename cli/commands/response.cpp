@@ -80,6 +80,7 @@ void Response::run() {
 
   // 2. The model.
   const Model model(model_, engine());
+  require_values(model.file, "response");
   if (model.file.joints.empty())
     warn(model.name() + ": no [[joints]]: the response is the linear substructure's");
   const fem::NodeDof force_at = model.dof("--force", force_);

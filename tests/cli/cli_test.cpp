@@ -526,6 +526,14 @@ TEST_F(CliTest, SimulateChecksEverythingBeforeWriting) {
       jointid({"compare", unvalued.string(), (dir() / "none.csv").string(), "-o", out.string()},
               dir()),
       no_value + "compare runs the model with its joints at their values");
+  expect_one_line_error(jointid({"response", unvalued.string(), "--force", "7:uy", "--amplitude",
+                                 "10", "--freq-range", "2:5", "-o", out.string()},
+                                dir()),
+                        no_value + "response runs the model with its joints at their values");
+  expect_one_line_error(jointid({"backbone", unvalued.string(), "--mode", "1", "--amplitude-range",
+                                 "1e-3:1e-2", "-o", out.string()},
+                                dir()),
+                        no_value + "backbone runs the model with its joints at their values");
   EXPECT_EQ(files_in_out(), 1);
   EXPECT_EQ(test::read_text(out / "keep.txt"), "keep\n");
   // A missing output directory is not created when the input is bad.
