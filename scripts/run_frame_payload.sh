@@ -32,7 +32,5 @@ done
 cp "$ex/start.toml" "$out/start.toml"
 $J discover "$out/start.toml" "$out"/tests/*.csv --band 10:26 -o "$out/discovery" "$@"
 # 5. The model discovery ended at, against the validation record (a level it was not given).
-python3 "$ex/discovered_model.py" "$out/start.toml" "$out/discovery/discovery.json" \
-  "$out/discovered.toml"
-$J compare "$out/discovered.toml" "$out"/validation/*.csv --band 10:26 -o "$out/compare"
+$J compare "$out/discovery/model.toml" "$out"/validation/*.csv --band 10:26 -o "$out/compare"
 echo "report: $out/discovery/report.md; validation: $out/compare/compare.json"

@@ -4,6 +4,7 @@
 #include "cli/common.hpp"
 #include "identify/measurement.hpp"
 #include "io/files.hpp"
+#include "io/model_write.hpp"
 #include "io/record_csv.hpp"
 #include "io/results_json.hpp"
 #include "joints/basis.hpp"
@@ -25,8 +26,8 @@ public:
   explicit Discover(CLI::App& parent)
       : Command(parent, "discover",
                 "Find where the model and the measurement disagree, name the missing joint "
-                "effect, add it and show the gap shrink; writes DIR/discovery.json and "
-                "DIR/report.md with plots") {
+                "effect, add it and show the gap shrink; writes DIR/discovery.json, "
+                "DIR/model.toml (the model it ends at) and DIR/report.md with plots") {
     add_model("Model file (TOML): the starting model");
     app()
         .add_option("TESTS", records_, "Measurement records or stepped-sine tables (CSV)")
@@ -95,7 +96,7 @@ void Discover::run() {
     throw io::Error(model.name() + ": no [[joints]]: discovery starts from the joints' terms");
   check_identifiable(model);
   const std::vector<identify::SineTest> tests = io::read_tests(records_);
-  for (const char* name : {"discovery.json", "report.md"})
+  for (const char* name : {"discovery.json", "model.toml", "report.md"})
     io::check_not_an_input(output_dir_ / name);
   const std::vector<identify::Measurement> measured = identify::measure(tests, measure);
 
@@ -104,11 +105,29 @@ void Discover::run() {
       discover::discover(model.sub, model.file.joints, measured, options);
   if (!output_rank()) return;
 
-  // 4. Write and report.
+  // 4. Write and report. The model it ends at as a model file, unless it cannot be written as
+  // one (a part's joint changed, a damping scale on parts): then no model.toml, and one left
+  // by an earlier run is removed rather than left beside a discovery.json it does not match.
+  std::vector<std::string> warnings = result.warnings;
+  const fs::path toml = output_dir_ / "model.toml";
+  std::string model_text;
+  const discover::State& last = result.states.back();
+  try {
+    model_text = io::model_with_joints(
+        model_, last.joints, last.damping_scale, toml,
+        fmt::format("The model `jointid discover` ended at ({}: final_model), written from\n{} "
+                    "with its joints' terms and values as discovered.",
+                    (output_dir_ / "discovery.json").string(), model_.string()));
+  } catch (const io::Error& e) {
+    warnings.push_back(fmt::format("{} not written: {}", toml.string(), e.what()));
+  }
   make_output_dir(output_dir_);
   const fs::path json = output_dir_ / "discovery.json";
   io::write_json(json, report::discovery_json(result));
-  std::vector<std::string> warnings = result.warnings;
+  if (!model_text.empty())
+    io::write_file_atomically(toml, model_text);
+  else if (std::error_code ec; fs::remove(toml, ec))
+    warnings.push_back(fmt::format("removed {} of an earlier run", toml.string()));
   report::ReportContext context{model_.string(), {}, plot_};
   for (const auto& p : records_)
     context.inputs.push_back(p.string());
@@ -116,6 +135,7 @@ void Discover::run() {
       report::write_discovery_report(output_dir_, result, context, warnings);
   print(result);
   fmt::print("wrote {}", json.string());
+  if (!model_text.empty()) fmt::print(", {}", toml.filename().string());
   for (const auto& p : written)
     fmt::print(", {}", p.filename().string());
   fmt::print("\n");

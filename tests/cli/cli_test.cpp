@@ -647,6 +647,24 @@ TEST_F(CliTest, DiscoverNamesAHiddenCubicStiffnessAndWritesItsReport) {
   EXPECT_TRUE(j["diagnosis"]["level_dependent"].get<bool>());
   EXPECT_EQ(j["diagnosis"]["nature"], "conservative");
   EXPECT_FALSE(j["diagnosis"]["findings"].empty());
+  // The model it ends at as a model file: the start's joint with final_model's terms and values,
+  // which simulate runs as it is (written from another directory: its paths hold).
+  EXPECT_NE(run.out.find("model.toml"), std::string::npos) << run.out;
+  const io::ModelFile found = io::read_model(out / "model.toml");
+  const json& terms = j["final_model"]["joints"][0]["terms"];
+  ASSERT_EQ(found.joints.size(), 1u);
+  ASSERT_EQ(found.joints[0].terms.size(), terms.size());
+  for (std::size_t t = 0; t < terms.size(); ++t) {
+    EXPECT_EQ(joints::term_name(found.joints[0].terms[t]), terms[t]["term"].get<std::string>());
+    const double v = terms[t]["value"].get<double>();
+    EXPECT_NEAR(found.joints[0].values[t], v, 1e-12 * std::abs(v)) << t;
+  }
+  EXPECT_EQ(found.model.nodes.size(), 7u);
+  const Outcome again =
+      jointid({"simulate", (out / "model.toml").string(), "--force", "7:uy", "--freq", "3",
+               "--amplitude", "10", "-o", (dir() / "discovered_sim").string()},
+              dir());
+  EXPECT_EQ(again.status, 0) << again.err;
   const std::string report = test::read_text(out / "report.md");
 #if JOINTID_WITH_VTK
   // The report and its plots (jointid runs itself under xvfb-run when there is no display).
