@@ -384,9 +384,104 @@ double rank_correlation(const std::vector<double>& a, const std::vector<double>&
   return d > 0.0 ? da.dot(db) / d : 0.0;
 }
 
+int turning_test(const std::vector<double>& x, const std::vector<double>& value,
+                 const std::vector<double>& std) {
+  std::vector<std::size_t> order(x.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t p, std::size_t q) { return x[p] < x[q]; });
+  // (a - b) in standard deviations of the difference.
+  const auto apart = [&](std::size_t a, std::size_t b) {
+    return (value[a] - value[b]) / std::hypot(std[a], std[b]);
+  };
+  const std::size_t n = order.size();
+  int best = -1;
+  double best_size = 0.0;
+  for (std::size_t m = 1; m + 1 < n; ++m) {
+    for (const double sign : {1.0, -1.0}) { // +1: a maximum; -1: a minimum
+      double before = 0.0, after = 0.0;     // the largest rise to m and fall after it
+      for (std::size_t i = 0; i < m; ++i)
+        before = std::max(before, sign * apart(order[m], order[i]));
+      for (std::size_t i = m + 1; i < n; ++i)
+        after = std::max(after, sign * apart(order[m], order[i]));
+      const double size = std::min(before, after);
+      if (size >= 3.0 && size > best_size) best = static_cast<int>(order[m]), best_size = size;
+    }
+  }
+  return best;
+}
+
+bool monotonic_within_noise(const std::vector<double>& x, const std::vector<double>& value,
+                            const std::vector<double>& std) {
+  std::vector<std::size_t> order(x.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t p, std::size_t q) { return x[p] < x[q]; });
+  bool rises = false, falls = false; // a step beyond 3 σ either way, between any two in order
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (std::size_t k = i + 1; k < order.size(); ++k) {
+      const double d =
+          (value[order[k]] - value[order[i]]) / std::hypot(std[order[k]], std[order[i]]);
+      if (x[order[k]] == x[order[i]]) { // the same abscissa, values apart: no function of x
+        if (std::abs(d) > 3.0) return false;
+        continue;
+      }
+      rises = rises || d > 3.0;
+      falls = falls || d < -3.0;
+    }
+  return !(rises && falls);
+}
+
+namespace {
+
+// "k at 'mount' is not one number: … it falls from … then rises …": a value that turns at test
+// m of the amplitude's order (turning_test), beyond the noise on both sides.
+std::string describe_turn(const Variation& v, const Candidate& c, const joints::Joint& j,
+                          std::size_t m) {
+  const auto lo = std::min_element(v.amplitude.begin(), v.amplitude.end()) - v.amplitude.begin();
+  const auto hi = std::max_element(v.amplitude.begin(), v.amplitude.end()) - v.amplitude.begin();
+  const bool rotational = fem::is_rotation(j.dof);
+  const joints::TermInfo& info = joints::term_info(*c.term);
+  const std::string unit(rotational ? info.rotational_unit : info.unit);
+  const auto at = [&](std::ptrdiff_t i) {
+    return fmt::format("{} {} at {} {}", number(v.value[i]), unit, number(v.amplitude[i]),
+                       rotational ? "rad" : "m");
+  };
+  const bool minimum = v.value[m] < v.value[lo];
+  std::string meaning;
+  if (*c.term == joints::Term::k && minimum)
+    meaning = "a stiffness that softens and then stiffens as the joint deforms more, as a joint "
+              "that slips and then closes a clearance does (friction with its own stiffness and "
+              "a stop); the library's jenkins and gap together describe it, but discovery adds "
+              "one such term at a joint at a time, and neither alone follows a turn";
+  else if (*c.term == joints::Term::c && !minimum)
+    meaning = "a damping that peaks at an amplitude, as the equivalent viscous damping of "
+              "friction does where it starts to slip";
+  else
+    meaning = fmt::format("a {} that {} and then {} with the deformation amplitude",
+                          joints::term_effect(*c.term), minimum ? "falls" : "grows",
+                          minimum ? "grows" : "falls");
+  return fmt::format(
+      "{} at '{}' is not one number: identified from each test alone it {} from {} (the smallest "
+      "deformation amplitude) to {}, then {} to {} (the largest), beyond the noise on both sides "
+      "(χ² {} for {} degrees of freedom): {}.",
+      joints::term_name(*c.term), j.name, minimum ? "falls" : "grows", at(lo),
+      at(static_cast<std::ptrdiff_t>(m)), minimum ? "rises" : "falls", at(hi), number(v.chi2),
+      v.dof, meaning);
+}
+
+} // namespace
+
 // "fc at 'spring' is not one number: identified from each test alone it goes from 0.5963 N at
 // the smallest deformation amplitude (0.98 mm) to 0.3412 N at the largest (2.94 mm), …"
 std::string describe(const Variation& v, const Candidate& c, const joints::Joint& j) {
+  // A turn with the amplitude that the frequency does not explain by a monotonic change (tests
+  // at one level across a resonance: their amplitude's order is not the frequency's).
+  if (v.value.size() >= 3 && v.std.size() == v.value.size()) {
+    const int m = turning_test(v.amplitude, v.value, v.std);
+    if (m >= 0 && !monotonic_within_noise(v.frequency_hz, v.value, v.std))
+      return describe_turn(v, c, j, static_cast<std::size_t>(m));
+  }
   const bool by_amplitude = std::abs(v.amplitude_correlation) >= std::abs(v.frequency_correlation);
   const std::vector<double>& x = by_amplitude ? v.amplitude : v.frequency_hz;
   const auto lo = std::min_element(x.begin(), x.end()) - x.begin();

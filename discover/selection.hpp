@@ -147,7 +147,20 @@ void judge_variation(Candidate& candidate, Variation variation, const State& sta
                      const joints::Joint& joint);
 /// Spearman's rank correlation (ties get their mean rank); 0 when either side is constant.
 double rank_correlation(const std::vector<double>& a, const std::vector<double>& b);
-/// What a variation says, in one sentence: "fc at 'spring' is not one number: …".
+/// The test (an index into x) where a per-test value turns as x grows: an interior extremum of
+/// the values in the order of x whose rise to it from some test before and fall to some test
+/// after (or fall and rise) are both at least 3 standard deviations of their difference; the
+/// largest such turn, or -1.
+int turning_test(const std::vector<double>& x, const std::vector<double>& value,
+                 const std::vector<double>& std);
+/// Whether the values are a monotonic function of x within the noise: false when, in the order
+/// of x, they both rise and fall by more than 3 standard deviations of a difference between
+/// some two tests, or when two tests at the same x differ by that much.
+bool monotonic_within_noise(const std::vector<double>& x, const std::vector<double>& value,
+                            const std::vector<double>& std);
+/// What a variation says, in one sentence: "fc at 'spring' is not one number: …". A value that
+/// turns with the deformation amplitude (turning_test) where the frequency does not order it
+/// monotonically is described by its turn: "k at 'mount' … falls from … to …, then rises to …".
 std::string describe(const Variation& variation, const Candidate& candidate,
                      const joints::Joint& joint);
 

@@ -407,5 +407,60 @@ TEST(VariesPerTest, RankCorrelationAgainstHandComputedValues) {
   EXPECT_EQ(rank_correlation({1.0, 1.0, 1.0}, {1.0, 2.0, 3.0}), 0.0);
 }
 
+TEST(VariesPerTest, ATurnIsAnInteriorExtremumBeyondTheNoiseOnBothSides) {
+  const std::vector<double> x{1.0, 2.0, 3.0, 4.0}, one(4, 1.0);
+  EXPECT_EQ(turning_test(x, {0.0, -10.0, 0.0, 1.0}, one), 1);     // falls 7.1 σ, rises 7.1 σ
+  EXPECT_EQ(turning_test(x, {0.0, 10.0, 9.0, 0.0}, one), 1);      // a maximum: the larger turn
+  EXPECT_EQ(turning_test(x, {0.0, -4.0, 0.0, 0.5}, one), -1);     // 2.8 σ: within the noise
+  EXPECT_EQ(turning_test(x, {0.0, -5.0, -10.0, -20.0}, one), -1); // monotonic
+  // The order is x's, not the list's: the same values listed in another order.
+  EXPECT_EQ(turning_test({3.0, 1.0, 2.0, 4.0}, {0.0, 0.0, -10.0, 1.0}, one), 2);
+  EXPECT_TRUE(monotonic_within_noise(x, {0.0, 5.0, 4.0, 20.0}, one)); // the dip: 0.7 σ
+  EXPECT_FALSE(monotonic_within_noise(x, {0.0, 10.0, 4.0, 20.0}, one));
+  EXPECT_FALSE(monotonic_within_noise({1.0, 1.0, 2.0, 3.0}, {0.0, 10.0, 11.0, 12.0}, one))
+      << "two tests at one x, 7 σ apart: x does not explain them";
+  EXPECT_TRUE(monotonic_within_noise({1.0, 1.0, 2.0, 3.0}, {0.0, 1.0, 11.0, 12.0}, one));
+}
+
+// The frame example's mount (examples/frame_payload, a run of 2026-12-06): k from each of six
+// multisine tests alone, against the fitted substructure, which holds the joint stuck. It falls
+// as the friction slips and rises where the clearance closes; the tests' equivalent frequency
+// also grows with k but not monotonically (k at 20.94 Hz: -1411 and -5083, 3.7 σ apart in the
+// wrong direction), so the turn with the amplitude is what is said.
+TEST(VariesPerTest, AStiffnessThatSoftensThenStiffensIsDescribedByItsTurn) {
+  discover::Variation v;
+  v.value = {45.1, -1615.0, -1411.0, -5083.0, -16753.0, 40093.0};
+  v.std = {2822.0, 1244.0, 765.0, 629.0, 664.0, 1018.0};
+  v.amplitude = {5.908e-5, 7.166e-5, 7.672e-5, 8.446e-5, 1.263e-4, 5.284e-4};
+  v.frequency_hz = {21.208, 21.023, 20.936, 20.937, 20.848, 24.305};
+  for (std::size_t i = 0; i < v.value.size(); ++i)
+    v.tests.push_back(fmt_test_name(i));
+  discover::Candidate c = candidate(Term::k, 0.0, 0.0);
+  c.joint = "mount";
+  joints::Joint mount = friction_joint();
+  mount.name = "mount";
+  State s = test::simulated({});
+  s.gap = 0.6, s.criterion = 40.0;
+  judge_variation(c, v, s, mount);
+  ASSERT_TRUE(c.varies.has_value());
+  const std::string& d = c.varies->description;
+  EXPECT_NE(d.find("k at 'mount' is not one number: identified from each test alone it falls "
+                   "from 45.1 N/m at 5.908e-05 m (the smallest deformation amplitude) to "
+                   "-1.675e+04 N/m at 0.0001263 m, then rises to 4.009e+04 N/m at 0.0005284 m "
+                   "(the largest), beyond the noise on both sides"),
+            std::string::npos)
+      << d;
+  EXPECT_NE(d.find("the library's jenkins and gap together describe it"), std::string::npos) << d;
+  EXPECT_EQ(d.find("frequency"), std::string::npos) << d;
+  // The same values where the frequency orders them (a stiffness that grows with frequency,
+  // the amplitudes scrambled by a resonance): the monotonic law with the frequency is said.
+  v.frequency_hz = {12.0, 11.0, 11.5, 10.5, 10.0, 13.0};
+  discover::Candidate f = candidate(Term::k, 0.0, 0.0);
+  judge_variation(f, v, s, mount);
+  EXPECT_NE(f.varies->description.find("it grows with the frequency (rank correlation +1.00)"),
+            std::string::npos)
+      << f.varies->description;
+}
+
 } // namespace
 } // namespace jointid
