@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,11 +46,21 @@ struct DesignOptions {
   std::function<void(double)> progress;
 };
 
+/// A periodic broadband candidate: a Schroeder multisine over [f0_hz, f1_hz] at an RMS force,
+/// of period period_s, sampled at sample_rate_hz (identify/random_tests.hpp's multisine).
+struct PeriodicPlan {
+  double f0_hz = 0.0, f1_hz = 0.0, rms = 0.0; ///< Hz, Hz, N or N·m
+  double period_s = 0.0, sample_rate_hz = 0.0;
+};
+
 /// One candidate test as predicted at the prior values.
 struct CandidateTest {
+  /// A sine test's frequency and amplitude; a periodic candidate's: 1/period_s (its lines'
+  /// spacing) and its RMS force.
   SineTestPlan plan;
-  bool usable = false; ///< predicted (the harmonic balance converged)
-  std::string reason;  ///< why not usable
+  std::optional<PeriodicPlan> periodic; ///< set for a periodic broadband candidate
+  bool usable = false;                  ///< predicted (the harmonic balance converged)
+  std::string reason;                   ///< why not usable
   /// Peak deformation (fundamental) of every joint, m or rad.
   std::vector<double> joint_amplitude;
   /// The information it gives about the unknowns (unknowns × unknowns, their units).
@@ -76,6 +87,27 @@ std::vector<CandidateTest> predict_candidates(const frf::Substructure& substruct
                                               const fem::NodeDof& force_at,
                                               const std::vector<SineTestPlan>& candidates,
                                               const DesignOptions& options = {});
+
+/// Predicts periodic broadband candidates (in parallel): each multisine is integrated in time at
+/// the prior values (identify::simulate_forced: the modal route, from rest, faded in over its
+/// first period) for `transient_periods` + `periods` periods, the transient's periods cut off,
+/// white noise of RMS `noise` × each channel's RMS added to every channel (force too, seeded by
+/// the candidate's index: the design is repeatable), and the record measured as identify
+/// measures a periodic test (identify::measure: its lines, their noise from the scatter of the
+/// periods, the periods averaged). Its information is that of its equations at every line
+/// `identify` would use (the excited ones, and those up to max(harmonics) times the highest
+/// excited line where the response stands out of its noise), weighted by that noise: what
+/// identify's equation error weights such a record with. joint_amplitude is each joint's
+/// equivalent sine (joint_equivalent_sine: the amplitude of the same RMS). Throws
+/// std::invalid_argument for bad options or plans (naming them), no unknowns, or a substructure
+/// that cannot be integrated in time (measured FRFs). A candidate whose simulation fails or whose
+/// periods do not settle is not usable, with the reason.
+std::vector<CandidateTest> predict_periodic_candidates(const frf::Substructure& substructure,
+                                                       const std::vector<joints::Joint>& joints,
+                                                       const fem::NodeDof& force_at,
+                                                       const std::vector<PeriodicPlan>& candidates,
+                                                       const DesignOptions& options = {},
+                                                       int transient_periods = 3);
 
 /// The unknowns of these joints, in the order of CandidateTest::information.
 std::vector<DesignUnknown> design_unknowns(const std::vector<joints::Joint>& joints);

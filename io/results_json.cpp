@@ -1,5 +1,6 @@
 #include "io/results_json.hpp"
 
+#include "identify/random_tests.hpp"
 #include "io/files.hpp"
 #include "io/json_text.hpp"
 
@@ -120,12 +121,31 @@ std::string modes_json(const fem::Modes& modes, int count,
   return text(out);
 }
 
+namespace {
+
+// A multisine candidate: its band, RMS force, period, sample rate and the record name simulate
+// gives such a test.
+Json periodic_json(const identify::PeriodicPlan& p) {
+  identify::ExcitationSpec spec;
+  spec.kind = identify::Excitation::multisine;
+  spec.f0_hz = p.f0_hz, spec.f1_hz = p.f1_hz, spec.level = p.rms;
+  return {{"band_hz", {p.f0_hz, p.f1_hz}},
+          {"rms", p.rms},
+          {"period_s", p.period_s},
+          {"sample_rate_hz", p.sample_rate_hz},
+          {"record", identify::excitation_record_name(spec)}};
+}
+
+} // namespace
+
 std::string design_json(const identify::Design& design,
                         const std::vector<identify::CandidateTest>& candidates,
                         const std::vector<identify::DesignUnknown>& unknowns,
                         const identify::DesignOptions& options,
                         const std::vector<identify::ParametricLevel>& levels) {
   Json out;
+  const bool periodic = !candidates.empty() && candidates.front().periodic.has_value();
+  out["excitation"] = periodic ? "multisine" : "sine";
   out["noise"] = options.noise;
   out["periods"] = options.periods;
   out["harmonics"] = options.harmonics;
@@ -146,11 +166,12 @@ std::string design_json(const identify::Design& design,
   Json chosen = Json::array();
   std::vector<bool> is_chosen(candidates.size(), false);
   for (int i : design.chosen) {
-    const auto& plan = candidates[static_cast<std::size_t>(i)].plan;
+    const auto& c = candidates[static_cast<std::size_t>(i)];
     is_chosen[static_cast<std::size_t>(i)] = true;
-    chosen.push_back({{"freq_hz", plan.frequency_hz},
-                      {"amplitude", plan.amplitude},
-                      {"record", identify::sine_test_name(plan)}});
+    chosen.push_back(c.periodic ? periodic_json(*c.periodic)
+                                : Json{{"freq_hz", c.plan.frequency_hz},
+                                       {"amplitude", c.plan.amplitude},
+                                       {"record", identify::sine_test_name(c.plan)}});
   }
   out["chosen"] = std::move(chosen);
   out["log_det"] = number(design.log_det);
@@ -158,9 +179,11 @@ std::string design_json(const identify::Design& design,
   Json all = Json::array();
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const auto& c = candidates[i];
-    Json j;
-    j["freq_hz"] = c.plan.frequency_hz;
-    j["amplitude"] = c.plan.amplitude;
+    Json j = c.periodic ? periodic_json(*c.periodic) : Json::object();
+    if (!c.periodic) {
+      j["freq_hz"] = c.plan.frequency_hz;
+      j["amplitude"] = c.plan.amplitude;
+    }
     j["usable"] = c.usable;
     j["misfit"] = number(c.misfit);
     if (!c.usable) j["reason"] = c.reason;

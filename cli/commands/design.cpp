@@ -1,6 +1,7 @@
-// jointid design: D-optimal experiment design. The `-n` candidate tests (frequencies x
-// amplitudes) that determine the joints' non-fixed terms best, predicted at the model's values;
-// DIR/design.json, and the chosen tests and the standard deviations to expect printed.
+// jointid design: D-optimal experiment design. The `-n` candidate tests (sine: frequencies x
+// amplitudes; multisine: RMS levels over a band) that determine the joints' non-fixed terms best,
+// predicted at the model's values; DIR/design.json, and the chosen tests and the standard
+// deviations to expect printed.
 #include "identify/design.hpp"
 #include "cli/command.hpp"
 #include "cli/common.hpp"
@@ -79,23 +80,34 @@ class Design final : public Command {
 public:
   explicit Design(CLI::App& parent)
       : Command(parent, "design",
-                "Experiment design: choose the N sine tests (of candidate frequencies x force "
-                "levels) that determine the joints' terms best (D-optimal, predicted at the "
-                "model's values as prior guesses); writes DIR/design.json") {
+                "Experiment design: choose the N tests (sine: of candidate frequencies x force "
+                "levels; multisine: of RMS levels over a band) that determine the joints' terms "
+                "best (D-optimal, predicted at the model's values as prior guesses); writes "
+                "DIR/design.json") {
     add_model("Model file (TOML); joint values = prior guesses");
     app().add_option("--force", force_, "DOF of the sine force, NODE:DOF (e.g. 7:uy)")->required();
     app()
         .add_option("--freq", frequencies_,
-                    "Candidate frequencies, Hz: values or ranges START:STEP:STOP (comma-separated)")
-        ->required()
+                    "Sine candidates' frequencies, Hz: values or ranges START:STEP:STOP "
+                    "(comma-separated)")
         ->delimiter(',')
         ->allow_extra_args(false);
     app()
         .add_option("--amplitude", amplitudes_,
-                    "Candidate force amplitudes (peak), N or N m: values or ranges START:STEP:STOP")
-        ->required()
+                    "Sine candidates' force amplitudes (peak), N or N m: values or ranges "
+                    "START:STEP:STOP")
         ->delimiter(',')
         ->allow_extra_args(false);
+    app().add_option("--band", band_, "Multisine candidates: F0:F1, the band excited, Hz");
+    app()
+        .add_option("--rms", rms_,
+                    "Multisine candidates' RMS forces, N or N m: values or ranges START:STEP:STOP")
+        ->delimiter(',')
+        ->allow_extra_args(false);
+    app().add_option("--period", period_, "Multisine candidates: the period, s");
+    app().add_option("--sample-rate", sample_rate_,
+                     "Multisine candidates: samples per second (default: the smallest power of "
+                     "two at least 32 x F1 and 8 x (largest --harmonics + 1) x F1)");
     app().add_option("-n", count_, "Number of tests to choose")->capture_default_str();
     add_harmonics(options_.harmonics,
                   "Harmonics whose equations the identification will use, e.g. 1,2,3");
@@ -116,8 +128,8 @@ public:
         ->capture_default_str();
     app()
         .add_option("--excitation", excitation_,
-                    "Kind of candidate test: sine (multisine candidates are not designed yet: "
-                    "refused, saying why)")
+                    "Kind of candidate test: sine (--freq, --amplitude) or multisine (--band, "
+                    "--rms, --period)")
         ->capture_default_str();
     add_output_dir();
     add_engine();
@@ -127,6 +139,8 @@ public:
 
 private:
   void check_options() const;
+  /// The multisine candidates of --band, --rms, --period and --sample-rate (checked).
+  std::vector<identify::PeriodicPlan> periodic_plans() const;
   void print(const identify::Design& chosen, const std::vector<identify::CandidateTest>& candidates,
              const std::vector<identify::DesignUnknown>& unknowns) const;
 
@@ -134,22 +148,30 @@ private:
   std::vector<std::string> frequencies_; ///< Hz: values or ranges F0:STEP:F1
   std::vector<std::string> amplitudes_;  ///< N or N·m (peak): values or ranges A0:STEP:A1
   int count_ = 10;                       ///< tests to choose
-  std::string excitation_ = "sine";      ///< the candidates' kind (only sine is designed)
+  std::string excitation_ = "sine";      ///< the candidates' kind: sine or multisine
+  std::string band_;                     ///< multisine: F0:F1, Hz
+  std::vector<std::string> rms_;         ///< multisine: RMS forces, values or ranges
+  double period_ = 0.0;                  ///< multisine: s
+  double sample_rate_ = 0.0;             ///< multisine: Hz; 0: the default
   identify::DesignOptions options_;      ///< the library's defaults
 };
 
 void Design::check_options() const {
-  // Periodic broadband candidates would need each multisine's prediction at all its lines and
-  // the information of its lines (noise per line from the period scatter): not there yet.
-  if (excitation_ == "multisine" || excitation_ == "periodic")
+  if (excitation_ != "sine" && excitation_ != "multisine")
     throw io::Error(
-        "--excitation multisine: design chooses sine tests only; multisine candidates (a band "
-        "and RMS levels) are not designed yet: their prediction would be a harmonic balance at "
-        "every line of the period and their information that of every line, which design does "
-        "not compute. Design sine tests, or run multisine tests at a few levels and let "
-        "identify's intervals say what they determine");
-  if (excitation_ != "sine")
-    throw io::Error(fmt::format("--excitation: expected sine, got \"{}\"", excitation_));
+        fmt::format("--excitation: expected sine or multisine, got \"{}\"", excitation_));
+  const bool sine = excitation_ == "sine";
+  if (sine && (frequencies_.empty() || amplitudes_.empty()))
+    throw io::Error("--excitation sine: expected --freq and --amplitude (the candidate "
+                    "frequencies and force amplitudes)");
+  if (sine && (!band_.empty() || !rms_.empty() || period_ != 0.0 || sample_rate_ != 0.0))
+    throw io::Error("--band, --rms, --period, --sample-rate: only with --excitation multisine");
+  if (!sine && (band_.empty() || rms_.empty() || period_ == 0.0))
+    throw io::Error("--excitation multisine: expected --band F0:F1, --rms (the candidate RMS "
+                    "forces) and --period (s)");
+  if (!sine && (!frequencies_.empty() || !amplitudes_.empty()))
+    throw io::Error("--freq, --amplitude: only with --excitation sine (a multisine candidate is "
+                    "--band, --rms and --period)");
   check_harmonics(options_.harmonics, 0);
   if (count_ < 1) throw io::Error(fmt::format("-n: expected at least 1 test, got {}", count_));
   if (!(options_.noise > 0.0 && options_.noise < 1.0))
@@ -168,16 +190,57 @@ void Design::check_options() const {
                                 options_.balance.harmonics));
 }
 
+std::vector<identify::PeriodicPlan> Design::periodic_plans() const {
+  const auto [f0, f1] = parse_band("--band", band_);
+  const std::vector<double> levels = parse_values("--rms", rms_, "N or N m");
+  if (!(period_ > 0.0 && std::isfinite(period_)))
+    throw io::Error(fmt::format("--period: expected seconds > 0, got {}", period_));
+  if (f1 * period_ < 1.0)
+    throw io::Error(fmt::format("--band {}: holds no line of the period's spacing ({:g} Hz): "
+                                "lengthen --period or raise F1",
+                                band_, 1.0 / period_));
+  double rate = sample_rate_;
+  if (rate == 0.0) { // the smallest power of two above what the lines and the harmonics need
+    const int K = *std::max_element(options_.harmonics.begin(), options_.harmonics.end());
+    rate = 1.0;
+    while (rate < std::max(32.0 * f1, 8.0 * (K + 1) * f1))
+      rate *= 2.0;
+  }
+  if (!(rate > 2.0 * f1 && std::isfinite(rate)))
+    throw io::Error(fmt::format("--sample-rate: expected more than twice F1 ({:g} Hz), got {}",
+                                2.0 * f1, rate));
+  const double n = period_ * rate;
+  if (std::abs(n - std::round(n)) > 1e-6 * n)
+    throw io::Error(fmt::format("--period {} at --sample-rate {}: a period must hold a whole "
+                                "number of samples (it holds {})",
+                                period_, rate, n));
+  std::vector<identify::PeriodicPlan> plans;
+  for (double r : levels)
+    plans.push_back({f0, f1, r, period_, rate});
+  return plans;
+}
+
 void Design::run() {
   // 1. The options.
-  const std::vector<double> freqs = parse_values("--freq", frequencies_, "Hz");
-  const std::vector<double> amps = parse_values("--amplitude", amplitudes_, "N or N m");
   check_options();
-  const std::size_t n_candidates = freqs.size() * amps.size();
+  const bool periodic = excitation_ == "multisine";
+  std::vector<double> freqs, amps;
+  std::vector<identify::PeriodicPlan> periodic_candidates;
+  if (periodic) {
+    periodic_candidates = periodic_plans();
+  } else {
+    freqs = parse_values("--freq", frequencies_, "Hz");
+    amps = parse_values("--amplitude", amplitudes_, "N or N m");
+  }
+  const std::size_t n_candidates =
+      periodic ? periodic_candidates.size() : freqs.size() * amps.size();
   if (static_cast<std::size_t>(count_) > n_candidates)
-    throw io::Error(fmt::format("-n {}: more than the {} candidates ({} frequencies x {} "
-                                "amplitudes)",
-                                count_, n_candidates, freqs.size(), amps.size()));
+    throw io::Error(periodic
+                        ? fmt::format("-n {}: more than the {} candidates (RMS levels of --rms)",
+                                      count_, n_candidates)
+                        : fmt::format("-n {}: more than the {} candidates ({} frequencies x {} "
+                                      "amplitudes)",
+                                      count_, n_candidates, freqs.size(), amps.size()));
   check_output_dir(output_dir_);
 
   // 2. The model and its unknowns.
@@ -209,6 +272,7 @@ void Design::run() {
                        "has no such force",
                        model.name(), u.joint, joints::term_name(u.term)));
   const fem::NodeDof force_at = model.dof("--force", force_);
+  if (periodic) check_time_simulation(model.file); // a multisine is predicted in time
 
   // 3. Predict the candidates, choose.
   std::vector<identify::SineTestPlan> plans;
@@ -217,11 +281,13 @@ void Design::run() {
       plans.push_back({f, a});
   identify::DesignOptions options = options_;
   const std::vector<identify::CandidateTest> candidates = with_progress(
-      fmt::format("jointid design: predicting {} candidates", plans.size()),
+      fmt::format("jointid design: predicting {} candidates", n_candidates),
       [&](const auto& progress) {
         options.progress = progress.callback();
         return for_model(model, [&] {
-          return identify::predict_candidates(model.sub, held, force_at, plans, options);
+          return periodic ? identify::predict_periodic_candidates(model.sub, held, force_at,
+                                                                  periodic_candidates, options)
+                          : identify::predict_candidates(model.sub, held, force_at, plans, options);
         });
       });
   const auto usable = std::count_if(candidates.begin(), candidates.end(),
@@ -259,19 +325,34 @@ void Design::print(const identify::Design& chosen,
              "RMS, {} periods a record, harmonics {}:\n",
              count_, candidates.size(), chosen.exchanges, 100.0 * options_.noise, options_.periods,
              fmt::join(options_.harmonics, ","));
-  fmt::print("  {:>12} {:>12}\n", "freq (Hz)", "force (N)");
-  for (int i : chosen.chosen)
-    fmt::print("  {:>12.6g} {:>12.6g}\n", candidates[static_cast<std::size_t>(i)].plan.frequency_hz,
-               candidates[static_cast<std::size_t>(i)].plan.amplitude);
+  if (excitation_ == "multisine") {
+    fmt::print("  {:>12} {:>12} {:>10}\n", "band (Hz)", "RMS (N)", "period (s)");
+    for (int i : chosen.chosen) {
+      const identify::PeriodicPlan& p = *candidates[static_cast<std::size_t>(i)].periodic;
+      fmt::print("  {:>12} {:>12.6g} {:>10.6g}\n", fmt::format("{:g}-{:g}", p.f0_hz, p.f1_hz),
+                 p.rms, p.period_s);
+    }
+  } else {
+    fmt::print("  {:>12} {:>12}\n", "freq (Hz)", "force (N)");
+    for (int i : chosen.chosen)
+      fmt::print("  {:>12.6g} {:>12.6g}\n",
+                 candidates[static_cast<std::size_t>(i)].plan.frequency_hz,
+                 candidates[static_cast<std::size_t>(i)].plan.amplitude);
+  }
   fmt::print("expected standard deviations and bias:\n  {:<12} {:<6} {:>14} {:>14} {:>10} {:>10}\n",
              "joint", "term", "prior", "std", "relative", "bias");
   for (std::size_t u = 0; u < unknowns.size(); ++u) {
     const double sd = chosen.std(static_cast<Eigen::Index>(u));
     const double prior = std::abs(unknowns[u].prior);
-    fmt::print("  {:<12} {:<6} {:>14.6g} {:>14.4g} {:>9.3g}% {:>+9.2g}%\n", unknowns[u].joint,
+    const double bias = chosen.bias(static_cast<Eigen::Index>(u));
+    fmt::print("  {:<12} {:<6} {:>14.6g} {:>14.4g} {:>9.3g}% {:>10}\n", unknowns[u].joint,
                joints::term_name(unknowns[u].term), unknowns[u].prior, sd, 100.0 * sd / prior,
-               100.0 * chosen.bias(static_cast<Eigen::Index>(u)) / prior);
+               std::isfinite(bias) ? fmt::format("{:+.2g}%", 100.0 * bias / prior)
+                                   : std::string("n/a"));
   }
+  if (excitation_ == "multisine")
+    fmt::print("(the bias is not predicted for multisine candidates: each one's prediction holds "
+               "a realisation of the noise)\n");
   for (const auto& w : chosen.warnings)
     warn(w);
 }

@@ -1284,14 +1284,28 @@ TEST_F(CliTest, DesignChecksItsOptionsBeforeWriting) {
                         "--noise");
   expect_one_line_error(run({"--freq", "2,3", "--amplitude", "10", "-n", "1", "--periods", "1"}),
                         "--periods");
-  // Multisine candidates are not designed (yet): refused by name, saying why and what instead.
-  const Outcome multisine =
-      run({"--freq", "2,3", "--amplitude", "10", "-n", "1", "--excitation", "multisine"});
-  expect_one_line_error(multisine, "--excitation multisine: design chooses sine tests only");
-  EXPECT_NE(multisine.err.find("not designed yet"), std::string::npos) << multisine.err;
+  // Multisine candidates take --band, --rms and --period, and nothing of a sine's.
+  expect_one_line_error(
+      run({"--freq", "2,3", "--amplitude", "10", "-n", "1", "--excitation", "multisine"}),
+      "--excitation multisine: expected --band F0:F1, --rms");
+  expect_one_line_error(run({"--excitation", "multisine", "--band", "1:4", "--rms", "10",
+                             "--period", "4", "--freq", "2", "-n", "1"}),
+                        "--freq, --amplitude: only with --excitation sine");
+  expect_one_line_error(
+      run({"--freq", "2,3", "--amplitude", "10", "-n", "1", "--band", "1:4", "--rms", "10"}),
+      "--band, --rms, --period, --sample-rate: only with --excitation multisine");
+  expect_one_line_error(run({"--excitation", "multisine", "--band", "1:4", "--rms", "10,20",
+                             "--period", "4", "-n", "3"}),
+                        "-n 3: more than the 2 candidates (RMS levels of --rms)");
+  expect_one_line_error(run({"--excitation", "multisine", "--band", "1:4", "--rms", "10",
+                             "--period", "4.001", "--sample-rate", "100", "-n", "1"}),
+                        "a period must hold a whole number of samples");
+  expect_one_line_error(run({"--excitation", "multisine", "--band", "4:1", "--rms", "10",
+                             "--period", "4", "-n", "1"}),
+                        "--band");
   expect_one_line_error(
       run({"--freq", "2,3", "--amplitude", "10", "-n", "1", "--excitation", "hammer"}),
-      "--excitation: expected sine");
+      "--excitation: expected sine or multisine");
   EXPECT_FALSE(fs::exists(out));
 }
 

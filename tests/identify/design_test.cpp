@@ -5,6 +5,8 @@
 #include "identify/fit.hpp"
 #include "identify/measurement.hpp"
 #include "identify/parametric.hpp"
+#include "identify/random_tests.hpp"
+#include "identify/sine_tests.hpp"
 #include "support/cantilever.hpp"
 #include "support/failing_substructure.hpp"
 
@@ -388,3 +390,80 @@ TEST(Design, ParametricLevelsSayWhichForcesReachMacroslip) {
 }
 
 } // namespace
+
+// A periodic candidate (a multisine over 1-4 Hz at 40 N RMS, period 4 s, 8 periods averaged,
+// 1 % noise on force, displacement and velocity): the standard deviations predicted from its
+// information are those identify reports for such a record (the mean of its std over 200
+// repetitions of fresh noise on the same steady record, by time integration, its transient cut
+// off as the prediction cuts it): within [0.95, 1.15] of them (measured 1.06-1.07), which fails a
+// prediction that miscounts the averaged periods (a factor √8) or the lines. Against the scatter
+// of the estimates themselves (±5 % from 200 repetitions) the ratio lies in [0.8, 1.35]: measured
+// 1.02 for c and c2, but 1.17 for k and 1.23 for k3, whose scatter identify's own intervals for
+// periodic records understate by a fifth to a quarter (its reported std: 6.83 N/m against a
+// scatter of 8.50; k3 2.15e5 against 2.80e5; 32 periods do not close it). The bias is not
+// predicted for periodic candidates (NaN), never a number.
+TEST(Design, APeriodicCandidatesPredictedStdIsTheMonteCarloScatter) {
+  const frf::Substructure sub(test::paper_cantilever());
+  const auto joints = model_I();
+  const identify::PeriodicPlan plan{1.0, 4.0, 40.0, 4.0, 256.0};
+  identify::DesignOptions d;
+  d.harmonics = {1, 2, 3};
+  d.noise = 0.01;
+  d.periods = 8;
+  const auto candidates = identify::predict_periodic_candidates(sub, joints, tip, {plan}, d);
+  ASSERT_EQ(candidates.size(), 1u);
+  ASSERT_TRUE(candidates[0].usable) << candidates[0].reason;
+  ASSERT_TRUE(candidates[0].periodic.has_value());
+  EXPECT_EQ(candidates[0].plan.frequency_hz, 0.25);
+  EXPECT_EQ(candidates[0].plan.amplitude, 40.0);
+  ASSERT_EQ(candidates[0].joint_amplitude.size(), 1u);
+  EXPECT_GT(candidates[0].joint_amplitude[0], 0.0);
+  const Eigen::VectorXd predicted = identify::predicted_std(candidates, {0});
+  EXPECT_TRUE(identify::predicted_bias(candidates, {0}).array().isNaN().all());
+
+  // The steady record, independently: 3 transient periods simulated and cut off.
+  const identify::ForceInput force = identify::generated_force(
+      {identify::Excitation::multisine, 1.0, 4.0, 40.0, 1, 11 * 4.0, 256.0, 4.0}, tip);
+  identify::ForcedOptions fo;
+  fo.fade_in_s = 4.0;
+  identify::ForcedTest run = identify::simulate_forced(sub, joints, force, fo);
+  ASSERT_TRUE(run.status.ok()) << run.status.reason;
+  identify::Record clean = run.record;
+  const Eigen::Index keep = clean.t.size() - 3 * 1024;
+  clean.t = Eigen::VectorXd(clean.t.tail(keep));
+  for (auto& ch : clean.channels)
+    ch.samples = Eigen::VectorXd(ch.samples.tail(keep));
+  clean.period_s = 4.0;
+  identify::FitOptions fit_options;
+  fit_options.harmonics = {1, 2, 3};
+  identify::MeasureOptions mo = identify::measure_options(fit_options);
+  mo.band_from_hz = 1.0;
+  mo.band_to_hz = 4.0;
+  constexpr int reps = 200;
+  const auto nu = predicted.size();
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(nu), square = sum, reported = sum;
+  for (int r = 0; r < reps; ++r) {
+    identify::Record rec = clean;
+    identify::add_noise(rec, d.noise, 104729ull + 31ull * static_cast<unsigned long long>(r));
+    const identify::FitResult fit = identify::fit(
+        sub, joints, {identify::measure(identify::SineTest(std::move(rec)), mo)}, fit_options);
+    ASSERT_TRUE(fit.status.ok()) << fit.status.reason;
+    for (Eigen::Index u = 0; u < nu; ++u) {
+      const double v = fit.joints[0].terms[static_cast<std::size_t>(u)].value;
+      sum(u) += v / reps;
+      square(u) += v * v / reps;
+      reported(u) += fit.joints[0].terms[static_cast<std::size_t>(u)].std / reps;
+    }
+  }
+  for (Eigen::Index u = 0; u < nu; ++u) {
+    const double scatter =
+        std::sqrt(std::max(0.0, square(u) - sum(u) * sum(u)) * reps / (reps - 1));
+    const std::string name(joints::term_name(joints[0].terms[static_cast<std::size_t>(u)]));
+    std::printf("  %-3s predicted std %.4g, Monte Carlo %.4g (ratio %.3f), fit's mean std %.4g\n",
+                name.c_str(), predicted(u), scatter, scatter / predicted(u), reported(u));
+    EXPECT_GT(predicted(u) / reported(u), 0.95) << name;
+    EXPECT_LT(predicted(u) / reported(u), 1.15) << name;
+    EXPECT_GT(scatter / predicted(u), 0.8) << name;
+    EXPECT_LT(scatter / predicted(u), 1.35) << name;
+  }
+}
