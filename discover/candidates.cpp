@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -75,58 +77,171 @@ Outcome consider_term(const Problem& problem, const State& state, const Simulato
   }
 }
 
+namespace {
+
+// The peak of the joint's deformation over a test's period against that of the sine of the same
+// RMS (√2 RMS): 1 for a sine test; a multisine's 1.4 to 2 (its slips and contacts start at its
+// peaks, which its equivalent sine does not reach). NaN where a DOF of the joint is not measured.
+double peak_ratio(const identify::Measurement& m, const joints::Joint& j) {
+  const int a = m.response_index({j.node, j.dof});
+  const int b = j.to_ground() ? -1 : m.response_index({j.node_b, j.dof});
+  if (a < 0 || (!j.to_ground() && b < 0) || m.x.rows() < 4) return nan;
+  Eigen::VectorXd y = m.x.col(a);
+  if (b >= 0) y -= m.x.col(b);
+  y.array() -= y.mean();
+  const double rms = std::sqrt(y.squaredNorm() / static_cast<double>(y.size()));
+  return rms > 0.0 ? y.cwiseAbs().maxCoeff() / (std::sqrt(2.0) * rms) : nan;
+}
+
+// The joint's equivalent stiffness per test less its other terms at the state's values (but k
+// and c, which the describing-function fit takes with it). With `at_peaks`, each test's
+// amplitude is its deformation's peak instead of its equivalent sine's (peak_ratio).
+std::vector<identify::EquivalentStiffness> parametric_points(const Problem& problem,
+                                                             const State& state,
+                                                             const Simulator& sim, std::size_t jj,
+                                                             bool at_peaks = false) {
+  std::vector<int> used;
+  std::vector<identify::EquivalentStiffness> points =
+      equivalent_stiffness(problem, state, sim, jj, &used);
+  if (at_peaks)
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (const double r =
+              peak_ratio(problem.tests()[static_cast<std::size_t>(used[i])], state.joints[jj]);
+          std::isfinite(r) && r > 1.0)
+        points[i].amplitude *= r;
+  const joints::Joint& now = state.joints[jj];
+  const auto other = [&now](std::size_t t) {
+    return !((now.terms[t] == joints::Term::k || now.terms[t] == joints::Term::c) && !now.fixed[t]);
+  };
+  for (auto& p : points)
+    p.Z -= joint_describing_function(now, p.amplitude, p.omega, other);
+  return points;
+}
+
+// Candidate c: the terms added to the joint, their parameters started by one describing-function
+// fit, the coefficient terms by equation error with their force known, and judged.
+Outcome add_parametric(const Problem& problem, const State& state, const Simulator& sim,
+                       Candidate c, const std::vector<joints::Term>& terms,
+                       std::vector<identify::EquivalentStiffness> points) {
+  std::vector<joints::Joint> joints = state.joints;
+  std::size_t jj = 0;
+  while (joints[jj].name != c.joint)
+    ++jj;
+  joints::Joint& J = joints[jj];
+  std::vector<std::size_t> added;
+  for (const joints::Term term : terms) {
+    const std::size_t T = J.terms.size();
+    added.push_back(T);
+    J.terms.push_back(term);
+    J.values.push_back(1.0);
+    J.fixed.push_back(false);
+    if (!J.given.empty()) J.given.push_back(false);
+    J.parameters.resize(T + 1);
+    const auto& info = joints::term_info(term).parameters;
+    J.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+    for (joints::Parameter& p : J.parameters[T])
+      p.given = false; // no start of its own: the describing-function fit's
+  }
+  try {
+    const joints::Joint& now = state.joints[jj];
+    const int k = now.term_index(joints::Term::k), cc = now.term_index(joints::Term::c);
+    const bool k_open = k >= 0 && !now.fixed[static_cast<std::size_t>(k)];
+    const bool c_open = cc >= 0 && !now.fixed[static_cast<std::size_t>(cc)];
+    // Its parameters from the describing function(s) fitted to the points.
+    std::string note;
+    J = identify::fit_describing_functions(J, added, std::move(points), k_open, c_open, note);
+    // The coefficient terms by equation error with its force known, then every non-fixed
+    // term and parameter by output error.
+    const identify::FitResult fit = problem.identify(joints, sim, problem.all_tests());
+    joints = fit.identified(joints);
+    // Two terms' start: a damping the equation error drove below zero beside them (their
+    // describing functions from equivalent sines misjudge a broadband test's dissipation) is
+    // brought back to zero, as the output error's search starts (refine.cpp).
+    if (c.with) clamp_dissipative(joints);
+    State s = problem.evaluate(joints, sim);
+    s.fit = fit;
+    judge(c, s);
+    // Its parameters from the start have no intervals: only output error (finalists) gives them.
+    for (auto* list : {&c.parameters, &c.with_parameters})
+      for (auto& p : *list) {
+        p.fixed = p.determined = false;
+        p.std = p.ci_low = p.ci_high = std::numeric_limits<double>::quiet_NaN();
+      }
+    if (c.rejected.empty()) c.rejected = interval_problem(c);
+    return {std::move(c), std::move(s)};
+  } catch (const std::invalid_argument& e) {
+    return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
+  }
+}
+
+} // namespace
+
 Outcome consider_parametric(const Problem& problem, const State& state, const Simulator& sim,
                             const std::string& joint, joints::Term term) {
   Candidate c;
   c.joint = joint;
   c.term = term;
-  std::vector<joints::Joint> joints = state.joints;
   std::size_t jj = 0;
-  while (joints[jj].name != joint)
+  while (state.joints[jj].name != joint)
     ++jj;
-  joints::Joint& J = joints[jj];
-  const std::size_t T = J.terms.size();
-  J.terms.push_back(term);
-  J.values.push_back(1.0);
-  J.fixed.push_back(false);
-  if (!J.given.empty()) J.given.push_back(false);
-  J.parameters.resize(T + 1);
-  const auto& info = joints::term_info(term).parameters;
-  J.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
-  for (joints::Parameter& p : J.parameters[T])
-    p.given = false; // no start of its own: the describing-function fit's
   try {
-    // 1. Each test's equivalent stiffness of the joint, less the joint's other terms (but k and
-    // c, which the fit takes with it) at the state's values.
-    std::vector<identify::EquivalentStiffness> points =
-        equivalent_stiffness(problem, state, sim, jj);
-    const joints::Joint& now = state.joints[jj];
-    const auto other = [&now](std::size_t t) {
-      return !((now.terms[t] == joints::Term::k || now.terms[t] == joints::Term::c) &&
-               !now.fixed[t]);
-    };
-    for (auto& p : points)
-      p.Z -= joint_describing_function(now, p.amplitude, p.omega, other);
-    const int k = now.term_index(joints::Term::k), cc = now.term_index(joints::Term::c);
-    const bool k_open = k >= 0 && !now.fixed[static_cast<std::size_t>(k)];
-    const bool c_open = cc >= 0 && !now.fixed[static_cast<std::size_t>(cc)];
-    // 2. Its parameters from the describing function fitted to them.
-    std::string note;
-    J = identify::fit_describing_function(J, T, std::move(points), k_open, c_open, note);
-    // 3. The coefficient terms by equation error with its force known, then every non-fixed
-    // term and parameter by output error.
-    const identify::FitResult fit = problem.identify(joints, sim, problem.all_tests());
-    joints = fit.identified(joints);
-    State s = problem.evaluate(joints, sim);
-    s.fit = fit;
-    judge(c, s);
-    // Its parameters from the start have no intervals: only output error (finalists) gives them.
-    for (auto& p : c.parameters) {
-      p.fixed = p.determined = false;
-      p.std = p.ci_low = p.ci_high = std::numeric_limits<double>::quiet_NaN();
+    return add_parametric(problem, state, sim, std::move(c), {term},
+                          parametric_points(problem, state, sim, jj));
+  } catch (const std::invalid_argument& e) {
+    return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
+  }
+}
+
+bool softens_then_stiffens(const std::vector<identify::EquivalentStiffness>& points) {
+  if (points.size() < 3) return false;
+  std::vector<identify::EquivalentStiffness> sorted = points;
+  std::sort(sorted.begin(), sorted.end(),
+            [](const auto& p, const auto& q) { return p.amplitude < q.amplitude; });
+  double largest = 0.0;
+  for (const auto& p : sorted)
+    largest = std::max(largest, std::abs(p.Z));
+  std::size_t m = 0;
+  for (std::size_t i = 1; i < sorted.size(); ++i)
+    if (sorted[i].Z.real() < sorted[m].Z.real()) m = i;
+  if (m == 0 || m + 1 == sorted.size()) return false;
+  const double least = sorted[m].Z.real();
+  double before = 0.0, after = 0.0;
+  for (std::size_t i = 0; i < m; ++i)
+    before = std::max(before, sorted[i].Z.real() - least);
+  for (std::size_t i = m + 1; i < sorted.size(); ++i)
+    after = std::max(after, sorted[i].Z.real() - least);
+  return before > 0.1 * largest && after > 0.1 * largest;
+}
+
+Outcome consider_pair(const Problem& problem, const State& state, const Simulator& sim,
+                      const std::string& joint, joints::Term term, joints::Term with) {
+  Candidate c;
+  c.joint = joint;
+  c.term = term;
+  c.with = with;
+  std::size_t jj = 0;
+  while (state.joints[jj].name != joint)
+    ++jj;
+  try {
+    std::vector<identify::EquivalentStiffness> points = parametric_points(problem, state, sim, jj);
+    if (!softens_then_stiffens(points))
+      return refused(std::move(c), state, std::string(pair_not_asked));
+    // Broadband tests: also started with each test at its deformation's peak (a multisine's
+    // slip and contact begin at its peaks, 1.4-2 times its equivalent sine's amplitude); the
+    // start that leaves the lower criterion is kept.
+    std::vector<identify::EquivalentStiffness> peaks =
+        parametric_points(problem, state, sim, jj, true);
+    bool broadband = false;
+    for (std::size_t i = 0; i < points.size() && i < peaks.size(); ++i)
+      broadband = broadband || peaks[i].amplitude > 1.02 * points[i].amplitude;
+    Outcome out = add_parametric(problem, state, sim, c, {term, with}, std::move(points));
+    if (broadband) {
+      Outcome other = add_parametric(problem, state, sim, c, {term, with}, std::move(peaks));
+      if (std::isfinite(other.second.criterion) &&
+          !(other.second.criterion >= out.second.criterion))
+        out = std::move(other);
     }
-    if (c.rejected.empty()) c.rejected = interval_problem(c);
-    return {std::move(c), std::move(s)};
+    return out;
   } catch (const std::invalid_argument& e) {
     return refused(std::move(c), state, std::string("cannot be identified: ") + e.what());
   }
@@ -265,6 +380,18 @@ std::vector<std::function<Outcome()>> candidate_jobs(const Problem& problem, con
       if (!open)
         jobs.push_back([=, name = j.name] { return consider_parametric(*p, *s, *sim, name, t); });
     }
+  // A friction and a clearance together, where the joint has no parametric term yet and both are
+  // candidates: tried only where its stiffness falls and then rises over the tests.
+  const auto& terms = problem.options().terms;
+  const auto offered = [&](joints::Term t) {
+    return std::find(terms.begin(), terms.end(), t) != terms.end();
+  };
+  if (offered(joints::Term::jenkins) && offered(joints::Term::gap))
+    for (const auto& j : state.joints)
+      if (!j.has_parametric_terms())
+        jobs.push_back([=, name = j.name] {
+          return consider_pair(*p, *s, *sim, name, joints::Term::jenkins, joints::Term::gap);
+        });
   if (can.damping_scale) jobs.push_back([=] { return consider_damping(*p, *s); });
   // What the library cannot add: a term of the model whose coefficient changes between tests
   // (with four tests or more: fewer leave too little to tell a trend from a fit).

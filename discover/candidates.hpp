@@ -4,9 +4,11 @@
 /// and each term of the model with a value per test. Each is identified and re-simulated, and
 /// judged by rules 1 and 2 (selection.hpp); rules 3–5 compare it with the others.
 #include "discover/problem.hpp"
+#include "identify/parametric.hpp"
 
 #include <functional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -31,6 +33,20 @@ Outcome consider_term(const Problem& problem, const State& state, const Simulato
 /// finalists (selection.hpp), the others stay undetermined.
 Outcome consider_parametric(const Problem& problem, const State& state, const Simulator& sim,
                             const std::string& joint, joints::Term term);
+/// Whether the equivalent stiffness's real part, in the order of the amplitudes, falls to an
+/// interior least point and rises after it, each by more than a tenth of the largest |Z|.
+bool softens_then_stiffens(const std::vector<identify::EquivalentStiffness>& points);
+/// Why a pair was not tried: the joint's stiffness does not turn. Such an outcome is left out of
+/// the ranking (it was never a candidate).
+inline constexpr std::string_view pair_not_asked =
+    "not tried: the joint's stiffness does not fall and then rise with the deformation amplitude "
+    "over the tests";
+/// Two parametric terms added to the joint together (jenkins and gap), started from one
+/// describing-function fit of both (identify::fit_describing_functions); refused with
+/// pair_not_asked unless the joint's equivalent stiffness softens and then stiffens
+/// (softens_then_stiffens).
+Outcome consider_pair(const Problem& problem, const State& state, const Simulator& sim,
+                      const std::string& joint, joints::Term term, joints::Term with);
 /// The joint's `term` identified from each test alone (every other term held at the state's
 /// value), and every test simulated at its own value: does the coefficient change between
 /// tests, beyond the noise, and with what? Admissible when the values disagree

@@ -239,6 +239,7 @@ private:
                       std::vector<State>& states) const {
     const std::vector<std::string> sources = problem_.sources(problem_.all_tests());
     for (auto& [c, s] : fem::parallel_map(jobs)) {
+      if (c.with && c.rejected == pair_not_asked) continue; // the joint did not ask for it
       compare_on_common_tests(c, s, now, problem_.compared(), sources);
       ranking.push_back(std::move(c));
       states.push_back(std::move(s));

@@ -130,7 +130,12 @@ struct Candidate {
   /// Not an addition: the joint's `term` given a value per test (Variation). Its state
   /// simulates each test at its own value; `value` is their weighted mean.
   std::optional<Variation> varies;
-  std::string name() const;   ///< "k3 at 'tip'", "substructure damping", "refit"
+  /// A second parametric term added together with `term` (jenkins with gap: a friction and a
+  /// clearance, whose stiffness falls and then rises with the amplitude; started from one
+  /// describing-function fit of both), and its parameters as identified.
+  std::optional<joints::Term> with;
+  std::vector<identify::ParameterEstimate> with_parameters;
+  std::string name() const;   ///< "k3 at 'tip'", "jenkins and gap at 'mount'", "refit"
   std::string effect() const; ///< "cubic stiffness", "substructure damping", …
   bool linear() const;        ///< k, c, a refit or the damping scale
   double value = 0.0;         ///< identified coefficient (SI), or the damping scale; a

@@ -409,6 +409,11 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
           break;
         }
       }
+    // Else by continuation in the non-linear forces, from the linear response.
+    if (!(r.status.ok() && r.X.allFinite()))
+      if (frf::HarmonicBalanceResult again = by_continuation(sim, t, these);
+          again.status.ok() && again.X.allFinite())
+        r = std::move(again);
     s.X[i] = r.X.topRows(rows_[i] + 1);
     s.Y[i] = r.Y;
     if (r.status.ok() && r.X.allFinite()) {
@@ -473,6 +478,34 @@ frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,
     frf::HarmonicBalanceResult again = sim.balance[i].solve(joints, drive_[i]);
     again.iterations += r.iterations;
     if (again.status.ok() || again.residual < r.residual) r = std::move(again);
+  }
+  return r;
+}
+
+frf::HarmonicBalanceResult
+Problem::by_continuation(const Simulator& sim, int i,
+                         const std::vector<joints::Joint>& joints) const {
+  frf::HarmonicBalanceResult r;
+  Eigen::MatrixXcd Y;
+  for (const double s : {0.125, 0.25, 0.5, 0.75, 1.0}) {
+    std::vector<joints::Joint> scaled = joints;
+    for (joints::Joint& j : scaled)
+      for (std::size_t t = 0; t < j.terms.size(); ++t) {
+        const joints::Term term = j.terms[t];
+        if (term == joints::Term::k || term == joints::Term::c) continue;
+        if (!joints::has_parameters(term)) {
+          j.values[t] *= s;
+          continue;
+        }
+        for (const char* name : {"kt", "fs", "kg"}) {
+          const int p = joints::parameter_index(term, name);
+          if (p >= 0) j.parameters[t][static_cast<std::size_t>(p)].value *= s;
+        }
+      }
+    r = sim.balance[static_cast<std::size_t>(i)].solve(scaled, drive_[static_cast<std::size_t>(i)],
+                                                       Y.size() ? &Y : nullptr);
+    if (!(r.status.ok() && r.X.allFinite())) return r;
+    Y = r.Y;
   }
   return r;
 }

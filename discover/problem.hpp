@@ -134,6 +134,13 @@ public:
   frf::HarmonicBalanceResult solve(const Simulator& sim, int i,
                                    const std::vector<joints::Joint>& joints,
                                    const Eigen::MatrixXcd* warm = nullptr) const;
+  /// Test i's steady state by continuation in the joints' non-linear forces: every term but k
+  /// and c scaled by s = 1/8, 1/4, 1/2, 3/4, 1 (a coefficient's value; a jenkins' or an iwan's
+  /// kt and fs, a gap's kg: each of these forces scales with s), each step from the last, the
+  /// first from the linear response. For a test that no start reaches directly (a clearance that
+  /// closes on part of a multisine's period beside a friction that slips); the last status.
+  frf::HarmonicBalanceResult by_continuation(const Simulator& sim, int i,
+                                             const std::vector<joints::Joint>& joints) const;
   /// The tests nearest to test i in frequency and force level (|ln f/fᵢ| + |ln F/Fᵢ|), nearest
   /// first, among `candidates`.
   std::vector<int> nearest(int i, const std::vector<int>& candidates, std::size_t count) const;

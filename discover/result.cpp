@@ -14,6 +14,9 @@ std::string Candidate::name() const {
   if (refit) return "refit of the starting values";
   if (!term) return "substructure damping";
   if (varies) return fmt::format("{} at '{}', a value per test", joints::term_name(*term), joint);
+  if (with)
+    return fmt::format("{} and {} at '{}'", joints::term_name(*term), joints::term_name(*with),
+                       joint);
   return fmt::format("{} at '{}'", joints::term_name(*term), joint);
 }
 
@@ -23,15 +26,19 @@ std::string Candidate::effect() const {
   if (varies)
     return fmt::format("{} that changes between tests (no term of the library)",
                        joints::term_effect(*term));
+  if (with) return fmt::format("{} and {}", joints::term_effect(*term), joints::term_effect(*with));
   return std::string(joints::term_effect(*term));
 }
 
 bool Candidate::determined() const {
-  if (term && joints::has_parameters(*term))
-    return std::any_of(parameters.begin(), parameters.end(), [](const auto& p) {
+  if (term && joints::has_parameters(*term)) {
+    const auto one = [](const auto& p) {
       return !p.fixed && p.determined && std::isfinite(p.ci_low) && std::isfinite(p.ci_high) &&
              p.ci_high > p.ci_low;
-    });
+    };
+    return std::any_of(parameters.begin(), parameters.end(), one) ||
+           std::any_of(with_parameters.begin(), with_parameters.end(), one);
+  }
   return std::isfinite(ci_low) && std::isfinite(ci_high) && ci_high > ci_low &&
          std::isfinite(std) && std > 0.0;
 }

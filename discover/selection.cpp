@@ -117,16 +117,20 @@ void fill(Candidate& candidate, const State& state) {
 
 void take_fit(Candidate& candidate, const identify::FitResult& fit, const std::string& joint,
               joints::Term term) {
-  for (const auto& je : fit.joints)
-    if (je.name == joint)
-      for (const auto& te : je.terms)
-        if (te.term == term) {
-          candidate.parameters = te.parameters;
-          candidate.value = te.value;
-          candidate.std = te.std;
-          candidate.ci_low = te.ci_low;
-          candidate.ci_high = te.ci_high;
-        }
+  for (const auto& je : fit.joints) {
+    if (je.name != joint) continue;
+    for (const auto& te : je.terms) {
+      if (candidate.with && te.term == *candidate.with) {
+        candidate.with_parameters = te.parameters;
+      } else if (te.term == term) {
+        candidate.parameters = te.parameters;
+        candidate.value = te.value;
+        candidate.std = te.std;
+        candidate.ci_low = te.ci_low;
+        candidate.ci_high = te.ci_high;
+      }
+    }
+  }
 }
 
 void judge(Candidate& candidate, const State& state) {
@@ -250,6 +254,10 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
   int coefficient = 0, place = 0; // place: among the candidates that may be refined
   for (std::size_t i : by) {
     if (!std::isfinite(ranking[i].criterion) || ranking[i].varies) continue;
+    if (ranking[i].with) { // two terms together: only tried where the joint asks for both
+      out.push_back(i);
+      continue;
+    }
     if (ranking[i].term && joints::has_parameters(*ranking[i].term)) {
       // The best one, besides the count, where it ranks among the best count + 1 (its start
       // screens it: further down, coefficient terms explain the data better).

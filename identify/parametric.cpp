@@ -183,26 +183,31 @@ void check_one_parametric_term(const std::vector<joints::Joint>& joints) {
   }
 }
 
-// Step 2: the parameters of term T of J (its fixed ones held) in their coordinates u that fit
-// N(a) + k + iωc to the points, sorted by amplitude (the joint's own k and c by least squares
-// where open), from a few starts read off the data; empty when no start gives a finite misfit.
-static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
+// Step 2: the parameters of the terms Ts of J (their fixed ones held), concatenated, in their
+// coordinates u that fit Σ N_T(a) + k + iωc to the points, sorted by amplitude (the joint's own
+// k and c by least squares where open), from a few starts read off the data (every combination
+// of each term's starts); empty when no start gives a finite misfit.
+static Eigen::VectorXd best_fit(const joints::Joint& J, const std::vector<std::size_t>& Ts,
                                 const std::vector<Point>& points, bool k_open, bool c_open,
                                 double& best_cost) {
-  const joints::Term term = J.terms[T];
-  // 2. N(a) + k + iωc fitted to Z(a).
-  const auto& info = joints::term_info(term).parameters;
-  const auto np = static_cast<Eigen::Index>(info.size());
-  std::vector<bool> free(info.size());
-  for (std::size_t p = 0; p < info.size(); ++p)
-    free[p] = !(J.parameters.size() > T && J.parameters[T].size() == info.size() &&
-                J.parameters[T][p].fixed);
+  // 2. Σ N(a) + k + iωc fitted to Z(a).
+  std::vector<std::size_t> offset; // of each term's parameters in u
+  std::vector<bool> free;
+  Eigen::Index np = 0;
+  joints::Joint trial = J;
+  for (const std::size_t T : Ts) {
+    const auto& info = joints::term_info(J.terms[T]).parameters;
+    offset.push_back(static_cast<std::size_t>(np));
+    np += static_cast<Eigen::Index>(info.size());
+    for (std::size_t p = 0; p < info.size(); ++p)
+      free.push_back(!(J.parameters.size() > T && J.parameters[T].size() == info.size() &&
+                       J.parameters[T][p].fixed));
+    if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
+      trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+  }
   std::vector<double> amplitudes;
   for (const Point& P : points)
     amplitudes.push_back(P.amplitude);
-  joints::Joint trial = J;
-  if (trial.parameters.size() <= T || trial.parameters[T].size() != info.size())
-    trial.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
   // Each point's misfit relative to its |Z|, but not below a tenth of the largest: a joint that
   // is a correction to a substructure fitted at low level (its stiffness there in the
   // substructure) has Z near 0 at small amplitudes, where relative errors would be its noise.
@@ -213,10 +218,13 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
     return std::max({std::abs(P.Z), 0.1 * largest, 1e-300});
   };
   const auto residual = [&](const Eigen::VectorXd& u, Eigen::VectorXd& r) -> bool {
-    for (Eigen::Index p = 0; p < np; ++p) {
-      joints::Parameter& P = trial.parameters[T][static_cast<std::size_t>(p)];
-      P.value = parameter_from_u(info[static_cast<std::size_t>(p)], u(p));
-      P.given = true;
+    for (std::size_t i = 0; i < Ts.size(); ++i) {
+      const auto& info = joints::term_info(J.terms[Ts[i]]).parameters;
+      for (std::size_t p = 0; p < info.size(); ++p) {
+        joints::Parameter& P = trial.parameters[Ts[i]][p];
+        P.value = parameter_from_u(info[p], u(static_cast<Eigen::Index>(offset[i] + p)));
+        P.given = true;
+      }
     }
     try {
       joints::check_parameters(trial);
@@ -224,10 +232,14 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
       return false;
     }
     const auto n = static_cast<Eigen::Index>(points.size());
-    const std::vector<Complex> N = describing_functions(trial, T, amplitudes, 24);
     Eigen::VectorXcd e(n);
     for (Eigen::Index i = 0; i < n; ++i)
-      e(i) = points[static_cast<std::size_t>(i)].Z - N[static_cast<std::size_t>(i)];
+      e(i) = points[static_cast<std::size_t>(i)].Z;
+    for (const std::size_t T : Ts) {
+      const std::vector<Complex> N = describing_functions(trial, T, amplitudes, 24);
+      for (Eigen::Index i = 0; i < n; ++i)
+        e(i) -= N[static_cast<std::size_t>(i)];
+    }
     // The joint's own k and c by least squares (each point weighted by 1/|Z|).
     double kw = 0.0, w = 0.0, cw = 0.0, wc = 0.0;
     for (Eigen::Index i = 0; i < n; ++i) {
@@ -253,38 +265,68 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
     dissipation = std::max(dissipation, std::numbers::pi * P.amplitude * P.amplitude * P.Z.imag());
   // The stiffness lost by slip and gained by contact: from the smallest amplitude's to the
   // least and the largest over the points (a joint can first slip, then close a clearance).
-  double least = lo.Z.real(), most = lo.Z.real();
-  for (const Point& P : points)
+  double least = lo.Z.real(), most = lo.Z.real(), at_least = lo.amplitude;
+  for (const Point& P : points) {
+    if (P.Z.real() < least) at_least = P.amplitude;
     least = std::min(least, P.Z.real()), most = std::max(most, P.Z.real());
+  }
   const double lost = lo.Z.real() - least, gained = most - lo.Z.real();
   const double k_small = std::max(k_open ? lost : lo.Z.real(), 1e-3 * std::abs(lo.Z));
-  std::vector<std::vector<double>> starts;
-  if (J.parameters.size() > T && J.parameters[T].size() == info.size() &&
-      std::all_of(J.parameters[T].begin(), J.parameters[T].end(),
-                  [](const joints::Parameter& p) { return p.given; })) {
-    std::vector<double> given;
-    for (const joints::Parameter& p : J.parameters[T])
-      given.push_back(p.value);
-    starts.push_back(given);
+  const bool pair = Ts.size() > 1;
+  // Each term's starts, then every combination of them.
+  std::vector<std::vector<std::vector<double>>> each;
+  for (const std::size_t T : Ts) {
+    const joints::Term term = J.terms[T];
+    const auto& info = joints::term_info(term).parameters;
+    std::vector<std::vector<double>> starts;
+    if (J.parameters.size() > T && J.parameters[T].size() == info.size() &&
+        std::all_of(J.parameters[T].begin(), J.parameters[T].end(),
+                    [](const joints::Parameter& p) { return p.given; })) {
+      std::vector<double> given;
+      for (const joints::Parameter& p : J.parameters[T])
+        given.push_back(p.value);
+      starts.push_back(given);
+    }
+    for (const double scale : {0.3, 1.0, 3.0}) {
+      const double fs = std::max(scale * dissipation / (4.0 * hi.amplitude), 1e-300);
+      if (term == joints::Term::jenkins) starts.push_back({std::max(k_small, 1e-300), fs});
+      if (term == joints::Term::iwan)
+        for (const double chi : {-0.6, -0.2})
+          starts.push_back({3.0 * fs, std::max(k_small, 1e-300), chi, 0.1});
+      if (term == joints::Term::gap) {
+        const double kg =
+            std::max(gained > 0.0 ? 2.0 * (pair ? most - least : gained) : std::abs(hi.Z), 1e-300);
+        // Beside a slip, the clearance closes about where the stiffness stops falling.
+        starts.push_back({scale * (pair ? at_least : lo.amplitude), kg});
+      }
+    }
+    each.push_back(std::move(starts));
   }
-  for (const double scale : {0.3, 1.0, 3.0}) {
-    const double fs = std::max(scale * dissipation / (4.0 * hi.amplitude), 1e-300);
-    if (term == joints::Term::jenkins) starts.push_back({std::max(k_small, 1e-300), fs});
-    if (term == joints::Term::iwan)
-      for (const double chi : {-0.6, -0.2})
-        starts.push_back({3.0 * fs, std::max(k_small, 1e-300), chi, 0.1});
-    if (term == joints::Term::gap)
-      starts.push_back(
-          {scale * lo.amplitude, std::max(gained > 0.0 ? 2.0 * gained : std::abs(hi.Z), 1e-300)});
+  std::vector<std::vector<double>> starts{{}};
+  for (const auto& list : each) {
+    std::vector<std::vector<double>> next;
+    for (const auto& head : starts)
+      for (const auto& tail : list) {
+        std::vector<double> joined = head;
+        joined.insert(joined.end(), tail.begin(), tail.end());
+        next.push_back(std::move(joined));
+      }
+    starts = std::move(next);
   }
+  std::vector<double> held(static_cast<std::size_t>(np)); // the fixed parameters' values
+  for (std::size_t i = 0; i < Ts.size(); ++i)
+    for (std::size_t p = 0; p < J.parameters_of(Ts[i]).size(); ++p)
+      held[offset[i] + p] = J.parameters_of(Ts[i])[p].value;
   best_cost = std::numeric_limits<double>::infinity();
   Eigen::VectorXd best;
   for (const auto& s : starts) {
     Eigen::VectorXd u(np), r, rn;
-    for (Eigen::Index p = 0; p < np; ++p) {
-      const std::size_t q = static_cast<std::size_t>(p);
-      const bool keep = !free[q] && J.parameters.size() > T;
-      u(p) = parameter_to_u(info[q], keep ? J.parameters[T][q].value : s[q]);
+    for (std::size_t i = 0; i < Ts.size(); ++i) {
+      const auto& info = joints::term_info(J.terms[Ts[i]]).parameters;
+      for (std::size_t p = 0; p < info.size(); ++p) {
+        const std::size_t q = offset[i] + p;
+        u(static_cast<Eigen::Index>(q)) = parameter_to_u(info[p], !free[q] ? held[q] : s[q]);
+      }
     }
     if (!residual(u, r)) continue;
     double cost = r.squaredNorm(), mu = 1e-2;
@@ -329,36 +371,48 @@ static Eigen::VectorXd best_fit(const joints::Joint& J, std::size_t T,
 joints::Joint fit_describing_function(const joints::Joint& J, std::size_t T,
                                       std::vector<EquivalentStiffness> points, bool k_open,
                                       bool c_open, std::string& note) {
-  const joints::Term term = J.terms[T];
+  return fit_describing_functions(J, {T}, std::move(points), k_open, c_open, note);
+}
+
+joints::Joint fit_describing_functions(const joints::Joint& J, const std::vector<std::size_t>& Ts,
+                                       std::vector<EquivalentStiffness> points, bool k_open,
+                                       bool c_open, std::string& note) {
+  std::vector<std::string> names;
+  for (const std::size_t T : Ts)
+    names.emplace_back(joints::term_name(J.terms[T]));
+  const std::string what = fmt::format("{}", fmt::join(names, " and "));
   if (points.empty())
     throw std::invalid_argument("joint '" + J.name + "': no equivalent stiffness to fit its " +
-                                std::string(joints::term_name(term)) + " to");
+                                what + " to");
   std::sort(points.begin(), points.end(),
             [](const Point& p, const Point& q) { return p.amplitude < q.amplitude; });
   double best_cost = 0.0;
-  const Eigen::VectorXd best = best_fit(J, T, points, k_open, c_open, best_cost);
+  const Eigen::VectorXd best = best_fit(J, Ts, points, k_open, c_open, best_cost);
   if (best.size() == 0)
     throw std::invalid_argument("joint '" + J.name + "': the describing-function fit of its " +
-                                std::string(joints::term_name(term)) + " found no start");
-  const auto& info = joints::term_info(term).parameters;
+                                what + " found no start");
   joints::Joint out = J;
-  if (out.parameters.size() <= T || out.parameters[T].size() != info.size())
-    out.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
   std::string values;
-  for (std::size_t q = 0; q < info.size(); ++q) {
-    joints::Parameter& P = out.parameters[T][q];
-    P.value = parameter_from_u(info[q], best(static_cast<Eigen::Index>(q)));
-    P.given = true;
-    values += fmt::format("{}{}.{} = {:.4g}", values.empty() ? "" : ", ", joints::term_name(term),
-                          info[q].name, P.value);
+  Eigen::Index u = 0;
+  for (const std::size_t T : Ts) {
+    const joints::Term term = J.terms[T];
+    const auto& info = joints::term_info(term).parameters;
+    if (out.parameters.size() <= T || out.parameters[T].size() != info.size())
+      out.set_parameters(T, std::vector<double>(info.size(), 0.0), false);
+    for (std::size_t q = 0; q < info.size(); ++q) {
+      joints::Parameter& P = out.parameters[T][q];
+      P.value = parameter_from_u(info[q], best(u++));
+      P.given = true;
+      values += fmt::format("{}{}.{} = {:.4g}", values.empty() ? "" : ", ", joints::term_name(term),
+                            info[q].name, P.value);
+    }
+    if (!out.given.empty()) out.given[T] = true;
   }
-  if (!out.given.empty()) out.given[T] = true;
   joints::check_parameters(out); // out of its range: std::invalid_argument saying which
   note = fmt::format("joint '{}': {} started from a describing-function fit of the equivalent "
                      "stiffness and damping of {} test(s) at deformation amplitudes {:.3g} … "
                      "{:.3g} (relative misfit {:.2g}): {}",
-                     J.name, joints::term_name(term), points.size(), points.front().amplitude,
-                     points.back().amplitude,
+                     J.name, what, points.size(), points.front().amplitude, points.back().amplitude,
                      std::sqrt(best_cost / static_cast<double>(2 * points.size())), values);
   return out;
 }
@@ -460,7 +514,7 @@ DescribingFunctionStart describing_function_start(const frf::Substructure& sub,
     const auto np = static_cast<Eigen::Index>(info.size());
     const Point &lo = points.front(), &hi = points.back();
     double best_cost = std::numeric_limits<double>::infinity();
-    const Eigen::VectorXd best = best_fit(J, T, points, k_open, c_open, best_cost);
+    const Eigen::VectorXd best = best_fit(J, {T}, points, k_open, c_open, best_cost);
     if (best.size() == 0) {
       start.status = fem::Status::failure(
           fem::Status::Code::not_converging,

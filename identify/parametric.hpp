@@ -83,6 +83,16 @@ joints::Joint fit_describing_function(const joints::Joint& joint, std::size_t te
                                       std::vector<EquivalentStiffness> points, bool k_open,
                                       bool c_open, std::string& note);
 
+/// The same for several parametric terms of the joint at once (`terms`, indices into its terms),
+/// their describing functions summed: a friction and a clearance whose stiffness first falls and
+/// then rises with the amplitude. Every combination of each term's starts is tried; a gap beside
+/// another term starts closing where the points' stiffness is least, its stop at twice the
+/// stiffness regained from there. The parameters of all of them are set.
+joints::Joint fit_describing_functions(const joints::Joint& joint,
+                                       const std::vector<std::size_t>& terms,
+                                       std::vector<EquivalentStiffness> points, bool k_open,
+                                       bool c_open, std::string& note);
+
 /// Output error identifies one parametric term a joint at a time: throws std::invalid_argument
 /// naming the joint and its terms when a joint has two or more whose parameters are not all
 /// fixed.

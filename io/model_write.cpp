@@ -138,6 +138,10 @@ bool same_terms(const joints::Joint& a, const joints::Joint& b) {
 std::string model_with_joints(const fs::path& start, const std::vector<joints::Joint>& joints,
                               double damping_scale, const fs::path& target,
                               std::string_view header) {
+  if (!fs::is_directory(target.parent_path().empty() ? fs::path(".") : target.parent_path()))
+    throw Error(fmt::format("{}: its directory does not exist (the model's paths are checked "
+                            "from it)",
+                            target.string()));
   const ModelFile original = read_model(start);
   toml::table root;
   try {

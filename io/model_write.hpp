@@ -25,7 +25,8 @@ namespace jointid::io {
 ///   than 1 on [[substructures]] or [frf] cannot be written;
 /// - `header` becomes the file's first comment lines.
 /// The text is read back (io::read_model, paths from `target`'s directory) and its joints
-/// compared with `joints` before it is returned. Throws io::Error saying what cannot be written.
+/// compared with `joints` before it is returned; `target`'s directory must exist. Throws
+/// io::Error saying what cannot be written.
 std::string model_with_joints(const std::filesystem::path& start,
                               const std::vector<joints::Joint>& joints, double damping_scale,
                               const std::filesystem::path& target, std::string_view header);

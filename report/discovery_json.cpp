@@ -93,6 +93,10 @@ Json candidate_json(const discover::Candidate& c) {
     j.erase("ci95");
     j["parameters"] = parameters_json(c.parameters, *c.term);
   }
+  if (c.with) // a second parametric term added with it: its term, effect and parameters
+    j["with"] = {{"term", std::string(joints::term_name(*c.with))},
+                 {"effect", std::string(joints::term_effect(*c.with))},
+                 {"parameters", parameters_json(c.with_parameters, *c.with)}};
   j["gap"] = number(c.gap);
   j["explained"] = number(c.explained);
   j["criterion"] = number(c.criterion);

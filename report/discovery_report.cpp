@@ -64,9 +64,19 @@ std::string parameters_text(const std::vector<identify::ParameterEstimate>& list
   return out;
 }
 
+// A parametric candidate's parameters; two terms added together: "jenkins: kt = …; gap: …".
+std::string parameters_text(const discover::Candidate& c) {
+  if (!c.with) return parameters_text(c.parameters, *c.term);
+  return fmt::format("{}: {}; {}: {}", joints::term_name(*c.term),
+                     parameters_text(c.parameters, *c.term), joints::term_name(*c.with),
+                     parameters_text(c.with_parameters, *c.with));
+}
+
 std::string short_name(const discover::Candidate& c) {
   if (c.refit) return "refit";
   if (!c.term) return "damping scale";
+  if (c.with)
+    return fmt::format("{}+{}@{}", joints::term_name(*c.term), joints::term_name(*c.with), c.joint);
   return fmt::format("{}@{}", joints::term_name(*c.term), c.joint);
 }
 
@@ -159,13 +169,12 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     for (std::size_t i = 0; i < r.steps.size(); ++i) {
       const auto& s = r.steps[i];
       const bool parametric = !s.added.parameters.empty();
-      md += fmt::format(
-          "| {} | {} | {} | {} | {} | {} | {} | {} |\n", i + 1, s.added.name(), s.added.effect(),
-          parametric ? parameters_text(s.added.parameters, *s.added.term) : g4(s.added.value),
-          parametric             ? std::string("(with each parameter)")
-          : s.added.determined() ? interval(s.added.ci_low, s.added.ci_high)
-                                 : std::string("undetermined"),
-          g4(s.gap_before), g4(s.gap_after), pct(s.added.explained));
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", i + 1, s.added.name(),
+                        s.added.effect(), parametric ? parameters_text(s.added) : g4(s.added.value),
+                        parametric             ? std::string("(with each parameter)")
+                        : s.added.determined() ? interval(s.added.ci_low, s.added.ci_high)
+                                               : std::string("undetermined"),
+                        g4(s.gap_before), g4(s.gap_after), pct(s.added.explained));
     }
     md += "\n";
   }
@@ -305,10 +314,9 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
       // A parametric term (jenkins, iwan, gap) has no single value: its parameters, each with
       // its interval, or "—" where its fit gave none.
       const bool parametric = cand.term && joints::has_parameters(*cand.term);
-      const std::string value = !parametric ? g4(cand.value)
-                                : cand.parameters.empty()
-                                    ? std::string("—")
-                                    : parameters_text(cand.parameters, *cand.term);
+      const std::string value = !parametric               ? g4(cand.value)
+                                : cand.parameters.empty() ? std::string("—")
+                                                          : parameters_text(cand);
       const std::string ci = !parametric               ? interval(cand.ci_low, cand.ci_high)
                              : cand.parameters.empty() ? std::string("—")
                                                        : std::string("(with each parameter)");

@@ -109,6 +109,7 @@ void Discover::run() {
   // one (a part's joint changed, a damping scale on parts): then no model.toml, and one left
   // by an earlier run is removed rather than left beside a discovery.json it does not match.
   std::vector<std::string> warnings = result.warnings;
+  make_output_dir(output_dir_); // (model.toml's paths are checked from it)
   const fs::path toml = output_dir_ / "model.toml";
   std::string model_text;
   const discover::State& last = result.states.back();
@@ -121,7 +122,6 @@ void Discover::run() {
   } catch (const io::Error& e) {
     warnings.push_back(fmt::format("{} not written: {}", toml.string(), e.what()));
   }
-  make_output_dir(output_dir_);
   const fs::path json = output_dir_ / "discovery.json";
   io::write_json(json, report::discovery_json(result));
   if (!model_text.empty())
@@ -154,11 +154,14 @@ void Discover::print(const discover::Result& result) const {
                s.added.effect(),
                s.added.parameters.empty() ? fmt::format("{:.5g}", s.added.value) : "(below)",
                s.gap_before, s.gap_after);
-    for (const auto& p : s.added.parameters) // a parametric term: its parameters below it
-      fmt::print("      {:<33} {}\n",
-                 fmt::format("{}.{}", joints::term_name(*s.added.term), p.name),
-                 p.determined ? fmt::format("{:.5g} [{:.5g}, {:.5g}]", p.value, p.ci_low, p.ci_high)
-                              : std::string("undetermined"));
+    // A parametric term (and one added with it): its parameters below it.
+    for (const auto& [term, list] : {std::pair{s.added.term, &s.added.parameters},
+                                     std::pair{s.added.with, &s.added.with_parameters}})
+      for (const auto& p : *list)
+        fmt::print("      {:<33} {}\n", fmt::format("{}.{}", joints::term_name(*term), p.name),
+                   p.determined
+                       ? fmt::format("{:.5g} [{:.5g}, {:.5g}]", p.value, p.ci_low, p.ci_high)
+                       : std::string("undetermined"));
   }
   fmt::print("\n{}\nStopped: {}.\n", result.diagnosis.findings.back(), result.stop_reason);
 }

@@ -87,6 +87,8 @@ void bind_discover(py::module_& m) {
               d["joint"] = s.added.joint;
               d["term"] = s.added.term ? std::string(joints::term_name(*s.added.term))
                                        : std::string("damping_scale");
+              if (s.added.with) // a second parametric term added with it (jenkins with gap)
+                d["with"] = std::string(joints::term_name(*s.added.with));
               d["effect"] = s.added.effect();
               d["value"] = s.added.value;
               d["ci95"] = py::make_tuple(s.added.ci_low, s.added.ci_high);
@@ -97,8 +99,8 @@ void bind_discover(py::module_& m) {
             }
             return out;
           },
-          "The terms added, one dict per step: joint, term, effect, value, ci95, gap_before, "
-          "gap_after, finding.")
+          "The terms added, one dict per step: joint, term (and with: a second parametric term "
+          "added together), effect, value, ci95, gap_before, gap_after, finding.")
       .def_property_readonly(
           "final_joints",
           [](const DiscoveryResult& self) {

@@ -729,6 +729,45 @@ TEST(Discover, PeriodicMultisineTestsNameAHiddenCubicStiffness) {
   EXPECT_EQ(r.comparisons.back()[0].measured, tests[0].X(4, 0));
 }
 
+// A friction with its own stiffness and a clearance at the tip (issue 30's joint of a real
+// structure): stuck at low levels, its stiffness falls as the Jenkins element slips (above fs/kt
+// = 1 mm) and rises once the stop is met (delta 4 mm). Neither term alone follows that; the pair
+// is started from one describing-function fit of both (each test at its deformation's peak: a
+// multisine's slip and contact begin there) and refined by output error. Multisine tests at six
+// levels, 1 % noise; discovery from k and c alone, the candidates jenkins and gap (to keep it
+// short), one step: "jenkins and gap at 'tip'", every parameter within 5 % of the truth, and the
+// gap at the noise level.
+TEST(Discover, AFrictionAndAClearanceTogetherAreNamedTogether) {
+  joints::Joint truth =
+      joint("tip", 7, {Term::k, Term::c, Term::jenkins, Term::gap}, {4800.0, 20.0, 1.0, 1.0});
+  truth.parameters.resize(4);
+  truth.set_parameters(2, {5000.0, 5.0});
+  truth.set_parameters(3, {4e-3, 2e4});
+  const std::vector<identify::Measurement> tests =
+      multisine_tests({truth}, {5.0, 10.0, 20.0, 40.0, 80.0, 120.0}, 0.01);
+  discover::Options o;
+  o.terms = {Term::jenkins, Term::gap};
+  o.max_steps = 1;
+  o.substructure_damping = false;
+  const discover::Result r = discover::discover(frf::Substructure(test::paper_cantilever()),
+                                                {linear_start("tip", 7)}, tests, o);
+  SCOPED_TRACE(describe(r));
+  ASSERT_EQ(r.steps.size(), 1u);
+  const discover::Candidate& added = r.steps[0].added;
+  EXPECT_EQ(added.name(), "jenkins and gap at 'tip'");
+  ASSERT_EQ(added.parameters.size(), 2u);
+  ASSERT_EQ(added.with_parameters.size(), 2u);
+  const double truth_values[] = {5000.0, 5.0, 4e-3, 2e4};
+  const identify::ParameterEstimate* found[] = {&added.parameters[0], &added.parameters[1],
+                                                &added.with_parameters[0],
+                                                &added.with_parameters[1]};
+  for (int p = 0; p < 4; ++p)
+    EXPECT_NEAR(found[p]->value, truth_values[p], 0.05 * truth_values[p]) << found[p]->name;
+  EXPECT_NEAR(value_of(r, "tip", Term::k), 4800.0, 0.05 * 4800.0);
+  EXPECT_GT(r.gap.front(), 10.0 * r.noise_gap);
+  expect_at_noise_level(r);
+}
+
 // A periodic test re-simulated through measured FRFs needs them to twice line max(K, 10) × its
 // highest driven line: lines 4 and 6 every 0.25 Hz, K = 3: line 60, 15 Hz, doubled 30 Hz; FRFs to
 // 20 Hz are refused, naming the test and saying how far to measure.

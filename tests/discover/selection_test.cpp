@@ -2,6 +2,7 @@
 // values in both its forms, and each admissibility rule rejecting a named candidate that every
 // other rule admits, with the reason it gives; cross-validation's folds; a coefficient that varies
 // per test, admitted only when its values disagree.
+#include "discover/candidates.hpp"
 #include "discover/selection.hpp"
 
 #include "constructed.hpp"
@@ -460,6 +461,24 @@ TEST(VariesPerTest, AStiffnessThatSoftensThenStiffensIsDescribedByItsTurn) {
   EXPECT_NE(f.varies->description.find("it grows with the frequency (rank correlation +1.00)"),
             std::string::npos)
       << f.varies->description;
+}
+
+// A pair of parametric terms is tried only where the joint's stiffness turns: it falls to an
+// interior least point and rises after it, each by more than a tenth of the largest |Z|.
+TEST(Pair, TriedWhereTheStiffnessFallsAndThenRises) {
+  const auto points = [](std::vector<double> re) {
+    std::vector<identify::EquivalentStiffness> out;
+    for (std::size_t i = 0; i < re.size(); ++i) // listed out of the amplitudes' order
+      out.push_back({1e-4 * static_cast<double>(re.size() - i), 100.0, {re[i], 0.0}});
+    return out;
+  };
+  // In amplitude order (the list reversed): 0, -5, -17, 40 (k 1e3): falls 17, rises 57.
+  EXPECT_TRUE(softens_then_stiffens(points({40.0, -17.0, -5.0, 0.0})));
+  EXPECT_FALSE(softens_then_stiffens(points({-40.0, -17.0, -5.0, 0.0}))) << "slip only";
+  EXPECT_FALSE(softens_then_stiffens(points({40.0, 17.0, 5.0, 0.0}))) << "contact only";
+  EXPECT_FALSE(softens_then_stiffens(points({40.0, -3.0, 0.0, 0.0})))
+      << "a fall of 3 where the largest |Z| is 40: within a tenth of it";
+  EXPECT_FALSE(softens_then_stiffens(points({-5.0, 0.0})));
 }
 
 } // namespace
