@@ -768,6 +768,39 @@ TEST(Discover, AFrictionAndAClearanceTogetherAreNamedTogether) {
   expect_at_noise_level(r);
 }
 
+// The same joint of a real structure under sine tests (35: 2-5 Hz at 10-80 N, time integration,
+// 1 % noise), with a strong friction and a wide clearance (kt 1e4 N/m, fs 20 N: slip from 2 mm;
+// delta 15 mm, kg 1e4 N/m): a case that one parametric term at a time never found (the Jenkins
+// element's screening state, the other terms refitted around it, left a gap of 1.64 against 0.33
+// before it). With every candidate of the library, the pair is named in one step, each parameter
+// within 3 % of the truth, and the gap falls from 0.68 by more than 100 times, to within twice its
+// floor (measured: 0.00138, the noise and the simulation's own error 0.00105 together; the
+// harmonic balance's error for a friction and a stop at 15 harmonics is what is left).
+TEST(Discover, AFrictionAndAWideClearanceUnderSineTestsAreNamedTogether) {
+  Data d;
+  joints::Joint truth =
+      joint("tip", 7, {Term::k, Term::c, Term::jenkins, Term::gap}, {4800.0, 20.0, 1.0, 1.0});
+  truth.parameters.resize(4);
+  truth.set_parameters(2, {1.0e4, 20.0});
+  truth.set_parameters(3, {15e-3, 1e4});
+  d.truth = {truth};
+  d.levels = {10.0, 20.0, 40.0, 60.0, 80.0};
+  const discover::Result r =
+      discover::discover(frf::Substructure(d.model), {linear_start("tip", 7)}, measure(d));
+  SCOPED_TRACE(describe(r));
+  ASSERT_GE(r.steps.size(), 1u);
+  const discover::Candidate& added = r.steps[0].added;
+  EXPECT_EQ(added.name(), "jenkins and gap at 'tip'");
+  ASSERT_EQ(added.parameters.size(), 2u);
+  ASSERT_EQ(added.with_parameters.size(), 2u);
+  EXPECT_NEAR(added.parameters[0].value, 1.0e4, 0.03 * 1.0e4);
+  EXPECT_NEAR(added.parameters[1].value, 20.0, 0.03 * 20.0);
+  EXPECT_NEAR(added.with_parameters[0].value, 15e-3, 0.03 * 15e-3);
+  EXPECT_NEAR(added.with_parameters[1].value, 1e4, 0.03 * 1e4);
+  EXPECT_LT(r.gap.back(), 0.01 * r.gap.front());
+  EXPECT_LT(r.gap.back(), 2.0 * std::hypot(r.noise_gap, r.simulation_gap));
+}
+
 // A periodic test re-simulated through measured FRFs needs them to twice line max(K, 10) × its
 // highest driven line: lines 4 and 6 every 0.25 Hz, K = 3: line 60, 15 Hz, doubled 30 Hz; FRFs to
 // 20 Hz are refused, naming the test and saying how far to measure.
