@@ -79,6 +79,14 @@ Outcome consider_term(const Problem& problem, const State& state, const Simulato
 
 namespace {
 
+// The index of the joint named `name` (one of them: the candidates are made from the joints).
+std::size_t position(const std::vector<joints::Joint>& joints, const std::string& name) {
+  std::size_t jj = 0;
+  while (joints[jj].name != name)
+    ++jj;
+  return jj;
+}
+
 // The peak of the joint's deformation over a test's period against that of the sine of the same
 // RMS (√2 RMS): 1 for a sine test; a multisine's 1.4 to 2 (its slips and contacts start at its
 // peaks, which its equivalent sine does not reach). NaN where a DOF of the joint is not measured.
@@ -124,9 +132,7 @@ Outcome add_parametric(const Problem& problem, const State& state, const Simulat
                        Candidate c, const std::vector<joints::Term>& terms,
                        std::vector<identify::EquivalentStiffness> points) {
   std::vector<joints::Joint> joints = state.joints;
-  std::size_t jj = 0;
-  while (joints[jj].name != c.joint)
-    ++jj;
+  const std::size_t jj = position(joints, c.joint);
   joints::Joint& J = joints[jj];
   std::vector<std::size_t> added;
   for (const joints::Term term : terms) {
@@ -181,9 +187,7 @@ Outcome consider_parametric(const Problem& problem, const State& state, const Si
   Candidate c;
   c.joint = joint;
   c.term = term;
-  std::size_t jj = 0;
-  while (state.joints[jj].name != joint)
-    ++jj;
+  const std::size_t jj = position(state.joints, joint);
   try {
     return add_parametric(problem, state, sim, std::move(c), {term},
                           parametric_points(problem, state, sim, jj));
@@ -219,9 +223,7 @@ Outcome consider_pair(const Problem& problem, const State& state, const Simulato
   c.joint = joint;
   c.term = term;
   c.with = with;
-  std::size_t jj = 0;
-  while (state.joints[jj].name != joint)
-    ++jj;
+  const std::size_t jj = position(state.joints, joint);
   try {
     std::vector<identify::EquivalentStiffness> points = parametric_points(problem, state, sim, jj);
     if (!softens_then_stiffens(points))

@@ -392,12 +392,22 @@ double rank_correlation(const std::vector<double>& a, const std::vector<double>&
   return d > 0.0 ? da.dot(db) / d : 0.0;
 }
 
-int turning_test(const std::vector<double>& x, const std::vector<double>& value,
-                 const std::vector<double>& std) {
+namespace {
+
+// The indices of x in ascending order of x (ties in their order).
+std::vector<std::size_t> ascending_order(const std::vector<double>& x) {
   std::vector<std::size_t> order(x.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t p, std::size_t q) { return x[p] < x[q]; });
+  return order;
+}
+
+} // namespace
+
+int turning_test(const std::vector<double>& x, const std::vector<double>& value,
+                 const std::vector<double>& std) {
+  const std::vector<std::size_t> order = ascending_order(x);
   // (a - b) in standard deviations of the difference.
   const auto apart = [&](std::size_t a, std::size_t b) {
     return (value[a] - value[b]) / std::hypot(std[a], std[b]);
@@ -421,10 +431,7 @@ int turning_test(const std::vector<double>& x, const std::vector<double>& value,
 
 bool monotonic_within_noise(const std::vector<double>& x, const std::vector<double>& value,
                             const std::vector<double>& std) {
-  std::vector<std::size_t> order(x.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t p, std::size_t q) { return x[p] < x[q]; });
+  const std::vector<std::size_t> order = ascending_order(x);
   bool rises = false, falls = false; // a step beyond 3 σ either way, between any two in order
   for (std::size_t i = 0; i < order.size(); ++i)
     for (std::size_t k = i + 1; k < order.size(); ++k) {
