@@ -3,6 +3,7 @@
 #include "discover/selection.hpp"
 #include "discover/text.hpp"
 #include "fem/constants.hpp"
+#include "fem/parallel.hpp"
 #include "identify/parametric.hpp"
 
 #include <fmt/format.h>
@@ -10,8 +11,11 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 namespace jointid::discover::detail {
@@ -391,13 +395,33 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
                                         static_cast<Eigen::Index>(response_eq_[i].size()), nan);
   s.Y.assign(tests_.size(), Eigen::MatrixXcd());
   const int limit = max_left_out(static_cast<int>(tests_.size()));
+  // Every test from its own start, in parallel; then, in order, the tests that did not converge
+  // from their neighbours solved before them (as a sweep would have been), and past `limit`
+  // failures the rest dropped as not tried: the same state as solving one test after another.
+  // Once more than `limit` have failed from their own start, the parallel pass stops starting
+  // tests (a model that fails everywhere costs a tenth of the tests, not all); the ones the
+  // ordered pass still needs it solves itself.
+  std::atomic<int> failures{0};
+  const auto own_start = [&](std::size_t i) {
+    const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
+    return solve(sim, static_cast<int>(i), per_test.empty() ? joints : per_test[i], start);
+  };
+  std::vector<std::function<std::optional<frf::HarmonicBalanceResult>()>> jobs;
+  for (std::size_t i = 0; i < tests_.size(); ++i)
+    jobs.push_back([&, i]() -> std::optional<frf::HarmonicBalanceResult> {
+      if (std::binary_search(skip.begin(), skip.end(), static_cast<int>(i)) || failures > limit)
+        return std::nullopt;
+      frf::HarmonicBalanceResult r = own_start(i);
+      if (!(r.status.ok() && r.X.allFinite())) ++failures;
+      return r;
+    });
+  std::vector<std::optional<frf::HarmonicBalanceResult>> first = fem::parallel_map(jobs);
   std::vector<int> solved;
   for (std::size_t i = 0; i < tests_.size(); ++i) {
     const int t = static_cast<int>(i);
     if (std::binary_search(skip.begin(), skip.end(), t)) continue;
     const std::vector<joints::Joint>& these = per_test.empty() ? joints : per_test[i];
-    const Eigen::MatrixXcd* start = warm && i < warm->Y.size() ? &warm->Y[i] : nullptr;
-    frf::HarmonicBalanceResult r = solve(sim, t, these, start);
+    frf::HarmonicBalanceResult r = first[i] ? std::move(*first[i]) : own_start(i);
     // Where the model's steady state is far from the measured one (a fold the model has and
     // the structure had not), the nearest tests re-simulated — the neighbours of a stepped
     // sweep — are the start a sweep would have had.
@@ -443,19 +467,23 @@ std::vector<std::vector<Eigen::MatrixXcd>>
 Problem::derivatives(const State& at, const std::vector<std::vector<joints::Joint>>& moved,
                      const std::vector<double>& steps, const Simulator& sim,
                      std::span<const int> skip) const {
-  std::vector<std::vector<Eigen::MatrixXcd>> out(tests_.size());
-  for (std::size_t i = 0; i < tests_.size(); ++i) {
-    const int t = static_cast<int>(i);
-    if (i >= at.Y.size() || at.Y[i].size() == 0 ||
-        std::binary_search(at.failed.begin(), at.failed.end(), t) ||
-        std::binary_search(skip.begin(), skip.end(), t))
-      continue;
-    if (o_.checkpoint) o_.checkpoint();
-    out[i] = sim.balance[i].output_derivatives(at.joints, drive_[i], at.Y[i], moved, steps);
-    for (Eigen::MatrixXcd& d : out[i])
-      if (d.size() > 0) d = d.topRows(rows_[i] + 1).eval();
-  }
-  return out;
+  using Derivatives = std::vector<Eigen::MatrixXcd>;
+  std::vector<std::function<Derivatives()>> jobs;
+  for (std::size_t i = 0; i < tests_.size(); ++i)
+    jobs.push_back([&, i] {
+      const int t = static_cast<int>(i);
+      if (i >= at.Y.size() || at.Y[i].size() == 0 ||
+          std::binary_search(at.failed.begin(), at.failed.end(), t) ||
+          std::binary_search(skip.begin(), skip.end(), t))
+        return Derivatives{};
+      if (o_.checkpoint) o_.checkpoint();
+      Derivatives d =
+          sim.balance[i].output_derivatives(at.joints, drive_[i], at.Y[i], moved, steps);
+      for (Eigen::MatrixXcd& column : d)
+        if (column.size() > 0) column = column.topRows(rows_[i] + 1).eval();
+      return d;
+    });
+  return fem::parallel_map(jobs);
 }
 
 frf::HarmonicBalanceResult Problem::solve(const Simulator& sim, int i,

@@ -24,6 +24,7 @@
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 namespace jointid::discover::detail {
 
@@ -40,28 +41,34 @@ bool has_friction(const std::vector<joints::Joint>& joints) {
 } // namespace
 
 void Problem::propagate_force_noise(const State& s, const Simulator& sim) {
-  for (auto& e : compared_.entries)
-    e.force = 0.0;
-  for (std::size_t i = 0; i < tests_.size(); ++i) {
-    if (o_.checkpoint) o_.checkpoint();
-    const auto& m = tests_[i];
-    const bool periodic = m.kind == identify::RecordKind::periodic;
-    const std::vector<int> lines = periodic ? m.excited_lines : std::vector<int>{1};
-    for (Eigen::Index c = 0; c < drive_[i].cols(); ++c) {
-      const double v = m.F_variance.size() > 0 ? m.F_variance(lines.front(), c) : nan;
-      if (!(v > 0.0) || !compared_.noise_known) continue;
-      for (Complex unit : {Complex(1.0, 0.0), Complex(0.0, 1.0)}) {
-        Eigen::MatrixXcd F = drive_[i];
-        for (int k : lines)
-          F(k, c) += std::sqrt(m.F_variance(k, c)) * unit;
-        const frf::HarmonicBalanceResult r =
-            sim.balance[i].solve(s.joints, F, s.Y[i].size() > 0 ? &s.Y[i] : nullptr);
-        if (!r.status.ok()) continue;
-        for (auto& e : compared_.entries)
-          if (e.test == static_cast<int>(i))
-            e.force += 0.5 * std::norm(r.X(e.row, e.response) - s.X[i](e.row, e.response));
+  // Per test (in parallel), the responses to its forces perturbed.
+  std::vector<std::function<std::vector<Eigen::MatrixXcd>()>> jobs;
+  for (std::size_t i = 0; i < tests_.size(); ++i)
+    jobs.push_back([&, i] {
+      std::vector<Eigen::MatrixXcd> moved;
+      if (o_.checkpoint) o_.checkpoint();
+      const auto& m = tests_[i];
+      const bool periodic = m.kind == identify::RecordKind::periodic;
+      const std::vector<int> lines = periodic ? m.excited_lines : std::vector<int>{1};
+      for (Eigen::Index c = 0; c < drive_[i].cols(); ++c) {
+        const double v = m.F_variance.size() > 0 ? m.F_variance(lines.front(), c) : nan;
+        if (!(v > 0.0) || !compared_.noise_known) continue;
+        for (Complex unit : {Complex(1.0, 0.0), Complex(0.0, 1.0)}) {
+          Eigen::MatrixXcd F = drive_[i];
+          for (int k : lines)
+            F(k, c) += std::sqrt(m.F_variance(k, c)) * unit;
+          frf::HarmonicBalanceResult r =
+              sim.balance[i].solve(s.joints, F, s.Y[i].size() > 0 ? &s.Y[i] : nullptr);
+          if (r.status.ok()) moved.push_back(std::move(r.X));
+        }
       }
-    }
+      return moved;
+    });
+  const std::vector<std::vector<Eigen::MatrixXcd>> moved = fem::parallel_map(jobs);
+  for (auto& e : compared_.entries) {
+    e.force = 0.0;
+    for (const Eigen::MatrixXcd& X : moved[static_cast<std::size_t>(e.test)])
+      e.force += 0.5 * std::norm(X(e.row, e.response) - s.X[e.test](e.row, e.response));
   }
 }
 
@@ -75,30 +82,31 @@ double Problem::estimate_simulation_error(State& s) {
   // balance with twice the harmonics.
   std::vector<Eigen::MatrixXcd> exact;
   if (has_friction(s.joints)) exact = time_integrated(s);
-  double E = 0.0;
-  for (std::size_t i = 0; i < tests_.size(); ++i) {
-    if (o_.checkpoint) o_.checkpoint();
-    Eigen::MatrixXcd reference;
-    double factor = 1.0;
-    // Time integration from rest may settle on another branch than the measured one (a jump):
-    // a difference beyond 5 % of a fundamental is a different solution, not the harmonic
-    // balance's error, and the refined harmonic balance is the reference there.
-    bool same_branch = i < exact.size() && exact[i].size() > 0;
-    if (same_branch)
-      for (Eigen::Index j = 0; j < exact[i].cols(); ++j)
-        same_branch =
-            same_branch && std::abs(exact[i](1, j) - s.X[i](1, j)) <= 0.05 * std::abs(s.X[i](1, j));
-    if (same_branch) {
-      reference = exact[i];
-    } else {
+  // Per test (in parallel), the reference and the factor on the difference from it.
+  std::vector<std::function<std::pair<Eigen::MatrixXcd, double>()>> jobs;
+  for (std::size_t i = 0; i < tests_.size(); ++i)
+    jobs.push_back([&, i]() -> std::pair<Eigen::MatrixXcd, double> {
+      if (o_.checkpoint) o_.checkpoint();
+      // Time integration from rest may settle on another branch than the measured one (a
+      // jump): a difference beyond 5 % of a fundamental is a different solution, not the
+      // harmonic balance's error, and the refined harmonic balance is the reference there.
+      bool same_branch = i < exact.size() && exact[i].size() > 0;
+      if (same_branch)
+        for (Eigen::Index j = 0; j < exact[i].cols(); ++j)
+          same_branch = same_branch &&
+                        std::abs(exact[i](1, j) - s.X[i](1, j)) <= 0.05 * std::abs(s.X[i](1, j));
+      if (same_branch) return {exact[i], 1.0};
       Eigen::MatrixXcd start = Eigen::MatrixXcd::Zero(fine.balance[i].options().harmonics + 1,
                                                       static_cast<Eigen::Index>(layout_.size()));
       start.topRows(measured_start_[i].rows()) = measured_start_[i];
       frf::HarmonicBalanceResult r = fine.balance[i].solve(s.joints, drive_[i], &start);
       if (!r.status.ok()) r = fine.balance[i].solve(s.joints, drive_[i]);
-      if (r.status.ok()) reference = r.X;
-      factor = 4.0; // twice the difference
-    }
+      return {r.status.ok() ? std::move(r.X) : Eigen::MatrixXcd(), 4.0}; // twice the difference
+    });
+  const std::vector<std::pair<Eigen::MatrixXcd, double>> references = fem::parallel_map(jobs);
+  double E = 0.0;
+  for (std::size_t i = 0; i < tests_.size(); ++i) {
+    const auto& [reference, factor] = references[i];
     for (auto& e : compared_.entries)
       if (e.test == static_cast<int>(i)) {
         e.simulation =

@@ -1,11 +1,13 @@
-// fem::parallel_map: results in list order, the first exception in list order, and no job
-// started after one has thrown (what lets an interrupt stop a map of long jobs).
+// fem::parallel_map: results in list order, the first exception in list order, no job
+// started after one has thrown (what lets an interrupt stop a map of long jobs), and maps inside
+// maps never run more jobs at once than the machine has cores.
 #include "fem/parallel.hpp"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -66,6 +68,39 @@ TEST(ParallelMap, NoJobStartsAfterOneHasThrown) {
   EXPECT_LT(started.load(), 1000);
   EXPECT_LE(started.load(),
             2 * static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+}
+
+TEST(ParallelMap, MapsInsideMapsNeverRunMoreJobsAtOnceThanThereAreCores) {
+  // Three levels of four jobs: each of the 64 innermost ones counts the jobs running with it.
+  // Each level starting its own threads would run up to cores³ of them at once (8 on two
+  // cores); the maps share the cores instead. The results still come back in order.
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::atomic<int> running{0}, most{0};
+  const auto leaf = [&](int i) {
+    const int now = ++running;
+    int seen = most.load();
+    while (now > seen && !most.compare_exchange_weak(seen, now)) {
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    --running;
+    return i;
+  };
+  const auto level = [](int base, const std::function<int(int)>& inner) {
+    std::vector<std::function<int()>> jobs;
+    for (int i = 0; i < 4; ++i)
+      jobs.push_back([=] { return inner(4 * base + i); });
+    int sum = 0;
+    for (int v : parallel_map(jobs))
+      sum += v;
+    return sum;
+  };
+  const int total =
+      level(0, [&](int a) { return level(a, [&](int b) { return level(b, leaf); }); });
+  EXPECT_EQ(total, 63 * 64 / 2); // the leaves 0 … 63, each once
+  EXPECT_LE(most.load(), cores);
+  EXPECT_GE(most.load(), 1);
+  // Every thread a map took is given back.
+  EXPECT_EQ(detail::free_threads().load(), cores - 1);
 }
 
 } // namespace
