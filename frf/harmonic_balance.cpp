@@ -11,6 +11,7 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 
@@ -491,6 +492,42 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
   return start_from(P, &Y);
 }
 
+namespace {
+
+// `moved` differs from `joints` in one coefficient alone (a term without parameters and not dry
+// friction, whose force is linear in its value): which, and by how much.
+struct CoefficientMove {
+  int joint;
+  joints::Term term;
+  double step;
+};
+std::optional<CoefficientMove> coefficient_move(const std::vector<joints::Joint>& joints,
+                                                const std::vector<joints::Joint>& moved) {
+  if (moved.size() != joints.size()) return std::nullopt;
+  std::optional<CoefficientMove> found;
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    const joints::Joint &a = joints[j], &b = moved[j];
+    if (a.terms != b.terms || a.values.size() != b.values.size() ||
+        a.parameters.size() != b.parameters.size() || a.node != b.node || a.node_b != b.node_b ||
+        a.dof != b.dof || a.iwan_sliders != b.iwan_sliders)
+      return std::nullopt;
+    for (std::size_t t = 0; t < a.parameters.size(); ++t) {
+      if (a.parameters[t].size() != b.parameters[t].size()) return std::nullopt;
+      for (std::size_t q = 0; q < a.parameters[t].size(); ++q)
+        if (a.parameters[t][q].value != b.parameters[t][q].value) return std::nullopt;
+    }
+    for (std::size_t t = 0; t < a.terms.size(); ++t) {
+      if (a.values[t] == b.values[t]) continue;
+      if (found || joints::has_parameters(a.terms[t]) || joints::is_dry_friction(a.terms[t]))
+        return std::nullopt;
+      found = CoefficientMove{static_cast<int>(j), a.terms[t], b.values[t] - a.values[t]};
+    }
+  }
+  return found;
+}
+
+} // namespace
+
 HarmonicBalanceResult HarmonicBalance::result(const detail::Equations& P,
                                               const Eigen::VectorXd& z) const {
   HarmonicBalanceResult out;
@@ -557,6 +594,7 @@ HarmonicBalance::output_derivatives(const std::vector<joints::Joint>& joints,
                                     std::span<const double> steps) const {
   JOINTID_ASSERT(moved.size() == steps.size(), "a step per move");
   const std::unique_ptr<Equations> P = equations(joints, F, &start);
+  P->scratch().keep_dG = true;
   Eigen::VectorXd z = first_guess(*P, &start);
   const int n = P->size();
   Eigen::VectorXd r0(n), r(n);
@@ -572,24 +610,40 @@ HarmonicBalance::output_derivatives(const std::vector<joints::Joint>& joints,
   detail::SmallLU<double> lu;
   lu.compute(J);
   if (!(lu.min_pivot > 1e-13 * std::max(1.0, J.lpNorm<Eigen::Infinity>()))) return {};
-  const Eigen::MatrixXcd X = result(*P, z).X;
+  const Eigen::MatrixXcd G = P->forces(z);
   std::vector<Eigen::MatrixXcd> out(moved.size());
   for (std::size_t p = 0; p < moved.size(); ++p) {
-    std::unique_ptr<Equations> Pm;
-    try {
-      Pm = equations(moved[p], F, &start);
-    } catch (const std::invalid_argument&) {
-      continue; // out of the joints' range
+    // The forces' change at z, ΔG, and the residual's, −(R_moved(z) − R(z)): a coefficient's
+    // from its own term alone (its force is linear in it), else from the moved equations.
+    Eigen::MatrixXcd dG;
+    Eigen::VectorXd dz;
+    const auto c = coefficient_move(joints, moved[p]);
+    // (An even term moved from 0 breaks half-wave symmetry: the equations' unknowns change.)
+    if (c && !(P->symmetric() && joints::term_info(c->term).even)) {
+      P->coefficient_change(z, c->joint, c->term, c->step, dG, dz);
+      dz = -dz;
+    } else {
+      std::unique_ptr<Equations> Pm;
+      try {
+        Pm = equations(moved[p], F, &start);
+      } catch (const std::invalid_argument&) {
+        continue; // out of the joints' range
+      }
+      if (Pm->size() != n || Pm->symmetric() != P->symmetric() ||
+          Pm->friction.size() != P->friction.size())
+        continue;
+      Pm->residual(z, 1.0, r, nullptr);
+      dG = Pm->forces(z) - G;
+      dz = r0 - r;
     }
-    if (Pm->size() != n || Pm->symmetric() != P->symmetric() ||
-        Pm->friction.size() != P->friction.size())
-      continue;
-    Pm->residual(z, 1.0, r, nullptr);
-    Eigen::VectorXd dz = r0 - r; // −(R_moved(z) − R(z))
     lu.solve_in_place(dz);
     if (!dz.allFinite()) continue;
-    const Eigen::VectorXd zm = z + dz;
-    out[p] = (result(*Pm, zm).X - X) / steps[p];
+    // The outputs X = H_of F − H_oy G move with the forces: ΔG + ∂G/∂z dz to first order.
+    dG += P->force_change(dz);
+    Eigen::MatrixXcd dX(K_ + 1, HoB_.data.rows());
+    for (int k = 0; k <= K_; ++k)
+      dX.row(k) = -(HoB_[k] * dG.row(k).transpose()).transpose() / steps[p];
+    out[p] = std::move(dX);
   }
   return out;
 }

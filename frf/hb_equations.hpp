@@ -202,6 +202,10 @@ struct Equations {
     joints::LoopWork loop_work;
     std::vector<double> loop_force;
     Eigen::MatrixXd loop_dy;
+    // Per joint, ∂pack(G_j)/∂z_j of its smooth force at the last jacobian(), when keep_dG is
+    // set (force_change() reads them).
+    bool keep_dG = false;
+    std::vector<Eigen::MatrixXd> dG;
 
     Scratch() = default;
     Scratch(const Scratch&) : Scratch() {}
@@ -548,6 +552,10 @@ struct Equations {
       }
       for (int a = 0; a < nj; ++a)
         add_coupling(J, a, b, b * m(), s.D);
+      if (s.keep_dG) {
+        s.dG.resize(static_cast<std::size_t>(nj));
+        s.dG[u] = s.D;
+      }
     }
     for (std::size_t f = 0; f < friction.size(); ++f) {
       const Friction& fr = friction[f];
@@ -561,6 +569,55 @@ struct Equations {
       J.block(o, o, m(), m()).diagonal().array() += fr.c;
       J.block(o, oy, m(), m()).setZero();
       add_rate(E, -fr.c * fr.r, J.block(o, oy, m(), m()));
+    }
+  }
+
+  // The change of the joints' force harmonics ((K+1) × nj) for a change dz of the unknowns, to
+  // first order at the point of the last jacobian() (made with scratch().keep_dG set): per
+  // joint its smooth force's ∂pack(G)/∂z times its block of dz, plus the change of its friction
+  // unknowns (which enter G as they are).
+  Eigen::MatrixXcd force_change(const Eigen::VectorXd& dz) const {
+    const Scratch& s = scratch();
+    JOINTID_ASSERT(s.keep_dG && s.dG.size() == static_cast<std::size_t>(nj) && dz.size() == size(),
+                   "force_change() follows a jacobian() that kept the force's derivative");
+    Eigen::VectorXd packed = Eigen::VectorXd::Zero(nj * m());
+    for (int j = 0; j < nj; ++j)
+      packed.segment(j * m(), m()) = s.dG[static_cast<std::size_t>(j)] * dz.segment(j * m(), m());
+    for (std::size_t f = 0; f < friction.size(); ++f)
+      packed.segment(friction[f].joint * m(), m()) +=
+          dz.segment((nj + static_cast<int>(f)) * m(), m());
+    return unpack(packed, nj);
+  }
+
+  // Coefficient `term` of joint j grown by `step` (a term without parameters and not dry
+  // friction: its force is linear in its coefficient): the harmonics of the added force at z
+  // ((K+1) × nj, joint j's column) and the residual's change, pack(H_yy ΔG) in every joint's
+  // rows (0 in the friction rows), exactly — without the joint's other forces (an iwan's loop).
+  void coefficient_change(const Eigen::VectorXd& z, int j, joints::Term term, double step,
+                          Eigen::MatrixXcd& dG, Eigen::VectorXd& dr) const {
+    std::vector<double> yv(static_cast<std::size_t>(2 * Nt));
+    samples(z.data() + j * m(), yv.data());
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(Nt, 3);
+    const auto n = static_cast<std::size_t>(Nt);
+    joints::add_samples(term, step, {yv.data(), n}, {yv.data() + Nt, n}, {g.col(0).data(), n},
+                        {g.col(1).data(), n}, {g.col(2).data(), n});
+    Eigen::VectorXd packed(m());
+    forward(g.col(0).data(), packed.data());
+    dG = Eigen::MatrixXcd::Zero(K + 1, nj);
+    dG.col(j) = unpack(packed, 1).col(0);
+    dr = Eigen::VectorXd::Zero(size());
+    for (int a = 0; a < nj; ++a) {
+      const int o = a * m();
+      for (int i = 0; i < count(); ++i) {
+        const int k = harmonics[i];
+        const Complex v = Hyy[k](a, j) * dG(k, j);
+        if (k == 0) {
+          dr(o) = v.real();
+        } else {
+          dr(o + at(i)) = v.real();
+          dr(o + at(i) + 1) = v.imag();
+        }
+      }
     }
   }
 

@@ -818,26 +818,34 @@ TEST(HarmonicBalance, OutputDerivativesAreThoseOfTheSolvedSteadyStates) {
        40.0},
       {"iwan, microslip", {parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1})}, 2.0},
       {"iwan, macroslip", {parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1})}, 20.0},
+      // Two joints (a coefficient of one moves the other's rows through H_yy), one with an
+      // even term (no half-wave symmetry: the mean is solved for).
+      {"iwan at the tip, k, k2, k3 at node 4",
+       {parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1}),
+        make("mid", 4, 0, {Term::k, Term::k2, Term::k3}, {2000.0, 4e5, 5e7})},
+       10.0},
   };
   // Each coefficient, and each parameter of a parametric term, moved by `relative` of itself.
   auto moves = [](const std::vector<joints::Joint>& js, double relative) {
     std::vector<std::vector<joints::Joint>> out;
     std::vector<double> steps;
-    const joints::Joint& j = js[0];
-    for (std::size_t t = 0; t < j.terms.size(); ++t) {
-      if (joints::has_parameters(j.terms[t])) {
-        for (std::size_t q = 0; q < j.parameters[t].size(); ++q) {
-          std::vector<joints::Joint> m = js;
-          const double h = relative * std::abs(j.parameters[t][q].value);
-          m[0].parameters[t][q].value += h;
-          out.push_back(m), steps.push_back(h);
+    for (std::size_t i = 0; i < js.size(); ++i) {
+      const joints::Joint& j = js[i];
+      for (std::size_t t = 0; t < j.terms.size(); ++t) {
+        if (joints::has_parameters(j.terms[t])) {
+          for (std::size_t q = 0; q < j.parameters[t].size(); ++q) {
+            std::vector<joints::Joint> m = js;
+            const double h = relative * std::abs(j.parameters[t][q].value);
+            m[i].parameters[t][q].value += h;
+            out.push_back(m), steps.push_back(h);
+          }
+          continue;
         }
-        continue;
+        std::vector<joints::Joint> m = js;
+        const double h = relative * std::abs(j.values[t]);
+        m[i].values[t] += h;
+        out.push_back(m), steps.push_back(h);
       }
-      std::vector<joints::Joint> m = js;
-      const double h = relative * std::abs(j.values[t]);
-      m[0].values[t] += h;
-      out.push_back(m), steps.push_back(h);
     }
     return std::pair{out, steps};
   };
