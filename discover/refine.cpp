@@ -108,6 +108,7 @@ public:
     current_ = begin;
     r_ = residual(current_);
     cost_ = r_.squaredNorm();
+    iterations_ = 0;
     double mu = 1e-3;
     J_.resize(r_.size(), p);
     for (int iteration = 0; iteration < iterations; ++iteration) {
@@ -135,10 +136,14 @@ public:
           accepted = true;
         }
       }
+      iterations_ = iteration + 1;
       if (!accepted || gain < 1e-5) break; // a 0.001 % smaller misfit is no longer worth a step
     }
     return current_;
   }
+
+  // The Levenberg–Marquardt iterations the last search() took.
+  int iterations() const { return iterations_; }
 
   // The fit of the values reached: intervals from the Jacobian there, or NaN (undetermined)
   // when it cannot be formed, there is no redundancy, or the tests do not constrain them.
@@ -398,6 +403,7 @@ private:
   Eigen::MatrixXd J_;
   State current_;
   double cost_ = 0.0;
+  int iterations_ = 0;
 };
 
 } // namespace
@@ -534,6 +540,7 @@ State refine_from(const Problem& problem, const State& start, const Simulator& s
   const State begin = search.begin(start);
   if (!std::isfinite(begin.criterion) || !physical_problem(begin.joints).empty()) return start;
   State from = begin;
+  int iterations = scope.iterations;
   const int n = static_cast<int>(problem.tests().size());
   if (scope.spread > 0 && n > scope.spread) {
     // First stage: an even spread of the tests (those the start re-simulated, not held out).
@@ -548,11 +555,16 @@ State refine_from(const Problem& problem, const State& start, const Simulator& s
     // Every test at the values reached; kept where it is no worse than the start on them.
     State all = problem.evaluate(reached.joints, sim, &begin);
     all.fit = begin.fit;
-    if (all.failed == begin.failed && std::isfinite(all.criterion) && all.gap < begin.gap)
+    if (all.failed == begin.failed && std::isfinite(all.criterion) && all.gap < begin.gap) {
       from = std::move(all);
+      // The first stage's iterations count against the budget: one that took them all is in a
+      // slow valley (an iwan's parameters), where going on at n / spread times the cost of an
+      // iteration buys little. The second stage takes what is left, and at least two.
+      iterations = std::max(2, scope.iterations - first.iterations());
+    }
   }
   search.compare_on(from, scope.held_out);
-  State refined = search.search(start, from, scope.iterations);
+  State refined = search.search(start, from, iterations);
   if (scope.intervals) refined.fit = search.fit(begin.fit);
   return refined;
 }

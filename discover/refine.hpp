@@ -18,12 +18,15 @@ namespace jointid::discover::detail {
 /// What a refinement compares and how far it goes.
 struct RefineScope {
   std::vector<int> held_out; ///< tests left out of the search too (ascending): a fold's
-  int iterations = 12;       ///< Levenberg–Marquardt iterations at most (each stage)
+  int iterations = 12;       ///< Levenberg–Marquardt iterations at most (both stages together)
   bool intervals = true;     ///< the fit's intervals (one more Jacobian)
   /// With more tests than this, the search first runs on an even spread of this many of them
   /// (the others not simulated), then goes on from there with all of them: a stepped-sine
   /// table's hundreds of tests determine a few parameters far beyond what the first stage needs
   /// to get near the minimum, and the second then takes one or two iterations instead of all.
+  /// The second stage takes the iterations the first left, and at least two: a first stage that
+  /// used them all is in a slow valley (an iwan's parameters), where iterations on every test
+  /// cost n / spread times as much and buy little.
   /// 0: one stage. The result is that of all the tests either way.
   int spread = 96;
 };
