@@ -193,9 +193,15 @@ bool steady_loop(const Sliders& s, std::span<const double> y, bool antisymmetric
     return i < N ? y[static_cast<std::size_t>(i)] : -y[static_cast<std::size_t>(i - N)];
   };
   const auto phi = [&w](int i) { return w.phi[static_cast<std::size_t>(i)]; };
-  bool closed = false;
+  // The first pass (from rest) only moves the elements: a loop closes at the earliest in the
+  // second, and only the last pass's forces are kept. A pass that closes after one that did not
+  // write them is followed by one that does (the same pass again).
+  const int passes = std::max(1, max_passes);
+  bool closed = false, written = false;
   positions(w, w.x);
-  for (int pass = 0; pass < std::max(1, max_passes) && !closed; ++pass) {
+  const int limit = passes == 1 ? 1 : passes + 1;
+  for (int pass = 0; pass < limit && !(closed && written); ++pass) {
+    const bool write = pass > 0 || passes == 1;
     w.x_start = w.x;
     if (derivative) derivative->clear();
     for (int t = 0; t < full; ++t) {
@@ -236,7 +242,7 @@ bool steady_loop(const Sliders& s, std::span<const double> y, bool antisymmetric
           if (p > 0) w.groups.push_back({0, p, false, t, yt, dir}), moved = true;
         }
       }
-      if (t >= N) continue; // a sample whose force is not written
+      if (t >= N || !write) continue; // a sample whose force is not written
       double force = 0.0, stuck = 0.0;
       const std::size_t first = derivative ? derivative->size() : 0;
       if (derivative) derivative->push_back({t, t, 0.0});
@@ -270,6 +276,7 @@ bool steady_loop(const Sliders& s, std::span<const double> y, bool antisymmetric
     }
     positions(w, w.x);
     closed = w.x == w.x_start;
+    written = write;
   }
   return closed;
 }

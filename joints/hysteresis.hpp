@@ -108,7 +108,8 @@ struct LoopWork {
 /// period (or, `antisymmetric`, over its first half, with y(t + T/2) = −y(t)): the elements
 /// start at rest at zero deformation (x = 0, the state of a joint assembled unloaded) and run
 /// over the period until their state at its end repeats — two passes when the first one sees
-/// every element slip (or none), at most `max_passes`. Writes the force of the last pass at the
+/// every element slip (or none), at most `max_passes` after a first that only moves the
+/// elements (one in all when max_passes is 1). Writes the force of the last pass at the
 /// samples to g (y's size) and, if `derivative` is given, the exact ∂g_n/∂y_m of that pass:
 /// an element stuck at sample n contributes k_i at (n, n) and, if it slid before, −k_i at the
 /// sample m where it last slid (its position there was y_m ∓ φ_i; for the antisymmetric form
