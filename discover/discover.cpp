@@ -15,6 +15,7 @@
 #include "discover/result.hpp"
 #include "discover/selection.hpp"
 #include "discover/text.hpp"
+#include "fem/constants.hpp"
 #include "fem/parallel.hpp"
 
 #include <fmt/format.h>
@@ -44,13 +45,17 @@ public:
     const Result at_start = out;
     const State start_state = state;
     const bool fitted = values_fitted_;
+    // The first path is only screened past its first step when a second path will be compared
+    // with it and the tests are many (its refinements search on the spread of tests alone:
+    // RefineScope::spread_only); followed in full where it is kept.
+    screen_first_path_ = static_cast<int>(problem_.tests().size()) > RefineScope{}.spread;
     double simulation_gap = follow(out, state); // of `state`, once estimated (else < 0)
+    screen_first_path_ = false;
     // A parametric term added first can stand in for two coefficient terms at once (an iwan's
     // softening and its damping that grows with amplitude, for k3 and c3), and the forward
     // search never takes a term back out: the path that starts from the best coefficient term
     // is followed too, and the one that ends with the lower criterion kept.
-    if (!out.steps.empty() && out.steps.front().added.term &&
-        joints::has_parameters(*out.steps.front().added.term) && first_) {
+    if (parametric_first(out) && first_) {
       Result other = at_start;
       State other_state = start_state;
       values_fitted_ = fitted;
@@ -59,21 +64,50 @@ public:
       const double other_gap = follow(other, other_state);
       coefficients_first_ = false;
       values_fitted_ = true;
-      simulation_gap = -1.0; // the problem's error estimates are the second path's now
       // A second path that adds the first path's parametric term after all only puts terms
       // before it that the first path found no need for beside it: the first path stands.
-      if (!other.steps.empty() && !added(other, *avoid_)) {
-        const double a = criterion_on_measurement_noise(problem_.compared(), state),
-                     b = criterion_on_measurement_noise(problem_.compared(), other_state);
-        const bool second = b < a;
+      const bool compared = !other.steps.empty() && !added(other, *avoid_);
+      const double b = criterion_on_measurement_noise(problem_.compared(), other_state);
+      double a = criterion_on_measurement_noise(problem_.compared(), state);
+      bool second = compared && b < a;
+      // A screened path is followed again in full from its first step unless the second path
+      // is clearly better than anything the screening met (its candidates included, refined
+      // on the spread alone): by 10 (a "very strong" difference of the criterion) and a tenth
+      // of the values compared (a misfit 10 % smaller than the spread's minimum).
+      const double margin = 10.0 + 0.1 * problem_.compared().values;
+      const bool screened = after_first_.has_value();
+      if (screened && second && !(b < screened_best_ - margin)) second = false;
+      std::string screening;
+      if (screened && !second) {
+        out = std::move(after_first_->first);
+        state = std::move(after_first_->second);
+        after_first_.reset();
+        simulation_gap = follow(out, state, 1);
+        a = criterion_on_measurement_noise(problem_.compared(), state);
+        second = compared && b < a;
+        screening = fmt::format(" (The first path was screened past its first step, its "
+                                "candidates refined on {} of the {} tests alone; not clearly "
+                                "worse, it was then followed in full.)",
+                                RefineScope{}.spread, problem_.tests().size());
+      } else {
+        simulation_gap = -1.0; // the problem's error estimates are the second path's now
+        if (screened)
+          screening = fmt::format(
+              " (The first path was screened past its first step, its candidates refined on {} "
+              "of the {} tests alone: the second path's criterion is below anything the "
+              "screening met, {}, by more than {}.)",
+              RefineScope{}.spread, problem_.tests().size(), number(screened_best_),
+              number(margin));
+      }
+      if (compared) {
         const std::string said = fmt::format(
             "The first addition, {}, is a parametric term: it can stand in for two coefficient "
             "terms at once, and the forward search cannot take it back out. So the search also "
             "started from the best coefficient term. Judged on the measurement's own noise, the "
             "path {} ends at a criterion of {} (gap {}), the path {} at {} (gap {}): the {} is "
-            "kept.",
+            "kept.{}",
             out.steps.front().added.name(), path(out), number(a), number(state.gap), path(other),
-            number(b), number(other_state.gap), second ? "second" : "first");
+            number(b), number(other_state.gap), second ? "second" : "first", screening);
         if (second) {
           out = std::move(other);
           state = std::move(other_state);
@@ -89,10 +123,13 @@ public:
 private:
   // The steps from `state` until the loop stops; the simulation's error of the state reached
   // if it was estimated there (else < 0).
-  double follow(Result& out, State& state) {
+  double follow(Result& out, State& state, int first_step = 0) {
     double simulation_gap = -1.0;
-    for (int step = 0; step < o_.max_steps; ++step) {
-      simulation_gap = problem_.estimate_simulation_error(state);
+    for (int step = first_step; step < o_.max_steps; ++step) {
+      // The simulation's own error weighs the misfit and judges the noise level only where
+      // the noise is known: without, it is estimated once, for the model the loop ends at.
+      if (problem_.compared().noise_known)
+        simulation_gap = problem_.estimate_simulation_error(state);
       identify_again_if_simulation_error_matters(state, out, simulation_gap);
       if (at_noise_level(problem_.compared(), state)) {
         out.stop_reason = fmt::format(
@@ -103,9 +140,28 @@ private:
       }
       if (!add_the_best(step, state, out)) break;
       simulation_gap = -1.0;
+      if (step == 0 && screen_first_path_ && !avoid_ && parametric_first(out)) {
+        after_first_.emplace(out, state);
+        screening_ = true;
+        screened_best_ = criterion_on_measurement_noise(problem_.compared(), state);
+      }
       if (avoid_ && added(out, *avoid_)) break; // a second path that is moot (run())
     }
+    screening_ = false;
     return simulation_gap;
+  }
+
+  // The first step of `r` added a parametric term.
+  static bool parametric_first(const Result& r) {
+    return !r.steps.empty() && r.steps.front().added.term &&
+           joints::has_parameters(*r.steps.front().added.term);
+  }
+
+  // How a candidate is refined: on the spread of tests alone while a path is screened.
+  RefineScope scope() const {
+    RefineScope s;
+    s.spread_only = screening_;
+    return s;
   }
 
   // Some step of `r` added the term of `c` at its joint.
@@ -214,7 +270,7 @@ private:
     const Compared& compared = problem_.compared();
     if (!(compared.noise_known && simulation_gap > 0.3 * compared.noise_gap && values_fitted_))
       return;
-    State again = refine(problem_, state, problem_.simulator(state.damping_scale));
+    State again = refine(problem_, state, problem_.simulator(state.damping_scale), scope());
     if (!std::isfinite(again.criterion) || again.failed.size() > state.failed.size()) return;
     state = std::move(again);
     simulation_gap = problem_.estimate_simulation_error(state);
@@ -236,7 +292,7 @@ private:
   // deformation biases it, e.g. a stiff joint's damping).
   void try_candidates(const std::vector<std::function<Outcome()>>& jobs, const State& now,
                       const Simulator& current, std::vector<Candidate>& ranking,
-                      std::vector<State>& states) const {
+                      std::vector<State>& states) {
     const std::vector<std::string> sources = problem_.sources(problem_.all_tests());
     for (auto& [c, s] : fem::parallel_map(jobs)) {
       if (c.with && c.rejected == pair_not_asked) continue; // the joint did not ask for it
@@ -252,13 +308,13 @@ private:
         if (states[i].damping_scale != current.scale)
           own = problem_.make_simulator(states[i].damping_scale, false);
         const Simulator& sim = own ? *own : current;
-        State refined = refine(problem_, states[i], sim);
+        State refined = refine(problem_, states[i], sim, scope());
         // Also from the model now with the term at 0; the better of the two (on the same tests).
         if (const auto js = nested_start(ranking[i], states[i], now)) {
           State start = problem_.evaluate(*js, sim, &now);
           start.fit = states[i].fit;
           if (std::isfinite(start.criterion)) {
-            State other = refine(problem_, start, sim);
+            State other = refine(problem_, start, sim, scope());
             if (other.failed == refined.failed && other.criterion < refined.criterion)
               refined = std::move(other);
           }
@@ -272,6 +328,12 @@ private:
       judge(ranking[i], states[i]);
       compare_on_common_tests(ranking[i], states[i], now, problem_.compared(), sources);
     }
+    if (screening_)
+      for (std::size_t i = 0; i < ranking.size(); ++i)
+        if (!ranking[i].varies && states[i].X.size() == problem_.tests().size() &&
+            std::isfinite(states[i].criterion))
+          screened_best_ = std::min(screened_best_,
+                                    criterion_on_measurement_noise(problem_.compared(), states[i]));
   }
 
   // The cross-validated gap of a state on the tests that it and the model now re-simulated,
@@ -467,6 +529,10 @@ private:
   std::optional<FirstStep> first_;  // once the first step's candidates were tried
   bool coefficients_first_ = false; // the first step takes a coefficient term only
   std::optional<Candidate> avoid_;  // a second path stops when it adds this term
+  bool screen_first_path_ = false;  // the first path is screened past its first step
+  bool screening_ = false;          // candidates are refined on the spread of tests alone
+  std::optional<std::pair<Result, State>> after_first_; // a screened path, after its first step
+  double screened_best_ = inf; // the lowest criterion a screened path met (its candidates too)
 };
 
 } // namespace

@@ -212,6 +212,25 @@ std::vector<int> Problem::all_tests() const {
   return all;
 }
 
+std::vector<int> Problem::spread(std::size_t taken) const {
+  const std::size_t n = tests_.size();
+  if (taken >= n) return all_tests();
+  std::vector<double> energy(n, 0.0);
+  for (const Entry& e : compared_.entries)
+    energy[static_cast<std::size_t>(e.test)] += std::norm(e.measured);
+  std::vector<int> order = all_tests();
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return energy[static_cast<std::size_t>(a)] > energy[static_cast<std::size_t>(b)];
+  });
+  std::vector<int> out(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(taken / 2));
+  std::vector<int> rest(order.begin() + static_cast<std::ptrdiff_t>(taken / 2), order.end());
+  std::sort(rest.begin(), rest.end());
+  for (int j : even_spread(rest.size(), taken - out.size()))
+    out.push_back(rest[static_cast<std::size_t>(j)]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 std::vector<std::string> Problem::sources(const std::vector<int>& tests) const {
   std::vector<std::string> out;
   for (int i : tests)

@@ -65,6 +65,11 @@ public:
   /// The rules these tests allow, and those they do not (said in sentences).
   const Preconditions& preconditions() const { return preconditions_; }
   std::vector<int> all_tests() const;
+  /// At most `taken` of the tests, ascending, to stand for all of them in a first search (the
+  /// misfit is absolute: a stepped-sine table's few tests at a sharp resonance carry most of
+  /// it, and an even spread by index misses them): half of them those whose measured values
+  /// are largest (their sum of squares), the rest an even spread of the others.
+  std::vector<int> spread(std::size_t taken) const;
   /// The sources of these tests ("table.csv:12"), for messages.
   std::vector<std::string> sources(const std::vector<int>& tests) const;
 

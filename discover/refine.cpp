@@ -543,9 +543,9 @@ State refine_from(const Problem& problem, const State& start, const Simulator& s
   int iterations = scope.iterations;
   const int n = static_cast<int>(problem.tests().size());
   if (scope.spread > 0 && n > scope.spread) {
-    // First stage: an even spread of the tests (those the start re-simulated, not held out).
+    // First stage: a spread of the tests (those the start re-simulated, not held out).
     std::vector<int> skip;
-    const std::vector<int> spread = even_spread(problem.tests().size(), scope.spread);
+    const std::vector<int> spread = problem.spread(static_cast<std::size_t>(scope.spread));
     for (int i = 0; i < n; ++i)
       if (!std::binary_search(spread.begin(), spread.end(), i)) skip.push_back(i);
     OutputError first(problem, sim, start);
@@ -555,13 +555,12 @@ State refine_from(const Problem& problem, const State& start, const Simulator& s
     // Every test at the values reached; kept where it is no worse than the start on them.
     State all = problem.evaluate(reached.joints, sim, &begin);
     all.fit = begin.fit;
-    if (all.failed == begin.failed && std::isfinite(all.criterion) && all.gap < begin.gap) {
+    if (all.failed == begin.failed && std::isfinite(all.criterion) && all.gap < begin.gap)
       from = std::move(all);
-      // The first stage's iterations count against the budget: one that took them all is in a
-      // slow valley (an iwan's parameters), where going on at n / spread times the cost of an
-      // iteration buys little. The second stage takes what is left, and at least two.
-      iterations = std::max(2, scope.iterations - first.iterations());
-    }
+    // The first stage's iterations count against the budget: one that took them all is in a
+    // slow valley (an iwan's parameters), where going on at n / spread times the cost of an
+    // iteration buys little. The second stage takes what is left, and at least two.
+    iterations = scope.spread_only ? 0 : std::max(2, scope.iterations - first.iterations());
   }
   search.compare_on(from, scope.held_out);
   State refined = search.search(start, from, iterations);

@@ -20,8 +20,8 @@ struct RefineScope {
   std::vector<int> held_out; ///< tests left out of the search too (ascending): a fold's
   int iterations = 12;       ///< Levenberg–Marquardt iterations at most (both stages together)
   bool intervals = true;     ///< the fit's intervals (one more Jacobian)
-  /// With more tests than this, the search first runs on an even spread of this many of them
-  /// (the others not simulated), then goes on from there with all of them: a stepped-sine
+  /// With more tests than this, the search first runs on this many of them (Problem::spread;
+  /// the others not simulated), then goes on from there with all of them: a stepped-sine
   /// table's hundreds of tests determine a few parameters far beyond what the first stage needs
   /// to get near the minimum, and the second then takes one or two iterations instead of all.
   /// The second stage takes the iterations the first left, and at least two: a first stage that
@@ -29,6 +29,11 @@ struct RefineScope {
   /// cost n / spread times as much and buy little.
   /// 0: one stage. The result is that of all the tests either way.
   int spread = 96;
+  /// With more tests than `spread`: the first stage alone. Every test is then simulated at the
+  /// values it reached (kept where they fit all the tests better than the start did), and the
+  /// intervals are those of all the tests there. For a path that is only screened
+  /// (discover.cpp): near the full refinement at a fraction of its cost.
+  bool spread_only = false;
 };
 
 /// The state refined from `start` (its fit replaced by the output-error one, when

@@ -128,7 +128,8 @@ TEST(Refine, AFirstStageOnASpreadEndsWhereTheSearchOnAllTestsDoes) {
   // 12 that skips the others: both end at the same minimum of all the tests, to 1e-3 of the
   // values' standard deviation (the searches stop at a gain of 1e-5 of the misfit, which leaves
   // a few 1e-3 σ). A first stage alone would end at the spread's minimum, a sizeable share of a
-  // σ away; the test asserts that it does (so that agreeing says something).
+  // σ away; the test asserts that it does (so that agreeing says something). The spread is half
+  // the tests of largest response and an even spread of the rest (Problem::spread).
   const test::OneMode m;
   const frf::Substructure sub = m.substructure();
   std::vector<identify::Measurement> tests;
@@ -150,8 +151,21 @@ TEST(Refine, AFirstStageOnASpreadEndsWhereTheSearchOnAllTestsDoes) {
   ASSERT_EQ(one.fit.joints.size(), 1u);
   ASSERT_EQ(two.fit.joints.size(), 1u);
   std::vector<int> skipped;
-  const std::vector<int> spread = even_spread(tests.size(), 12);
+  const std::vector<int> spread = problem.spread(12);
   ASSERT_EQ(spread.size(), 12u);
+  EXPECT_TRUE(std::is_sorted(spread.begin(), spread.end()));
+  EXPECT_EQ(std::adjacent_find(spread.begin(), spread.end()), spread.end());
+  // Half of it the tests of largest measured response (here the six nearest the resonance),
+  // the rest an even spread of the others, from the first to the last.
+  std::vector<int> by_size(120);
+  for (int i = 0; i < 120; ++i)
+    by_size[static_cast<std::size_t>(i)] = i;
+  std::sort(by_size.begin(), by_size.end(), [&](int a, int b) {
+    return std::abs(tests[static_cast<std::size_t>(a)].X(1, 0)) >
+           std::abs(tests[static_cast<std::size_t>(b)].X(1, 0));
+  });
+  for (std::size_t k = 0; k < 6; ++k)
+    EXPECT_TRUE(std::binary_search(spread.begin(), spread.end(), by_size[k])) << by_size[k];
   EXPECT_EQ(spread.front(), 0);
   EXPECT_EQ(spread.back(), 119);
   for (int i = 0; i < 120; ++i)
@@ -167,6 +181,20 @@ TEST(Refine, AFirstStageOnASpreadEndsWhereTheSearchOnAllTestsDoes) {
     EXPECT_GT(std::abs(on_spread.joints[0].values[t] - one.joints[0].values[t]), 0.05 * sd) << t;
   }
   EXPECT_NEAR(two.gap, one.gap, 1e-6 * one.gap);
+  // The first stage alone (a screened path's refinement): the spread's minimum, every test
+  // simulated there and the intervals of all of them, near the full refinement's.
+  RefineScope screened = spread_first;
+  screened.spread_only = true;
+  const discover::State alone = refine(problem, start, sim, screened);
+  EXPECT_TRUE(alone.failed.empty());
+  EXPECT_EQ(alone.X.size(), tests.size());
+  EXPECT_TRUE(std::isfinite(alone.gap));
+  EXPECT_GE(alone.chi2, one.chi2 * (1.0 - 1e-9)); // the minimum over all tests is the full one
+  for (std::size_t t = 0; t < 2; ++t) {
+    const double sd = one.fit.joints[0].terms[t].std;
+    EXPECT_NEAR(alone.joints[0].values[t], on_spread.joints[0].values[t], 1e-3 * sd) << t;
+    EXPECT_NEAR(alone.fit.joints[0].terms[t].std, sd, 0.05 * sd) << t;
+  }
   // A state that skips tests: those not simulated, the others as every test's state has them.
   const discover::State skipping = problem.evaluate(one.joints, sim, nullptr, skipped);
   EXPECT_TRUE(skipping.failed.empty());
