@@ -81,6 +81,6 @@ void BM_PeriodicHarmonicBalance(benchmark::State& state) {
 } // namespace
 
 BENCHMARK(BM_PeriodicHarmonicBalance)
-    ->ArgsProduct({{64, 128, 256}, {0, 1}})
+    ->ArgsProduct({{64, 128, 256, 512}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -97,6 +97,13 @@ struct Options {
   int finalists = 3;
   /// Points of each state's response curves for the report (0: none).
   int curve_points = 30;
+  /// A periodic test is re-simulated by a harmonic balance of its lines up to its highest line
+  /// compared or max(K, 10) times its highest driven line. Its Newton matrix is dense, so a
+  /// solve costs as the cube of the lines (256 lines about 0.2 s, 512 about 0.9 s: docs/
+  /// benchmarks.md; the simulation's error twice as many), and a discovery takes thousands.
+  /// A test that needs more lines than this is refused, naming it, before any is solved (a
+  /// ground-vibration test's 0.05 Hz lines to 15 Hz would need about 3000).
+  int max_balance_lines = 512;
   /// Called before every re-simulation of a test (a harmonic balance, or a time integration
   /// for the simulation's own error), from the threads the candidates run on, possibly at the
   /// same time: an exception thrown from it stops the run and leaves discover() (e.g. an

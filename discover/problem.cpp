@@ -104,7 +104,19 @@ void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
       // cubic stiffness driven hard spreads its response far past three times the highest
       // excited line: on the cantilever's 90 N multisine test with k3, truncated at 3 times it
       // has no solution, at 5 times it is 17 % off the solution at 10 times.)
-      const int reach = std::max(m.lines.back(), std::max(K_, 10) * highest_driven(m));
+      const int driven = highest_driven(m);
+      const int reach = std::max(m.lines.back(), std::max(K_, 10) * driven);
+      if (reach > o_.max_balance_lines)
+        throw std::invalid_argument(fmt::format(
+            "discover: {} needs a harmonic balance of {} lines {} Hz apart (its highest line "
+            "compared, {}, or {} times its highest driven line, {} at {} Hz, whichever is "
+            "higher), more than the {} it may have (--max-balance-lines): its "
+            "dense Newton costs as the cube of the lines (512 take about 0.9 s a solve, and a "
+            "discovery takes thousands). A record with fewer lines (a shorter "
+            "period, a narrower excited band) can be re-simulated; this one can be identified "
+            "(`jointid identify`: no re-simulation)",
+            m.source, reach, number(m.frequency_hz), m.lines.back(), std::max(K_, 10), driven,
+            number(driven * m.frequency_hz), o_.max_balance_lines));
       balance_harmonics_.push_back(reach);
       rows_.push_back(m.harmonics);
       top = std::max(top, frf::synthesis_band_hz(m.frequency_hz, 2 * reach)); // refined: twice

@@ -43,6 +43,11 @@ public:
     add_balance_harmonics(options_.balance.harmonics,
                           "Harmonics 0 … K of the harmonic-balance re-simulations");
     app().add_option("--max-steps", options_.max_steps, "Most terms added")->capture_default_str();
+    app()
+        .add_option("--max-balance-lines", options_.max_balance_lines,
+                    "Most lines of a periodic test's harmonic balance (dense: its cost grows as "
+                    "their cube); a test that needs more is refused")
+        ->capture_default_str();
     std::vector<std::string> names;
     for (const joints::Term t : joints::all_terms)
       names.emplace_back(joints::term_name(t));
@@ -79,6 +84,9 @@ void Discover::run() {
   check_balance_harmonics(options_.balance.harmonics, K, "the largest of --harmonics");
   if (options_.max_steps < 1)
     throw io::Error(fmt::format("--max-steps: expected at least 1, got {}", options_.max_steps));
+  if (options_.max_balance_lines < 1)
+    throw io::Error(fmt::format("--max-balance-lines: expected at least 1, got {}",
+                                options_.max_balance_lines));
   discover::Options options = options_;
   if (!terms_.empty()) {
     options.terms.clear();

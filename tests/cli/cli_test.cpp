@@ -725,6 +725,16 @@ TEST_F(CliTest, DiscoverTakesMultisineRecordsAndNamesAHiddenCubicStiffness) {
   std::vector<std::string> bad = args;
   bad.insert(bad.end(), {"--band", "4", "-o", out.string()});
   expect_one_line_error(jointid(bad, dir()), "--band");
+  // Their harmonic balance has 160 lines (10 times the highest driven one, 4 Hz at 0.25 Hz):
+  // with at most 100 allowed, the first record is refused before anything is solved.
+  std::vector<std::string> capped = args;
+  capped.insert(capped.end(), {"--band", "1:4", "--max-balance-lines", "100", "-o", out.string()});
+  const Outcome refused = jointid(capped, dir());
+  expect_one_line_error(refused, "multisine_1-4Hz_10N.csv needs a harmonic balance of 160 lines");
+  EXPECT_NE(refused.err.find("more than the 100 it may have (--max-balance-lines)"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(fs::exists(out / "discovery.json"));
   args.insert(args.end(), {"--band", "1:4", "--terms", "k3,c3", "--no-damping-candidate",
                            "--no-plot", "-o", out.string()});
   const Outcome run = jointid(args, dir());
