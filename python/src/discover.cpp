@@ -20,7 +20,8 @@ struct DiscoveryResult {
 DiscoveryResult discover_terms(const ModelPtr& model, const py::object& tests_given,
                                const std::vector<int>& harmonics,
                                const py::object& balance_harmonics, int max_steps,
-                               const py::object& terms, bool damping_candidate) {
+                               const py::object& terms, bool damping_candidate,
+                               int max_balance_lines) {
   // 1. The arguments, as `jointid discover` checks its options.
   discover::Options options;
   options.harmonics = harmonics;
@@ -31,6 +32,10 @@ DiscoveryResult discover_terms(const ModelPtr& model, const py::object& tests_gi
   if (max_steps < 1)
     throw io::Error(fmt::format("max_steps: expected at least 1, got {}", max_steps));
   options.max_steps = max_steps;
+  if (max_balance_lines < 1)
+    throw io::Error(
+        fmt::format("max_balance_lines: expected at least 1, got {}", max_balance_lines));
+  options.max_balance_lines = max_balance_lines;
   if (!terms.is_none()) {
     options.terms.clear();
     for (const std::string& t : strings(terms, "terms")) {
@@ -138,15 +143,16 @@ void bind_discover(py::module_& m) {
       "discover",
       [](const ModelPtr& model, const py::object& tests, const py::object& harmonics,
          const py::object& balance_harmonics, int max_steps, const py::object& terms,
-         bool damping_candidate) {
+         bool damping_candidate, int max_balance_lines) {
         return discover_terms(model, tests, integers(harmonics, "harmonics"), balance_harmonics,
-                              max_steps, terms, damping_candidate);
+                              max_steps, terms, damping_candidate, max_balance_lines);
       },
       py::arg("model"), py::arg("tests"), py::kw_only(),
       py::arg("harmonics") = discover::Options{}.harmonics,
       py::arg("balance_harmonics") = py::none(),
       py::arg("max_steps") = discover::Options{}.max_steps, py::arg("terms") = py::none(),
       py::arg("damping_candidate") = true,
+      py::arg("max_balance_lines") = discover::Options{}.max_balance_lines,
       "Model discovery (as `jointid discover`): from the model's joints, adds the missing joint "
       "terms one at a time while they explain the gap between the tests and the model's "
       "re-simulation of them. terms: the candidate terms (default: all); damping_candidate: "

@@ -112,3 +112,5 @@ def test_bad_arguments(cantilever):
         "falsely small)")
     with pytest.raises(TypeError):
         jointid.identify(cantilever, [1.5])
+    assert message(lambda: jointid.discover(cantilever, [r], max_balance_lines=0)) == (
+        "max_balance_lines: expected at least 1, got 0")

@@ -1776,6 +1776,9 @@ TEST_F(CliTest, OptionsOutOfRangeAreNamedBeforeAnythingIsRead) {
       jointid({"discover", model_path, rec, "--max-steps", "0", "-o", out.string()}, dir()),
       "jointid: --max-steps: expected at least 1, got 0");
   expect_one_line_error(
+      jointid({"discover", model_path, rec, "--max-balance-lines", "0", "-o", out.string()}, dir()),
+      "jointid: --max-balance-lines: expected at least 1, got 0");
+  expect_one_line_error(
       jointid({"modes", model_path, "--count", "0", "--pictures", "0", "-o", out.string()}, dir()),
       "jointid: --count: expected at least 1, got 0");
   for (const std::string t : {"0", "1", "-1e-9"})
