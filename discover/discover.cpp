@@ -78,7 +78,8 @@ public:
       const bool screened = after_first_.has_value();
       if (screened && second && !(b < screened_best_ - margin)) second = false;
       std::string screening;
-      if (screened && !second) {
+      const bool again = screened && !second; // the first path followed again in full
+      if (again) {
         out = std::move(after_first_->first);
         state = std::move(after_first_->second);
         after_first_.reset();
@@ -111,7 +112,9 @@ public:
         if (second) {
           out = std::move(other);
           state = std::move(other_state);
-          simulation_gap = other_gap;
+          // Followed again, the first path made the problem's error estimates its own: they
+          // are made again for the second path's end (finish()).
+          simulation_gap = again ? -1.0 : other_gap;
         }
         out.diagnosis.findings.push_back(said);
       }
