@@ -125,6 +125,61 @@ std::pair<double, double> parse_pair(const std::string& option, const std::strin
   return {f0, f1};
 }
 
+// "3", "1.5e3" or a range "F0:STEP:F1" (F0, F0 + STEP, … up to F1 within a millionth of STEP),
+// every value finite and > 0; sorted, each once.
+std::vector<double> parse_values(const std::string& option, const std::vector<std::string>& items,
+                                 const char* unit) {
+  auto refuse = [&](const std::string& item) {
+    return io::Error(fmt::format("{}: expected numbers ({}) or ranges START:STEP:STOP, got \"{}\"",
+                                 option, unit, item));
+  };
+  auto number = [&](const std::string& text, const std::string& item) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v)) throw refuse(item);
+    return v;
+  };
+  std::vector<double> out;
+  for (const auto& item : items) {
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    for (std::size_t c = item.find(':'); c != std::string::npos; c = item.find(':', start)) {
+      parts.push_back(item.substr(start, c - start));
+      start = c + 1;
+    }
+    parts.push_back(item.substr(start));
+    if (parts.size() == 1) {
+      out.push_back(number(parts[0], item));
+    } else if (parts.size() == 3) {
+      const double a = number(parts[0], item), step = number(parts[1], item),
+                   b = number(parts[2], item);
+      if (!(step > 0.0) || b < a)
+        throw io::Error(fmt::format(
+            "{} {}: expected START:STEP:STOP with STEP > 0 and STOP >= START", option, item));
+      const double n = std::floor((b - a) / step + 1e-6);
+      if (n > 10000) throw io::Error(fmt::format("{} {}: more than 10000 values", option, item));
+      for (int i = 0; i <= static_cast<int>(n); ++i)
+        out.push_back(a + i * step);
+    } else {
+      throw refuse(item);
+    }
+  }
+  if (out.empty())
+    throw io::Error(fmt::format("{}: expected at least one value ({})", option, unit));
+  for (double v : out)
+    if (!(v > 0.0))
+      throw io::Error(fmt::format("{}: expected values > 0 {}, got {}", option, unit, v));
+  std::sort(out.begin(), out.end());
+  if (std::adjacent_find(out.begin(), out.end()) != out.end())
+    throw io::Error(fmt::format("{}: a value is listed twice", option));
+  return out;
+}
+
 std::pair<double, double> parse_band(const std::string& option, const std::string& text) {
   const auto [f0, f1] = parse_pair(option, text, "2:40");
   if (!(f0 >= 0.0 && f1 > f0))

@@ -50,6 +50,11 @@ std::pair<double, double> parse_pair(const std::string& option, const std::strin
                                      const char* example);
 /// A band "F0:F1" in Hz with 0 <= F0 < F1.
 std::pair<double, double> parse_band(const std::string& option, const std::string& text);
+/// Values of an option given as numbers ("3", "1.5e3") or ranges START:STEP:STOP (START,
+/// START + STEP, … up to STOP within a millionth of STEP; at most 10000 a range), every one
+/// finite and > 0 (`unit` names them in messages): sorted, each once.
+std::vector<double> parse_values(const std::string& option, const std::vector<std::string>& items,
+                                 const char* unit);
 /// --channels x, v, a: each once.
 std::vector<identify::Quantity> parse_channels(const std::vector<std::string>& channels);
 /// --route modal or full.

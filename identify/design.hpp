@@ -53,6 +53,11 @@ struct PeriodicPlan {
   double period_s = 0.0, sample_rate_hz = 0.0;
 };
 
+/// The sample rate a periodic candidate is predicted at when none is given: the smallest power
+/// of two (Hz) at or above 32 f1 and 8 (K + 1) f1, K the largest harmonic fitted (the joints'
+/// harmonics up to K times the highest line stay well below the Nyquist frequency).
+double default_periodic_sample_rate(double f1_hz, int harmonics);
+
 /// One candidate test as predicted at the prior values.
 struct CandidateTest {
   /// A sine test's frequency and amplitude; a periodic candidate's: 1/period_s (its lines'

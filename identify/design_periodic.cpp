@@ -47,6 +47,13 @@ void check_plan(const PeriodicPlan& p, std::size_t i) {
 
 } // namespace
 
+double default_periodic_sample_rate(double f1_hz, int harmonics) {
+  double rate = 1.0;
+  while (rate < std::max(32.0 * f1_hz, 8.0 * (harmonics + 1) * f1_hz))
+    rate *= 2.0;
+  return rate;
+}
+
 std::vector<CandidateTest>
 predict_periodic_candidates(const frf::Substructure& sub, const std::vector<joints::Joint>& joints,
                             const fem::NodeDof& force_at, const std::vector<PeriodicPlan>& plans,

@@ -21,61 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// "3", "1.5e3" or a range "F0:STEP:F1" (F0, F0 + STEP, … up to F1 within a millionth of STEP),
-// every value finite and > 0; sorted, each once.
-std::vector<double> parse_values(const std::string& option, const std::vector<std::string>& items,
-                                 const char* unit) {
-  auto refuse = [&](const std::string& item) {
-    return io::Error(fmt::format("{}: expected numbers ({}) or ranges START:STEP:STOP, got \"{}\"",
-                                 option, unit, item));
-  };
-  auto number = [&](const std::string& text, const std::string& item) {
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != text.size() || !std::isfinite(v)) throw refuse(item);
-    return v;
-  };
-  std::vector<double> out;
-  for (const auto& item : items) {
-    std::vector<std::string> parts;
-    std::size_t start = 0;
-    for (std::size_t c = item.find(':'); c != std::string::npos; c = item.find(':', start)) {
-      parts.push_back(item.substr(start, c - start));
-      start = c + 1;
-    }
-    parts.push_back(item.substr(start));
-    if (parts.size() == 1) {
-      out.push_back(number(parts[0], item));
-    } else if (parts.size() == 3) {
-      const double a = number(parts[0], item), step = number(parts[1], item),
-                   b = number(parts[2], item);
-      if (!(step > 0.0) || b < a)
-        throw io::Error(fmt::format(
-            "{} {}: expected START:STEP:STOP with STEP > 0 and STOP >= START", option, item));
-      const double n = std::floor((b - a) / step + 1e-6);
-      if (n > 10000) throw io::Error(fmt::format("{} {}: more than 10000 values", option, item));
-      for (int i = 0; i <= static_cast<int>(n); ++i)
-        out.push_back(a + i * step);
-    } else {
-      throw refuse(item);
-    }
-  }
-  if (out.empty())
-    throw io::Error(fmt::format("{}: expected at least one value ({})", option, unit));
-  for (double v : out)
-    if (!(v > 0.0))
-      throw io::Error(fmt::format("{}: expected values > 0 {}, got {}", option, unit, v));
-  std::sort(out.begin(), out.end());
-  if (std::adjacent_find(out.begin(), out.end()) != out.end())
-    throw io::Error(fmt::format("{}: a value is listed twice", option));
-  return out;
-}
-
 class Design final : public Command {
 public:
   explicit Design(CLI::App& parent)
@@ -200,12 +145,9 @@ std::vector<identify::PeriodicPlan> Design::periodic_plans() const {
                                 "lengthen --period or raise F1",
                                 band_, 1.0 / period_));
   double rate = sample_rate_;
-  if (rate == 0.0) { // the smallest power of two above what the lines and the harmonics need
-    const int K = *std::max_element(options_.harmonics.begin(), options_.harmonics.end());
-    rate = 1.0;
-    while (rate < std::max(32.0 * f1, 8.0 * (K + 1) * f1))
-      rate *= 2.0;
-  }
+  if (rate == 0.0)
+    rate = identify::default_periodic_sample_rate(
+        f1, *std::max_element(options_.harmonics.begin(), options_.harmonics.end()));
   if (!(rate > 2.0 * f1 && std::isfinite(rate)))
     throw io::Error(fmt::format("--sample-rate: expected more than twice F1 ({:g} Hz), got {}",
                                 2.0 * f1, rate));
