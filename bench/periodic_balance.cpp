@@ -5,10 +5,13 @@
 // 1-4 Hz (13 lines, Schroeder phases, 60 N RMS), solved with K harmonics of the base frequency:
 // K = 64, 128, 256 (lines up to 16, 32, 64 Hz; the multisine has even lines, so every harmonic
 // is solved: 2K + 1 = 129, 257, 513 unknowns, as in discovery's re-simulation of a multisine
-// record). state.range(1): 1 the transforms and the hysteretic
-// loop's derivative by FFT from 96 unknowns a block (the default), 0 by the sample tables
-// (Equations::fft_from set out of reach: the route before). Counters: Newton iterations and
-// unknowns. Results: docs/benchmarks.md, "Harmonic balance of many lines".
+// record); and K = 1024, 4096, 9216 (lines to 256 Hz, 1 kHz, 2.3 kHz: a ground-vibration test's
+// record of 20 s periods has as many). state.range(1), the route: 0 the sample tables and the
+// dense Newton (Equations::fft_from and matrix_free_from out of reach: the route before); 1 the
+// transforms and the hysteretic loop's derivative by FFT, dense Newton; 2 Newton–Krylov, no
+// matrix (matrix_free_from = 1). By default the route is 0 below 96 unknowns a block, 1 below
+// 1024, then 2. Counters: Newton iterations and unknowns. Results: docs/benchmarks.md,
+// "Harmonic balance of many lines".
 #include "frf/harmonic_balance.hpp"
 #include "frf/hb_equations.hpp"
 #include "frf/substructure.hpp"
@@ -58,21 +61,23 @@ Eigen::MatrixXcd multisine(int K, double rms) {
 
 void BM_PeriodicHarmonicBalance(benchmark::State& state) {
   const int K = static_cast<int>(state.range(0));
-  const bool fft = state.range(1) != 0;
+  const int route = static_cast<int>(state.range(1));
   static const frf::Substructure sub(test::paper_cantilever());
   const int tip = sub.dofs().equation({7, fem::Dof::uy});
   const frf::ModalSynthesis H = sub.synthesis({tip}, 0.25 * (K + 1));
   const std::vector<joints::Joint> j{tip_joint()};
+  using frf::detail::Equations;
+  const int fft_from = Equations::fft_from, free_from = Equations::matrix_free_from;
+  Equations::fft_from = route == 0 ? 1 << 30 : fft_from;
+  Equations::matrix_free_from = route == 2 ? 1 : 1 << 30;
   const frf::HarmonicBalance hb(H, j, sub.dofs(), {tip}, {tip}, 0.25, {.harmonics = K});
   const Eigen::MatrixXcd F = multisine(K, 60.0);
-  const int before = frf::detail::Equations::fft_from;
-  frf::detail::Equations::fft_from = fft ? before : 1 << 30;
   frf::HarmonicBalanceResult r;
   for (auto _ : state) {
     r = hb.solve(j, F);
     benchmark::DoNotOptimize(r);
   }
-  frf::detail::Equations::fft_from = before;
+  Equations::fft_from = fft_from, Equations::matrix_free_from = free_from;
   if (!r.status.ok()) state.SkipWithError(r.status.reason.c_str());
   state.counters["iterations"] = static_cast<double>(r.iterations);
   state.counters["sum_abs_Y_mm"] = 1e3 * r.Y.col(0).cwiseAbs().sum();
@@ -81,6 +86,7 @@ void BM_PeriodicHarmonicBalance(benchmark::State& state) {
 } // namespace
 
 BENCHMARK(BM_PeriodicHarmonicBalance)
-    ->ArgsProduct({{64, 128, 256, 512}, {0, 1}})
+    ->ArgsProduct({{64, 128, 256, 512}, {0, 1, 2}})
+    ->ArgsProduct({{1024, 4096, 9216}, {2}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -98,12 +98,14 @@ struct Options {
   /// Points of each state's response curves for the report (0: none).
   int curve_points = 30;
   /// A periodic test is re-simulated by a harmonic balance of its lines up to its highest line
-  /// compared or max(K, 10) times its highest driven line. Its Newton matrix is dense, so a
-  /// solve costs as the cube of the lines (256 lines about 0.2 s, 512 about 0.9 s: docs/
-  /// benchmarks.md; the simulation's error twice as many), and a discovery takes thousands.
-  /// A test that needs more lines than this is refused, naming it, before any is solved (a
-  /// ground-vibration test's 0.05 Hz lines to 15 Hz would need about 3000).
-  int max_balance_lines = 512;
+  /// compared or max(K, 10) times its highest driven line (the simulation's error twice as
+  /// many). Its Newton steps are solved by GMRES with FFT products (frf/hb_equations.hpp), so a
+  /// solve costs about its Newton and GMRES iterations times O(lines log lines): 1024 lines
+  /// 60 ms, 9216 lines 0.6 s with the benchmark's joint (docs/benchmarks.md), many times that
+  /// with a strongly non-linear one; a discovery takes thousands. A test that needs more lines
+  /// than this is refused, naming it, before any is solved (a ground-vibration test's 0.05 Hz
+  /// lines to 15 Hz need about 3000).
+  int max_balance_lines = 4096;
   /// Called before every re-simulation of a test (a harmonic balance, or a time integration
   /// for the simulation's own error), from the threads the candidates run on, possibly at the
   /// same time: an exception thrown from it stops the run and leaves discover() (e.g. an

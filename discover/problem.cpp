@@ -110,11 +110,12 @@ void Problem::set_up_equations(const std::vector<joints::Joint>& start) {
         throw std::invalid_argument(fmt::format(
             "discover: {} needs a harmonic balance of {} lines {} Hz apart (its highest line "
             "compared, {}, or {} times its highest driven line, {} at {} Hz, whichever is "
-            "higher), more than the {} it may have (--max-balance-lines): its "
-            "dense Newton costs as the cube of the lines (512 take about 0.9 s a solve, and a "
-            "discovery takes thousands). A record with fewer lines (a shorter "
-            "period, a narrower excited band) can be re-simulated; this one can be identified "
-            "(`jointid identify`: no re-simulation)",
+            "higher), more than the {} it may have (--max-balance-lines): a discovery "
+            "takes thousands of solves, each of Newton iterations whose products grow with the "
+            "lines (9216 lines: about 0.6 s a solve with a mildly non-linear joint, and many "
+            "times that with a strongly non-linear one). Raise the limit, or use a record with "
+            "fewer lines (a shorter period, a narrower excited band); this one can be "
+            "identified (`jointid identify`: no re-simulation)",
             m.source, reach, number(m.frequency_hz), m.lines.back(), std::max(K_, 10), driven,
             number(driven * m.frequency_hz), o_.max_balance_lines));
       balance_harmonics_.push_back(reach);
@@ -456,8 +457,10 @@ State Problem::evaluate_each(const std::vector<joints::Joint>& joints,
     // Where the model's steady state is far from the measured one (a fold the model has and
     // the structure had not), the nearest tests re-simulated — the neighbours of a stepped
     // sweep — are the start a sweep would have had.
+    // (A periodic test's neighbour may have a balance of other lines: not a start for it.)
     if (!(r.status.ok() && r.X.allFinite()))
       for (int j : nearest(t, solved, 2)) {
+        if (s.Y[j].rows() != sim.balance[i].options().harmonics + 1) continue;
         frf::HarmonicBalanceResult again = sim.balance[i].solve(these, drive_[i], &s.Y[j]);
         if (again.status.ok() && again.X.allFinite()) {
           r = std::move(again);
@@ -503,7 +506,7 @@ Problem::derivatives(const State& at, const std::vector<std::vector<joints::Join
   for (std::size_t i = 0; i < tests_.size(); ++i)
     jobs.push_back([&, i] {
       const int t = static_cast<int>(i);
-      if (i >= at.Y.size() || at.Y[i].size() == 0 ||
+      if (i >= at.Y.size() || at.Y[i].rows() != sim.balance[i].options().harmonics + 1 ||
           std::binary_search(at.failed.begin(), at.failed.end(), t) ||
           std::binary_search(skip.begin(), skip.end(), t))
         return Derivatives{};

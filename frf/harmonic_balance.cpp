@@ -2,6 +2,7 @@
 
 #include "frf/hb_equations.hpp"
 
+#include "fem/gmres.hpp"
 #include "fem/minimise.hpp"
 
 #include <Eigen/Dense>
@@ -24,8 +25,11 @@ namespace jointid::frf {
 // that the products of two harmonics make (the Jacobian's; p ≤ 2K, the even ones only when
 // symmetric). Kept in a cache: the continuation builds a HarmonicBalance at every frequency it
 // visits, and computing (and allocating) these each time was most of its cost.
+// Past Equations::matrix_free_from unknowns a block only the harmonics and the sample count are
+// kept (the transforms run by FFT, and the Jacobian is not formed).
 struct detail::Tables {
   std::vector<int> harmonics;
+  int samples = 0; // kept: Nt, or Nt / 2 when symmetric
   Eigen::MatrixXd dy, dv_unit, dyv_unit, forward_t, trig;
 };
 
@@ -33,17 +37,25 @@ namespace {
 
 const detail::Tables& aft_tables(int Nt, int K, bool symmetric) {
   static std::mutex mutex;
-  static std::map<std::tuple<int, int, bool>, std::unique_ptr<const detail::Tables>> cache;
+  static std::map<std::tuple<int, int, bool, bool>, std::unique_ptr<const detail::Tables>> cache;
   const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{Nt, K, symmetric}];
+  const int count = symmetric ? (K + 1) / 2 : K + 1;
+  const int m = 2 * count - (symmetric ? 0 : 1);
+  const bool matrix_free =
+      m >= detail::Equations::matrix_free_from && m >= detail::Equations::fft_from;
+  auto& slot = cache[{Nt, K, symmetric, matrix_free}];
   if (!slot) {
     auto t = std::make_unique<detail::Tables>();
     const int step = symmetric ? 2 : 1;
     for (int k = symmetric ? 1 : 0; k <= K; k += step)
       t->harmonics.push_back(k);
     const int n = symmetric ? Nt / 2 : Nt; // the samples kept (Nt is even when symmetric)
-    const int count = static_cast<int>(t->harmonics.size());
-    const int m = 2 * count - (symmetric ? 0 : 1);
+    t->samples = n;
+    JOINTID_ASSERT(static_cast<int>(t->harmonics.size()) == count, "the harmonics counted");
+    if (matrix_free) {
+      slot = std::move(t);
+      return *slot;
+    }
     // the angle p θ_n reduced exactly, p n mod Nt
     auto angle = [Nt](long long p, int i) { return 2.0 * std::numbers::pi * (p * i % Nt) / Nt; };
     t->dy.resize(n, m), t->dv_unit.resize(n, m), t->forward_t.resize(n, m);
@@ -81,8 +93,78 @@ using detail::Equations;
 using detail::Friction;
 using detail::two_pi;
 
+namespace {
+
+// The step of an inexact Newton iteration by GMRES, to a relative tolerance that tightens as
+// the residual falls (quadratic convergence's: the linear error η|r| at |r| ~ the step's
+// second-order error), never tighter than the tolerance needs.
+fem::GmresOptions krylov_options(double res_norm, double tolerance) {
+  fem::GmresOptions g;
+  g.tolerance = std::min(1e-2, std::max(res_norm, 0.1 * tolerance / std::max(res_norm, 1e-300)));
+  g.tolerance = std::max(g.tolerance, 1e-13);
+  // A step GMRES has not solved in 100 products is taken as it stands (it still lowers the
+  // linear model's residual; the backtracking judges it): where the joints' tangent varies most
+  // over the period (a cubic joint through resonance) the line preconditioner is weakest, and
+  // a few such systems took 600 products, most of a discovery's time.
+  g.restart = g.max_iterations = 100;
+  return g;
+}
+
+// Solves J x = b at the last residual's point by GMRES with the line preconditioner (prepared by
+// the caller); x starts at 0.
+fem::GmresResult krylov_solve(const Equations& P, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                              const fem::GmresOptions& g) {
+  x.setZero(b.size());
+  return fem::gmres([&P](const Eigen::Ref<const Eigen::VectorXd>& v,
+                         Eigen::VectorXd& out) { P.jacobian_times(v, out); },
+                    [&P](const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::VectorXd& out) {
+                      P.precondition(v, out);
+                    },
+                    b, x, g);
+}
+
+// newton() without a matrix (Equations::matrix_free()): Newton–Krylov, the same backtracking.
+bool newton_krylov(const Equations& P, Eigen::VectorXd& z, double load,
+                   const HarmonicBalanceOptions& o, int& iterations, double& res_norm) {
+  const int n = P.size();
+  Eigen::VectorXd r(n), step(n), zt(n), rt(n);
+  P.residual(z, load, r, nullptr);
+  // Newton that creeps (a hardening joint driven through resonance from far off: steps cut to
+  // 1/500, each taking 0.1 % off the residual) is stopped after a few such steps: the load
+  // continuation that follows reaches the solution in a fraction of the products.
+  int creeping = 0;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    ++iterations;
+    res_norm = r.norm() / std::max(P.norm(z), 1e-300);
+    if (res_norm < o.tolerance) return true;
+    P.prepare_preconditioner();
+    const fem::GmresResult solved =
+        krylov_solve(P, -r, step, krylov_options(res_norm, o.tolerance));
+    if (!step.allFinite() || !(solved.residual < 1.0)) return false;
+    double t = 1.0;
+    bool improved = false;
+    const double r_norm = r.norm();
+    for (int ls = 0; ls < 30; ++ls, t *= 0.5) {
+      zt.noalias() = z + t * step;
+      P.residual(zt, load, rt, nullptr);
+      if (rt.allFinite() && rt.norm() < r_norm) {
+        z.swap(zt), r.swap(rt), improved = true;
+        break;
+      }
+    }
+    if (!improved) return res_norm < o.tolerance;
+    creeping = r.norm() > 0.99 * r_norm ? creeping + 1 : 0;
+    if (creeping == 4) break;
+  }
+  res_norm = r.norm() / std::max(P.norm(z), 1e-300);
+  return res_norm < o.tolerance;
+}
+
+} // namespace
+
 bool detail::newton(const Equations& P, Eigen::VectorXd& z, double load,
                     const HarmonicBalanceOptions& o, int& iterations, double& res_norm) {
+  if (P.matrix_free()) return newton_krylov(P, z, load, o, iterations, res_norm);
   const int n = P.size();
   // Work arrays kept per thread and per size (newton does not call itself): sizing them is
   // free from the second call on. A point solves two sizes (the first guess's fundamental-only
@@ -289,10 +371,10 @@ HarmonicBalance::equations(const std::vector<joints::Joint>& joints, const Eigen
   for (int j = 0; j < nj_; ++j)
     if (joints[j].has_parametric_terms())
       sliders[static_cast<std::size_t>(j)] = joints::JointLaw(joints[j]).sliders();
-  auto P = std::make_unique<Equations>(Equations{
-      K_, nj_, static_cast<int>(tables.dy.rows()), tables.harmonics, Hyy_, std::move(HyF_F),
-      std::move(Fk), joints, exact ? 0.0 : options_.friction_width, std::move(friction), tables.dy,
-      tables.dv_unit, tables.dyv_unit, tables.forward_t, tables.trig, omega_});
+  auto P = std::make_unique<Equations>(
+      Equations{K_, nj_, tables.samples, tables.harmonics, Hyy_, std::move(HyF_F), std::move(Fk),
+                joints, exact ? 0.0 : options_.friction_width, std::move(friction), tables.dy,
+                tables.dv_unit, tables.dyv_unit, tables.forward_t, tables.trig, omega_});
   P->sliders = std::move(sliders);
   return P;
 }
@@ -350,13 +432,14 @@ Eigen::VectorXd start_from(const Equations& P, const Eigen::MatrixXcd* start) {
         P.pack(L, z, nj + static_cast<int>(f));
       }
     }
-    Eigen::VectorXd v(P.Nt), slip(P.Nt); // ẏ / ω and the slip force
+    Eigen::VectorXd yv(2 * P.Nt), slip(P.Nt); // y and ẏ, the slip force
     for (std::size_t f = 0; f < friction.size() && !start; ++f) {
-      detail::multiply(P.dv_unit, z.data() + friction[f].joint * m, v.data());
-      for (int n = 0; n < P.Nt; ++n)
-        slip(n) = v(n) > 0.0 ? friction[f].limit : v(n) < 0.0 ? -friction[f].limit : 0.0;
-      detail::multiply_transposed(P.forward_t, slip.data(),
-                                  z.data() + (nj + static_cast<int>(f)) * m);
+      P.samples(z.data() + friction[f].joint * m, yv.data());
+      for (int n = 0; n < P.Nt; ++n) {
+        const double v = yv(P.Nt + n);
+        slip(n) = v > 0.0 ? friction[f].limit : v < 0.0 ? -friction[f].limit : 0.0;
+      }
+      P.forward(slip.data(), z.data() + (nj + static_cast<int>(f)) * m);
     }
   }
   return z;
@@ -449,23 +532,10 @@ Eigen::VectorXd HarmonicBalance::first_guess(const detail::Equations& P,
   // guess.
   // (Hyy_ serves as is: the equations read its harmonics 0 and 1 only.)
   const detail::Tables& t1 = *coarse_tables_[P.symmetric() ? 1 : 0];
-  const Equations P1{1,
-                     nj_,
-                     static_cast<int>(t1.dy.rows()),
-                     t1.harmonics,
-                     Hyy_,
-                     P.HyF_F.topRows(2),
-                     P.Fk.topRows(2),
-                     P.joints,
-                     P.width,
-                     P.friction,
-                     t1.dy,
-                     t1.dv_unit,
-                     t1.dyv_unit,
-                     t1.forward_t,
-                     t1.trig,
-                     omega_,
-                     P.sliders};
+  const Equations P1{
+      1,        nj_,     t1.samples, t1.harmonics, Hyy_,       P.HyF_F.topRows(2), P.Fk.topRows(2),
+      P.joints, P.width, P.friction, t1.dy,        t1.dv_unit, t1.dyv_unit,        t1.forward_t,
+      t1.trig,  omega_,  P.sliders};
   Eigen::VectorXd z1 = start_from(P1, nullptr);
   // The linear response can be far off in amplitude (a stiffening joint near resonance: 9×)
   // and phase; Newton then creeps (by 2/3 a step for a cubic; by 1/2 with friction, 10 steps on
@@ -597,19 +667,38 @@ HarmonicBalance::output_derivatives(const std::vector<joints::Joint>& joints,
   P->scratch().keep_dG = true;
   Eigen::VectorXd z = first_guess(*P, &start);
   const int n = P->size();
+  const bool matrix_free = P->matrix_free();
   Eigen::VectorXd r0(n), r(n);
-  Eigen::MatrixXd J(n, n);
-  P->residual(z, 1.0, r0, &J);
+  Eigen::MatrixXd J(matrix_free ? 0 : n, matrix_free ? 0 : n);
+  P->residual(z, 1.0, r0, matrix_free ? nullptr : &J);
   // `start` is usually the steady state already solved: solved again only where it is not.
   if (!(r0.norm() / std::max(P->norm(z), 1e-300) < options_.tolerance)) {
     int iterations = 0;
     double residual = 0.0;
     if (!detail::newton(*P, z, 1.0, options_, iterations, residual)) return {};
-    P->residual(z, 1.0, r0, &J);
+    P->residual(z, 1.0, r0, matrix_free ? nullptr : &J);
   }
+  // dz ← J⁻¹ dz: by the factorisation, or by GMRES (to 1e-10: a derivative, not a step).
   detail::SmallLU<double> lu;
-  lu.compute(J);
-  if (!(lu.min_pivot > 1e-13 * std::max(1.0, J.lpNorm<Eigen::Infinity>()))) return {};
+  fem::GmresOptions tight;
+  tight.tolerance = 1e-10;
+  tight.restart = 100, tight.max_iterations = 300;
+  auto solve = [&](Eigen::VectorXd& dz) {
+    if (!matrix_free) {
+      lu.solve_in_place(dz);
+      return true;
+    }
+    Eigen::VectorXd x;
+    const bool ok = krylov_solve(*P, dz, x, tight).converged;
+    dz = std::move(x);
+    return ok;
+  };
+  if (matrix_free) {
+    P->prepare_preconditioner();
+  } else {
+    lu.compute(J);
+    if (!(lu.min_pivot > 1e-13 * std::max(1.0, J.lpNorm<Eigen::Infinity>()))) return {};
+  }
   const Eigen::MatrixXcd G = P->forces(z);
   std::vector<Eigen::MatrixXcd> out(moved.size());
   for (std::size_t p = 0; p < moved.size(); ++p) {
@@ -636,8 +725,7 @@ HarmonicBalance::output_derivatives(const std::vector<joints::Joint>& joints,
       dG = Pm->forces(z) - G;
       dz = r0 - r;
     }
-    lu.solve_in_place(dz);
-    if (!dz.allFinite()) continue;
+    if (!solve(dz) || !dz.allFinite()) continue;
     // The outputs X = H_of F − H_oy G move with the forces: ΔG + ∂G/∂z dz to first order.
     dG += P->force_change(dz);
     Eigen::MatrixXcd dX(K_ + 1, HoB_.data.rows());

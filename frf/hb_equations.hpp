@@ -168,6 +168,15 @@ struct Equations {
   // the hysteretic loop's derivative, O(m Nt log Nt) instead of the forward table's O(m² Nt).
   // A variable so that the tests can compare the two routes.
   static inline int fft_from = 96;
+  // From this many unknowns per block (and by FFT) nothing is tabulated and the Jacobian is
+  // never formed: at a ground-vibration test's thousands of lines its tables and the dense
+  // matrix would take O(m Nt) and O(m²) memory (over 100 GB and 2.7 GB at 9 000 lines) and its
+  // factorisation O(m³). Newton's steps are solved by GMRES instead, with products J v
+  // (jacobian_times(), by FFT, O(Nt log Nt) a product) and a preconditioner of each line's own
+  // coupling (precondition()). Faster from the FFT's threshold on (bench_periodic_balance: 1.4
+  // against 5.1 ms a steady state at 129 unknowns, 19 against 1 280 ms at 1 025). A variable so
+  // that the tests can compare the two routes.
+  static inline int matrix_free_from = 96;
 
   bool symmetric() const { return harmonics.front() != 0; }
   int count() const { return static_cast<int>(harmonics.size()); }
@@ -206,6 +215,11 @@ struct Equations {
     // set (force_change() reads them).
     bool keep_dG = false;
     std::vector<Eigen::MatrixXd> dG;
+    // jacobian_times()'s work arrays (samples of a direction: y, ẏ, the weighted sum; its force
+    // change, packed), and precondition()'s matrices: per line of `harmonics`, the inverse of
+    // that line's own coupling ((nj + friction) square, side by side).
+    Vector product{nullptr, 0}, change{nullptr, 0}, lambda_change{nullptr, 0};
+    Eigen::MatrixXcd line_inverse;
 
     Scratch() = default;
     Scratch(const Scratch&) : Scratch() {}
@@ -218,8 +232,9 @@ struct Equations {
     if (w.yv.size() == 2 * Nt) return w;
     const Eigen::Index n = Nt, M = m(), nf = static_cast<Eigen::Index>(friction.size());
     const Eigen::Index nw = 4 * K + 1, nt = trig.cols();
+    const Eigen::Index dense = matrix_free() ? 0 : M; // E and D: not when matrix-free
     w.buffer.assign(static_cast<std::size_t>(2 * n + M + 2 * n + nj * 3 * n + nf * n + 2 * nt +
-                                             2 * M * M + 2 * nw + size()),
+                                             2 * dense * dense + 2 * nw + size() + 3 * n + 2 * M),
                     0.0);
     double* at = w.buffer.data();
     auto take = [&at](Eigen::Index size) {
@@ -237,15 +252,18 @@ struct Equations {
     for (Eigen::Index f = 0; f < nf; ++f)
       w.stick.emplace_back(take(n), n);
     new (&w.weights) Scratch::Matrix(take(2 * nt), nt, 2);
-    new (&w.E) Scratch::Matrix(take(M * M), M, M);
-    new (&w.D) Scratch::Matrix(take(M * M), M, M);
+    new (&w.E) Scratch::Matrix(take(dense * dense), dense, dense);
+    new (&w.D) Scratch::Matrix(take(dense * dense), dense, dense);
     new (&w.w) Scratch::Vector(take(2 * nw), 2 * nw);
     new (&w.last) Scratch::Vector(take(size()), size());
+    new (&w.product) Scratch::Vector(take(3 * n), 3 * n);
+    new (&w.change) Scratch::Vector(take(M), M);
+    new (&w.lambda_change) Scratch::Vector(take(M), M);
     w.has_last = false;
     w.G.setZero(K + 1, nj);
     w.loop.assign(static_cast<std::size_t>(nj), {});
     w.loop_force.assign(static_cast<std::size_t>(n), 0.0);
-    w.loop_dy.setZero(n, M);
+    if (!matrix_free()) w.loop_dy.setZero(n, M);
     return w;
   }
 
@@ -341,6 +359,7 @@ struct Equations {
   // kept samples are the first half, the second half the first negated (odd harmonics) or
   // repeated (a weight of even harmonics).
   bool by_fft() const { return m() >= fft_from; }
+  bool matrix_free() const { return by_fft() && m() >= matrix_free_from; }
   int period_samples() const { return symmetric() ? 2 * Nt : Nt; }
   static fem::RealFft& fft(int n) {
     thread_local std::map<int, std::unique_ptr<fem::RealFft>> plans;
@@ -507,16 +526,25 @@ struct Equations {
     for (std::size_t f = 0; f < friction.size(); ++f) {
       const Friction& fr = friction[f];
       const int o = (nj + static_cast<int>(f)) * m(), oy = fr.joint * m();
-      multiply(dy, z.data() + o, s.lambda.data());
-      multiply(dv_unit, z.data() + oy, s.yv.data() + Nt);
+      double rw = fr.r * omega; // r ẏ = r ω (ẏ / ω) from the tables; r ẏ by FFT
+      if (by_fft()) {
+        double* work = s.product.data(); // λ and its (unused) rate, then ẏ
+        samples(z.data() + o, work);
+        s.lambda = Eigen::Map<const Eigen::VectorXd>(work, Nt);
+        samples(z.data() + oy, work);
+        s.yv.tail(Nt) = Eigen::Map<const Eigen::VectorXd>(work + Nt, Nt);
+        rw = fr.r;
+      } else {
+        multiply(dy, z.data() + o, s.lambda.data());
+        multiply(dv_unit, z.data() + oy, s.yv.data() + Nt);
+      }
       Scratch::Vector& stick = s.stick[f];
-      const double rw = fr.r * omega; // r ẏ = r ω (ẏ / ω)
       for (int n = 0; n < Nt; ++n) {
         const double trial = s.lambda(n) + rw * s.yv(Nt + n);
         stick(n) = std::abs(trial) < fr.limit ? 1.0 : 0.0;
         s.clamped(n) = std::clamp(trial, -fr.limit, fr.limit);
       }
-      multiply_transposed(forward_t, s.clamped.data(), s.harmonics.data());
+      forward(s.clamped.data(), s.harmonics.data());
       r.segment(o, m()) = fr.c * (z.segment(o, m()) - s.harmonics);
     }
     if (J) jacobian(*J);
@@ -578,6 +606,16 @@ struct Equations {
   // unknowns (which enter G as they are).
   Eigen::MatrixXcd force_change(const Eigen::VectorXd& dz) const {
     const Scratch& s = scratch();
+    if (matrix_free()) { // from the samples of the last residual(), as jacobian_times()
+      JOINTID_ASSERT(dz.size() == size(), "a change of every unknown");
+      Eigen::VectorXd packed(nj * m());
+      for (int j = 0; j < nj; ++j)
+        smooth_force_change(j, dz.data() + j * m(), packed.data() + j * m());
+      for (std::size_t f = 0; f < friction.size(); ++f)
+        packed.segment(friction[f].joint * m(), m()) +=
+            dz.segment((nj + static_cast<int>(f)) * m(), m());
+      return unpack(packed, nj);
+    }
     JOINTID_ASSERT(s.keep_dG && s.dG.size() == static_cast<std::size_t>(nj) && dz.size() == size(),
                    "force_change() follows a jacobian() that kept the force's derivative");
     Eigen::VectorXd packed = Eigen::VectorXd::Zero(nj * m());
@@ -587,6 +625,129 @@ struct Equations {
       packed.segment(friction[f].joint * m(), m()) +=
           dz.segment((nj + static_cast<int>(f)) * m(), m());
     return unpack(packed, nj);
+  }
+
+  // The matrix-free Jacobian (matrix_free(); any size, for the tests). All at the point of the
+  // last residual(), from the samples it kept; none of them changes those.
+  //
+  // Packed harmonics (m) of the change of joint b's smooth force for a change v (packed, m) of
+  // its deformation's harmonics: the transform of ∂g/∂y δy + ∂g/∂ẏ δẏ at the samples, plus its
+  // hysteretic loop's ∂g_n/∂y_m δy_m. O(Nt log Nt) by FFT.
+  void smooth_force_change(int b, const double* v, double* out) const {
+    Scratch& s = scratch();
+    double* yv = s.product.data(); // δy, δẏ (2 Nt), then the force's change (Nt)
+    double* w = yv + 2 * Nt;
+    samples(v, yv);
+    const Scratch::Matrix& g = s.g[static_cast<std::size_t>(b)];
+    for (int n = 0; n < Nt; ++n)
+      w[n] = g(n, 1) * yv[n] + g(n, 2) * yv[Nt + n];
+    const auto u = static_cast<std::size_t>(b);
+    if (u < sliders.size() && !sliders[u].empty())
+      for (const joints::LoopEntry& e : s.loop[u])
+        w[e.n] += e.value * yv[e.m];
+    forward(w, out);
+  }
+  // out[rows of joint a] += pack(H_yy(kω)_ab D_k) for the packed harmonics d (m).
+  void add_receptance_times(int a, int b, const double* d, double* out) const {
+    double* o = out + a * m();
+    if (!symmetric()) o[0] += Hyy[0](a, b).real() * d[0];
+    for (int i = first(); i < count(); ++i) {
+      const Complex v = Hyy[harmonics[i]](a, b) * Complex(d[at(i)], d[at(i) + 1]);
+      o[at(i)] += v.real(), o[at(i) + 1] += v.imag();
+    }
+  }
+  // out = J v, J the (generalised) Jacobian jacobian() would form.
+  void jacobian_times(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::VectorXd& out) const {
+    JOINTID_ASSERT(v.size() == size(), "a direction of every unknown");
+    Scratch& s = scratch();
+    out = v;
+    double* dG = s.change.data();
+    for (int b = 0; b < nj; ++b) {
+      smooth_force_change(b, v.data() + b * m(), dG);
+      for (std::size_t f = 0; f < friction.size(); ++f)
+        if (friction[f].joint == b) s.change += v.segment((nj + static_cast<int>(f)) * m(), m());
+      for (int a = 0; a < nj; ++a)
+        add_receptance_times(a, b, dG, out.data());
+    }
+    for (std::size_t f = 0; f < friction.size(); ++f) {
+      // c (δΛ − transform of stick · (δλ + r δẏ))
+      const Friction& fr = friction[f];
+      const int o = (nj + static_cast<int>(f)) * m();
+      double* work = s.product.data();
+      samples(v.data() + fr.joint * m(), work);
+      Eigen::Map<Eigen::VectorXd> rate(work + 2 * Nt, Nt);
+      rate = Eigen::Map<const Eigen::VectorXd>(work + Nt, Nt) * fr.r; // (samples: ẏ itself)
+      samples(v.data() + o, work);                                    // δλ (its rate unused)
+      for (int n = 0; n < Nt; ++n)
+        work[n] = s.stick[f](n) * (work[n] + rate(n));
+      forward(work, s.lambda_change.data());
+      out.segment(o, m()) = fr.c * (v.segment(o, m()) - s.lambda_change);
+    }
+  }
+  // The preconditioner of jacobian_times(): each line's own coupling, with the joints' tangents
+  // and the friction joints' stick fractions averaged over the period (the couplings between
+  // lines that their variation makes are left out). Per line k (complex, δY then δΛ):
+  //     δY_a + Σ_b H_ab (ḡ_y,b + ikω ḡ_ẏ,b) δY_b + Σ_f H_a,j(f) δΛ_f,
+  //     c_f ((1 − s̄_f) δΛ_f − s̄_f r_f ikω δY_j(f)),
+  // with ḡ_y a hysteretic loop's mean diagonal ∂g_n/∂y_n too. Exact for linear joints.
+  void prepare_preconditioner() const {
+    Scratch& s = scratch();
+    const int nf = static_cast<int>(friction.size()), q = nj + nf;
+    std::vector<double> gy(static_cast<std::size_t>(nj)), gv(gy.size()),
+        stuck(static_cast<std::size_t>(nf));
+    for (int b = 0; b < nj; ++b) {
+      const auto u = static_cast<std::size_t>(b);
+      const Scratch::Matrix& g = s.g[u];
+      gy[u] = g.col(1).mean(), gv[u] = g.col(2).mean();
+      if (u < sliders.size() && !sliders[u].empty())
+        for (const joints::LoopEntry& e : s.loop[u])
+          if (e.n == e.m) gy[u] += e.value / Nt;
+    }
+    for (int f = 0; f < nf; ++f)
+      stuck[static_cast<std::size_t>(f)] = s.stick[static_cast<std::size_t>(f)].mean();
+    s.line_inverse.resize(q, q * count());
+    Eigen::MatrixXcd A(q, q);
+    for (int i = 0; i < count(); ++i) {
+      const int k = harmonics[i];
+      const Complex ikw(0.0, k * omega);
+      A.setIdentity();
+      for (int a = 0; a < nj; ++a) {
+        for (int b = 0; b < nj; ++b)
+          A(a, b) += Hyy[k](a, b) *
+                     (gy[static_cast<std::size_t>(b)] + ikw * gv[static_cast<std::size_t>(b)]);
+        for (int f = 0; f < nf; ++f)
+          A(a, nj + f) += Hyy[k](a, friction[static_cast<std::size_t>(f)].joint);
+      }
+      for (int f = 0; f < nf; ++f) {
+        const Friction& fr = friction[static_cast<std::size_t>(f)];
+        const double st = stuck[static_cast<std::size_t>(f)];
+        A.row(nj + f).setZero();
+        A(nj + f, nj + f) = fr.c * (1.0 - st);
+        A(nj + f, fr.joint) -= fr.c * st * fr.r * ikw;
+      }
+      // A friction joint stuck throughout leaves its mean singular: a least-squares inverse.
+      s.line_inverse.middleCols(i * q, q) = A.completeOrthogonalDecomposition().pseudoInverse();
+    }
+  }
+  // out = (the preconditioner)⁻¹ v, line by line.
+  void precondition(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::VectorXd& out) const {
+    const Scratch& s = scratch();
+    const int nf = static_cast<int>(friction.size()), q = nj + nf;
+    out.resize(size());
+    Eigen::VectorXcd x(q), y(q);
+    for (int i = 0; i < count(); ++i) {
+      const bool mean = harmonics[i] == 0;
+      for (int u = 0; u < q; ++u) {
+        const int o = u * m() + (mean ? 0 : at(i));
+        x(u) = mean ? Complex(v(o)) : Complex(v(o), v(o + 1));
+      }
+      y.noalias() = s.line_inverse.middleCols(i * q, q) * x;
+      for (int u = 0; u < q; ++u) {
+        const int o = u * m() + (mean ? 0 : at(i));
+        out(o) = y(u).real();
+        if (!mean) out(o + 1) = y(u).imag();
+      }
+    }
   }
 
   // Coefficient `term` of joint j grown by `step` (a term without parameters and not dry
@@ -660,7 +821,7 @@ struct Equations {
             joints::add_samples(joints[b].terms[t], joints[b].values[t], ys, vs, gs, gys, gvs),
                 any = true;
         if (!any) continue;
-        multiply_transposed(forward_t, g.data(), s.harmonics.data());
+        forward(g.data(), s.harmonics.data());
         for (int a = 0; a < nj; ++a) // joint a's rows: Σ_b H_yy(kω)_ab G_b,k
           for (int i = 0; i < count(); ++i) {
             const int k = harmonics[i];

@@ -45,8 +45,8 @@ public:
     app().add_option("--max-steps", options_.max_steps, "Most terms added")->capture_default_str();
     app()
         .add_option("--max-balance-lines", options_.max_balance_lines,
-                    "Most lines of a periodic test's harmonic balance (dense: its cost grows as "
-                    "their cube); a test that needs more is refused")
+                    "Most lines of a periodic test's harmonic balance (a solve's cost grows "
+                    "with them); a test that needs more is refused")
         ->capture_default_str();
     std::vector<std::string> names;
     for (const joints::Term t : joints::all_terms)

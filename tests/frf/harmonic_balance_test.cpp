@@ -779,6 +779,136 @@ TEST(HarmonicBalance, ManyHarmonicsGiveTheSameEquationsByFftAsByTheTables) {
     }
 }
 
+namespace {
+
+// The joints of the matrix-free tests: each kind of force the Jacobian has (smooth with ∂g/∂y
+// and ∂g/∂ẏ, a hysteretic loop, a gap, exact Coulomb friction), and two joints coupled through
+// the structure, one of them with friction.
+std::vector<std::pair<std::string, std::vector<joints::Joint>>> matrix_free_cases() {
+  const joints::Joint smooth =
+      make("tip", 7, 0, {Term::k, Term::c, Term::k3, Term::c2}, {4800.0, 20.0, 1.6e8, 500.0});
+  return {{"cubic", {smooth}},
+          {"jenkins", {parametric(Term::jenkins, {1.0e4, 3.0})}},
+          {"iwan", {parametric(Term::iwan, {3.0, 1.0e4, -0.5, 0.1})}},
+          {"gap", {parametric(Term::gap, {5e-3, 2e4})}},
+          {"friction", {make("tip", 7, 0, {Term::k, Term::c, Term::fc}, {4800.0, 20.0, 3.0})}},
+          {"two joints",
+           {make("tip", 7, 0, {Term::k, Term::c, Term::k3}, {4800.0, 20.0, 1.6e8}),
+            make("mid", 4, 0, {Term::k, Term::c, Term::fc}, {2.0e4, 10.0, 4.0})}}};
+}
+
+struct SavedRoutes {
+  int fft = frf::detail::Equations::fft_from, free = frf::detail::Equations::matrix_free_from;
+  ~SavedRoutes() {
+    frf::detail::Equations::fft_from = fft, frf::detail::Equations::matrix_free_from = free;
+  }
+};
+
+} // namespace
+
+TEST(HarmonicBalance, TheMatrixFreeJacobianIsTheFormedOne) {
+  // jacobian_times() (products by FFT from the residual's samples) against the Jacobian that
+  // jacobian() forms, on random directions, at the steady state of 40 N at 3 Hz (the sliders
+  // slip, the gap closes, the friction sticks and slips) and off it (1.3 times): equal to
+  // rounding, 1e-12 of |J| |v|. And the line preconditioner: exact for linear joints (k, c):
+  // preconditioned, J v comes back as v. (The dense route, so that jacobian() can form J.)
+  const SavedRoutes saved;
+  frf::detail::Equations::matrix_free_from = 1 << 30;
+  const PaperCantilever c;
+  for (const auto& [name, js] : matrix_free_cases()) {
+    SCOPED_TRACE(name);
+    frf::HarmonicBalanceOptions o;
+    o.harmonics = 60;
+    o.half_wave_symmetry = false;
+    const frf::HarmonicBalance problem(c.H, js, c.system.dofs, {c.eq(7)}, {c.eq(7)}, 3.0, o);
+    const frf::HarmonicBalanceResult solved = problem.solve(js, frf::sine_force(40.0));
+    ASSERT_TRUE(solved.status.ok()) << solved.status.reason;
+    const auto P = problem.equations(js, frf::sine_force(40.0));
+    ASSERT_TRUE(P->by_fft());
+    Eigen::VectorXd z = problem.first_guess(*P, &solved.Y);
+    for (const double scale : {1.0, 1.3}) {
+      const Eigen::VectorXd at = scale * z;
+      Eigen::MatrixXd J;
+      P->residual(at, 1.0, &J);
+      std::srand(7);
+      for (int trial = 0; trial < 3; ++trial) {
+        const Eigen::VectorXd v = Eigen::VectorXd::Random(P->size());
+        Eigen::VectorXd Jv;
+        P->jacobian_times(v, Jv);
+        EXPECT_LE((Jv - J * v).norm(), 1e-12 * J.norm() * v.norm()) << scale;
+      }
+    }
+  }
+  const std::vector<joints::Joint> linear{make("tip", 7, 0, {Term::k, Term::c}, {4800.0, 20.0})};
+  frf::HarmonicBalanceOptions o;
+  o.harmonics = 60;
+  const frf::HarmonicBalance problem(c.H, linear, c.system.dofs, {c.eq(7)}, {c.eq(7)}, 3.0, o);
+  const auto P = problem.equations(linear, frf::sine_force(40.0));
+  const Eigen::VectorXd z = problem.first_guess(*P, nullptr);
+  P->residual(z, 1.0, nullptr);
+  P->prepare_preconditioner();
+  const Eigen::VectorXd v = Eigen::VectorXd::Random(P->size());
+  Eigen::VectorXd Jv, back;
+  P->jacobian_times(v, Jv);
+  P->precondition(Jv, back);
+  EXPECT_LE((back - v).norm(), 1e-12 * v.norm());
+}
+
+TEST(HarmonicBalance, NewtonKrylovSolvesAsTheDenseNewton) {
+  // The matrix-free route (Equations::matrix_free_from lowered to every size, so that both run
+  // at 60 harmonics) against the dense one: the same steady state, to the solves' tolerance
+  // (1e-12 of |Y|: 1e-9 asserted), half-wave symmetric and not; and the same output
+  // derivatives (implicit differentiation by GMRES to 1e-10 against the factorisation: 1e-7).
+  const SavedRoutes saved;
+  const PaperCantilever c;
+  for (const bool symmetric : {false, true})
+    for (const auto& [name, js] : matrix_free_cases()) {
+      SCOPED_TRACE(name + std::string(symmetric ? ", symmetric" : ""));
+      frf::HarmonicBalanceOptions o;
+      o.harmonics = 60;
+      o.half_wave_symmetry = symmetric;
+      std::vector<frf::HarmonicBalanceResult> solved;
+      std::vector<std::vector<Eigen::MatrixXcd>> derivatives;
+      // k (a coefficient), and the third term's first parameter, or its value (k3: a
+      // coefficient; fc: re-simulated equations)
+      std::vector<std::vector<joints::Joint>> moved(2, js);
+      std::vector<double> steps{js[0].values[0] * 1e-6};
+      moved[0][0].values[0] += steps[0];
+      if (js[0].has_parametric_terms()) {
+        steps.push_back(js[0].parameters[2][0].value * 1e-6);
+        moved[1][0].parameters[2][0].value += steps[1];
+      } else {
+        steps.push_back(js[0].values[2] * 1e-6);
+        moved[1][0].values[2] += steps[1];
+      }
+      for (const bool free : {false, true}) {
+        frf::detail::Equations::fft_from = 1;
+        frf::detail::Equations::matrix_free_from = free ? 1 : 1 << 30;
+        const frf::HarmonicBalance problem(c.H, js, c.system.dofs, {c.eq(7)}, {c.eq(7), c.eq(4)},
+                                           3.0, o);
+        ASSERT_EQ(problem.equations(js, frf::sine_force(40.0))->matrix_free(), free);
+        solved.push_back(problem.solve(js, frf::sine_force(40.0)));
+        ASSERT_TRUE(solved.back().status.ok()) << solved.back().status.reason;
+        derivatives.push_back(
+            problem.output_derivatives(js, frf::sine_force(40.0), solved.back().Y, moved, steps));
+      }
+      const auto& [dense, free] = std::pair{solved[0], solved[1]};
+      EXPECT_LE((free.X - dense.X).norm(), 1e-9 * dense.X.norm());
+      EXPECT_GT(dense.X.bottomRows(50).norm(), 1e-6 * dense.X.norm()); // harmonics are there
+      ASSERT_EQ(derivatives[0].size(), 2u);
+      ASSERT_EQ(derivatives[1].size(), 2u);
+      for (std::size_t p = 0; p < 2; ++p) {
+        if (derivatives[0][p].size() == 0) continue; // (a move the dense route re-simulates)
+        ASSERT_EQ(derivatives[1][p].size(), derivatives[0][p].size());
+        // (as changes of the outputs over the step: a derivative that is zero to rounding, the
+        // kt of a Jenkins element in macroslip, compared at rounding level, 1e-13 of |X|)
+        EXPECT_LE((derivatives[1][p] - derivatives[0][p]).norm() * steps[p],
+                  1e-7 * derivatives[0][p].norm() * steps[p] + 1e-13 * dense.X.norm())
+            << p;
+      }
+    }
+}
+
 TEST(HarmonicBalance, ParametricTermsOutOfRangeAreRefusedNamingTheKey) {
   const PaperCantilever c;
   joints::Joint j = parametric(Term::iwan, {3.0, 1.0e4, 0.5, 0.1});
