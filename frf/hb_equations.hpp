@@ -359,7 +359,8 @@ struct Equations {
   // kept samples are the first half, the second half the first negated (odd harmonics) or
   // repeated (a weight of even harmonics).
   bool by_fft() const { return m() >= fft_from; }
-  bool matrix_free() const { return by_fft() && m() >= matrix_free_from; }
+  // (Decided when the tables were chosen, HarmonicBalance's construction: they are left out.)
+  bool matrix_free() const { return dy.size() == 0; }
   int period_samples() const { return symmetric() ? 2 * Nt : Nt; }
   static fem::RealFft& fft(int n) {
     thread_local std::map<int, std::unique_ptr<fem::RealFft>> plans;
@@ -554,6 +555,17 @@ struct Equations {
   // the samples it kept: Newton needs it only where it takes a step from.
   void jacobian(Eigen::MatrixXd& J) const {
     Scratch& s = scratch();
+    if (matrix_free()) { // (the continuation's and the backbone's: column by column)
+      J.resize(size(), size());
+      Eigen::VectorXd unit = Eigen::VectorXd::Zero(size()), column;
+      for (int c = 0; c < size(); ++c) {
+        unit(c) = 1.0;
+        jacobian_times(unit, column);
+        J.col(c) = column;
+        unit(c) = 0.0;
+      }
+      return;
+    }
     J.setIdentity(size(), size());
     for (int b = 0; b < nj; ++b) {
       const Scratch::Matrix& g = s.g[static_cast<std::size_t>(b)];

@@ -733,8 +733,11 @@ TEST(HarmonicBalance, ManyHarmonicsGiveTheSameEquationsByFftAsByTheTables) {
   // half-wave symmetric and not, at 60 harmonics (121 and 60 unknowns a block), at the solution
   // at 40 N near resonance (the sliders slip, the gap is closed for part of the period), and off
   // it (1.3 times the solution).
+  // (The dense Newton's route, tabulated: Equations::matrix_free_from out of reach.)
   const PaperCantilever c;
   const int saved = frf::detail::Equations::fft_from;
+  const int saved_free = frf::detail::Equations::matrix_free_from;
+  frf::detail::Equations::matrix_free_from = 1 << 30;
   joints::Joint smooth =
       make("tip", 7, 0, {Term::k, Term::c, Term::k3, Term::c2}, {4800.0, 20.0, 1.6e8, 500.0});
   for (const bool symmetric : {false, true})
@@ -777,6 +780,7 @@ TEST(HarmonicBalance, ManyHarmonicsGiveTheSameEquationsByFftAsByTheTables) {
       // closes (beyond 5 mm)
       EXPECT_GT(std::abs(solved.Y(1, 0)), j.term_index(Term::gap) >= 0 ? 5e-3 : 3e-4);
     }
+  frf::detail::Equations::matrix_free_from = saved_free;
 }
 
 namespace {
@@ -837,6 +841,15 @@ TEST(HarmonicBalance, TheMatrixFreeJacobianIsTheFormedOne) {
         P->jacobian_times(v, Jv);
         EXPECT_LE((Jv - J * v).norm(), 1e-12 * J.norm() * v.norm()) << scale;
       }
+      // A matrix-free problem still forms J when asked (the continuation's), by its products.
+      frf::detail::Equations::matrix_free_from = 1;
+      const frf::HarmonicBalance free(c.H, js, c.system.dofs, {c.eq(7)}, {c.eq(7)}, 3.0, o);
+      const auto Pf = free.equations(js, frf::sine_force(40.0));
+      frf::detail::Equations::matrix_free_from = 1 << 30;
+      ASSERT_TRUE(Pf->matrix_free());
+      Eigen::MatrixXd Jf;
+      Pf->residual(at, 1.0, &Jf);
+      EXPECT_LE((Jf - J).norm(), 1e-12 * J.norm()) << scale;
     }
   }
   const std::vector<joints::Joint> linear{make("tip", 7, 0, {Term::k, Term::c}, {4800.0, 20.0})};
