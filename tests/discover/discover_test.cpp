@@ -801,10 +801,10 @@ TEST(Discover, AFrictionAndAWideClearanceUnderSineTestsAreNamedTogether) {
   EXPECT_LT(r.gap.back(), 2.0 * std::hypot(r.noise_gap, r.simulation_gap));
 }
 
-// A periodic test re-simulated through measured FRFs needs them to twice line max(K, 10) × its
-// highest driven line: lines 4 and 6 every 0.25 Hz, K = 3: line 60, 15 Hz, doubled 30 Hz; FRFs to
-// 20 Hz are refused, naming the test and saying how far to measure.
-TEST(Discover, APeriodicTestBeyondTheMeasuredFrfsBandIsRefusedNamingIt) {
+namespace {
+
+// The cantilever's tip receptance sampled every 0.05 Hz to 20 Hz, as a measured-FRF substructure.
+frf::MeasuredFrf tip_frf_to_20_hz() {
   const frf::Substructure model(test::paper_cantilever());
   const int tip = model.dofs().equation({7, fem::Dof::uy});
   const frf::ModalSynthesis H = model.synthesis({tip}, 100.0);
@@ -817,22 +817,53 @@ TEST(Discover, APeriodicTestBeyondTheMeasuredFrfsBandIsRefusedNamingIt) {
     f.receptance.push_back(H.receptance(2.0 * std::numbers::pi * 0.05 * i, e, e)(0, 0));
   }
   frf.functions.push_back(f);
-  std::vector<std::complex<double>> X(7, 1e-4);
+  return frf;
+}
+
+// A multisine test every 0.25 Hz, lines 4 and 6 excited by 10 N, `other` N at line 8 (not
+// excited), its force's noise unknown.
+identify::Measurement multisine_with_line_8(double other) {
+  std::vector<std::complex<double>> X(9, 1e-4);
   identify::Measurement m =
-      test::measurement("multisine.csv", 0.25, 0.0, X, std::vector<double>(7, 1e-12));
+      test::measurement("multisine.csv", 0.25, 0.0, X, std::vector<double>(9, 1e-12));
   m.kind = identify::RecordKind::periodic;
-  m.F(4, 0) = 10.0, m.F(6, 0) = 10.0;
+  m.F(4, 0) = 10.0, m.F(6, 0) = 10.0, m.F(8, 0) = other;
   m.lines = m.excited_lines = {4, 6};
+  return m;
+}
+
+// The refusal of a periodic test whose balance reaches past the measured FRFs.
+std::string refusal_at_20_hz(const identify::Measurement& m) {
   try {
-    (void)discover::discover(frf::Substructure(frf), {linear_start("tip", 7)}, {m});
-    ADD_FAILURE() << "a band to 20 Hz was accepted";
+    (void)discover::discover(frf::Substructure(tip_frf_to_20_hz()), {linear_start("tip", 7)}, {m});
   } catch (const std::invalid_argument& e) {
-    EXPECT_STREQ(e.what(), "multisine.csv: the measured FRFs reach 20 Hz; this periodic test's "
-                           "re-simulation needs 30 Hz (twice line 60: the joints' response up to "
-                           "10 times its highest driven line, doubled to estimate the "
-                           "simulation's own error). Measure the FRFs to that, or use fewer of "
-                           "its lines (--band)");
+    return e.what();
   }
+  return "a band to 20 Hz was accepted";
+}
+
+} // namespace
+
+// A periodic test re-simulated through measured FRFs needs them to twice line max(K, 10) × its
+// highest driven line: lines 4 and 6 every 0.25 Hz, K = 3: line 60, 15 Hz, doubled 30 Hz; FRFs to
+// 20 Hz are refused, naming the test and saying how far to measure.
+TEST(Discover, APeriodicTestBeyondTheMeasuredFrfsBandIsRefusedNamingIt) {
+  EXPECT_EQ(refusal_at_20_hz(multisine_with_line_8(0.0)),
+            "multisine.csv: the measured FRFs reach 20 Hz; this periodic test's "
+            "re-simulation needs 30 Hz (twice line 60: the joints' response up to "
+            "10 times its highest driven line, doubled to estimate the "
+            "simulation's own error). Measure the FRFs to that, or use fewer of "
+            "its lines (--band)");
+}
+
+// A line the periodic test does not excite drives its re-simulation (and sets how far its
+// balance reaches) only above 1e-3 of its largest excited line, whatever its noise: 1 % of it
+// at line 8 takes the balance to line 80 (twice: 40 Hz), 1e-4 of it leaves line 60 (30 Hz).
+TEST(Discover, APeriodicTestsLineFarBelowItsExcitedOnesDoesNotDriveIt) {
+  EXPECT_NE(refusal_at_20_hz(multisine_with_line_8(0.1)).find("needs 40 Hz (twice line 80"),
+            std::string::npos);
+  EXPECT_NE(refusal_at_20_hz(multisine_with_line_8(1e-3)).find("needs 30 Hz (twice line 60"),
+            std::string::npos);
 }
 
 TEST(Discover, BadInputIsRefusedWithTheReason) {
