@@ -123,6 +123,23 @@ fem::GmresResult krylov_solve(const Equations& P, const Eigen::VectorXd& b, Eige
                     b, x, g);
 }
 
+// Backtracking along a Newton step: the first of step, step/2, … (30 halvings) that lowers the
+// residual's norm is taken (z and r moved there, zt and rt work arrays). False: none did.
+bool backtrack(const Equations& P, double load, const Eigen::VectorXd& step, Eigen::VectorXd& z,
+               Eigen::VectorXd& r, Eigen::VectorXd& zt, Eigen::VectorXd& rt) {
+  const double r_norm = r.norm();
+  double t = 1.0;
+  for (int ls = 0; ls < 30; ++ls, t *= 0.5) {
+    zt.noalias() = z + t * step;
+    P.residual(zt, load, rt, nullptr);
+    if (rt.allFinite() && rt.norm() < r_norm) {
+      z.swap(zt), r.swap(rt);
+      return true;
+    }
+  }
+  return false;
+}
+
 // newton() without a matrix (Equations::matrix_free()): Newton–Krylov, the same backtracking.
 bool newton_krylov(const Equations& P, Eigen::VectorXd& z, double load,
                    const HarmonicBalanceOptions& o, int& iterations, double& res_norm) {
@@ -141,17 +158,8 @@ bool newton_krylov(const Equations& P, Eigen::VectorXd& z, double load,
     const fem::GmresResult solved =
         krylov_solve(P, -r, step, krylov_options(res_norm, o.tolerance));
     if (!step.allFinite() || !(solved.residual < 1.0)) return false;
-    double t = 1.0;
-    bool improved = false;
     const double r_norm = r.norm();
-    for (int ls = 0; ls < 30; ++ls, t *= 0.5) {
-      zt.noalias() = z + t * step;
-      P.residual(zt, load, rt, nullptr);
-      if (rt.allFinite() && rt.norm() < r_norm) {
-        z.swap(zt), r.swap(rt), improved = true;
-        break;
-      }
-    }
+    const bool improved = backtrack(P, load, step, z, r, zt, rt);
     if (!improved) return res_norm < o.tolerance;
     creeping = r.norm() > 0.99 * r_norm ? creeping + 1 : 0;
     if (creeping == 4) break;
@@ -206,17 +214,7 @@ bool detail::newton(const Equations& P, Eigen::VectorXd& z, double load,
       cod.setThreshold(1e-13);
       step = cod.solve(-r);
     }
-    double t = 1.0;
-    bool improved = false;
-    const double r_norm = r.norm();
-    for (int ls = 0; ls < 30; ++ls, t *= 0.5) {
-      zt.noalias() = z + t * step;
-      P.residual(zt, load, rt, nullptr);
-      if (rt.allFinite() && rt.norm() < r_norm) {
-        z.swap(zt), r.swap(rt), improved = true;
-        break;
-      }
-    }
+    const bool improved = backtrack(P, load, step, z, r, zt, rt);
     if (!improved) return res_norm < o.tolerance;
     // The last residual evaluated is the accepted point's: its Jacobian, unless it converged.
     if (r.norm() / std::max(P.norm(z), 1e-300) >= o.tolerance) P.jacobian(J);
