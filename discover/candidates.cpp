@@ -65,6 +65,7 @@ Outcome consider_term(const Problem& problem, const State& state, const Simulato
     const identify::FitResult fit = problem.identify(joints, sim, problem.all_tests());
     joints = fit.identified(joints);
     take_fit(c, fit, joint, term);
+    c.equation_residual = fit.residual_relative;
     // Not simulated: negative dry friction has no steady state to compare.
     if (const std::string why = friction_problem(joints); !why.empty())
       return refused(std::move(c), state, why);

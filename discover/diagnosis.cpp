@@ -452,6 +452,17 @@ JointBehaviour behaviour(const std::string& joint,
       "Joint '{}': its dissipation per cycle beyond the viscous part grows as the amplitude to the "
       "power {:.2g} (up to {} of it) and its stiffness {} over the amplitudes",
       joint, b.slope, pct(b.hysteretic_share), stiffness_change_text(b));
+  // Slip softens a joint: a smooth dissipation (power 2.2 or more) beside a stiffness that
+  // rises over the amplitudes is more likely a damping that grows with the velocity (power 3
+  // for a velocity-squared damping, 4 for a cubic one) beside a hardening; or slip and a contact
+  // at once. It is not named.
+  if (b.slope >= 2.2 && b.stiffness_change > 0.02 && k_low > 0.0) {
+    b.finding = grows + ": not slip alone, which softens a joint — a damping that grows with "
+                        "the velocity (power 3 for velocity-squared damping, 4 for cubic) beside "
+                        "a hardening (a cubic stiffness or a contact), or slip and a contact at "
+                        "once.";
+    return b;
+  }
   if (b.slope < 1.6) {
     b.behaviour = "macroslip";
     b.finding = grows + ": macroslip — the joint slides, dissipating like Coulomb friction "

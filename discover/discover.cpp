@@ -119,6 +119,7 @@ public:
         out.diagnosis.findings.push_back(said);
       }
     }
+    if (prune(out, state)) simulation_gap = -1.0;
     finish(out, state, simulation_gap);
     return out;
   }
@@ -141,7 +142,15 @@ private:
             number(state.gap), number(problem_.compared().noise_gap), number(simulation_gap));
         break;
       }
-      if (!add_the_best(step, state, out)) break;
+      if (!add_the_best(step, state, out)) {
+        // The best explanation outside the library: unless the library's terms, one or two
+        // more, explain more (look_ahead).
+        const int taken = outside_ && !library_only_ ? look_ahead(step, state, out) : 0;
+        if (taken == 0) break;
+        step += taken - 1;
+        simulation_gap = -1.0;
+        continue;
+      }
       simulation_gap = -1.0;
       if (step == 0 && screen_first_path_ && !avoid_ && parametric_first(out)) {
         after_first_.emplace(out, state);
@@ -152,6 +161,159 @@ private:
     }
     screening_ = false;
     return simulation_gap;
+  }
+
+  // When a coefficient with a value per test (outside the library) is the best explanation at
+  // `step`, the library may still explain more with two terms than with one: two effects
+  // missing at once (a cubic stiffness and a quadratic damping) each explain less alone than a
+  // stiffness per test, which absorbs part of both. So the best admissible term of the library
+  // is added on trial and, unless that alone does, the step after it taken too; the terms are
+  // kept where the model they give ends below the variation's criterion. Returns the steps
+  // kept (0: none, `out` and `state` as they were, the stop reason saying what was tried).
+  int look_ahead(int step, State& state, Result& out) {
+    const Candidate outside = *outside_;
+    Result trial = out;
+    State trial_state = state;
+    trial.stop_reason.clear();
+    trial.last_ranking.clear();
+    library_only_ = true;
+    const bool first = add_the_best(step, trial_state, trial);
+    library_only_ = false;
+    outside_.reset();
+    kept_.reset();
+    if (!first) return 0;
+    int taken = 1;
+    if (!(trial_state.criterion < outside.criterion) && step + 1 < o_.max_steps &&
+        !at_noise_level(problem_.compared(), trial_state)) {
+      if (add_the_best(step + 1, trial_state, trial)) taken = 2;
+      outside_.reset(), kept_.reset();
+    }
+    const std::string compared = fmt::format(
+        "{} ends at a criterion of {} (gap {}); {} at {} (gap {})", path(trial, out.steps.size()),
+        number(trial_state.criterion), number(trial_state.gap), outside.name(),
+        number(outside.criterion), number(outside.gap));
+    if (!(trial_state.criterion < outside.criterion)) {
+      out.stop_reason +=
+          fmt::format("; the library's best path from here, {}: not lower", compared);
+      return 0;
+    }
+    trial.diagnosis.findings.push_back(fmt::format(
+        "At step {} the best single explanation was outside the library ({}). But the "
+        "library's best path from there, {}: so the terms were added (two effects missing at "
+        "once can each explain less alone than a coefficient per test, which absorbs part of "
+        "both).",
+        out.steps.size() + 1, outside.varies ? outside.varies->description : outside.name(),
+        compared));
+    out = std::move(trial);
+    state = std::move(trial_state);
+    return taken;
+  }
+
+  // 3. Backward: the forward search never takes a term back out, so a term added early can
+  // stand for effects that the terms added after it explain better (a cubic damping chosen first
+  // for the velocity-squared damping added later). Each coefficient term added (but the last,
+  // whose addition judged exactly that) is taken out in turn and the model without it
+  // identified again by output error; judged as an addition to that model, a term that would
+  // not be added now (rule 3: it does not lower the criterion; rule 4: it explains less than
+  // min_explained) is taken out — where several, the one whose model has the lowest criterion
+  // — as a step of its own, and the others are judged again. True if any was taken out.
+  bool prune(Result& out, State& state) {
+    bool any = false;
+    for (bool first_round = true;; first_round = false) {
+      struct Trial {
+        std::size_t joint, term;
+      };
+      std::vector<Trial> trials;
+      for (std::size_t i = 0; i < out.steps.size(); ++i) {
+        const Candidate& c = out.steps[i].added;
+        if (out.steps[i].removed || c.refit || c.varies || !c.term ||
+            joints::has_parameters(*c.term) || (first_round && i + 1 == out.steps.size()))
+          continue;
+        for (std::size_t j = 0; j < state.joints.size(); ++j)
+          if (const int t = state.joints[j].term_index(*c.term);
+              state.joints[j].name == c.joint && t >= 0 &&
+              !state.joints[j].fixed[static_cast<std::size_t>(t)])
+            trials.push_back({j, static_cast<std::size_t>(t)});
+      }
+      if (trials.empty()) return any;
+      const Simulator& sim = problem_.simulator(state.damping_scale);
+      std::vector<std::function<State()>> jobs;
+      for (const Trial& t : trials)
+        jobs.push_back([&, t] {
+          std::vector<joints::Joint> without = state.joints;
+          remove_term(without[t.joint], t.term);
+          // Started as a candidate is, from equation error with every test: the other terms'
+          // values as they are would drive the model without it far from the measurement (a
+          // cubic stiffness without the damping that held its resonance down), where a
+          // re-simulation costs the most.
+          identify::FitResult fit = state.fit;
+          try {
+            fit = problem_.identify(without, sim, problem_.all_tests());
+            without = fit.identified(without);
+          } catch (const std::invalid_argument&) {
+            // (the values as they are)
+          }
+          State start = problem_.evaluate(without, sim, &state);
+          start.fit = fit;
+          if (!std::isfinite(start.criterion)) return start;
+          return refine(problem_, start, sim, scope());
+        });
+      std::vector<State> models = fem::parallel_map(jobs);
+      std::optional<std::size_t> best;
+      Candidate judged;
+      for (std::size_t i = 0; i < trials.size(); ++i) {
+        const State& m = models[i];
+        if (!std::isfinite(m.criterion) || m.failed.size() > state.failed.size()) continue;
+        Candidate c;
+        c.criterion = state.criterion, c.gap = state.gap, c.chi2 = state.chi2;
+        c.explained = explained(state.gap, m.gap);
+        c.chi2_explained = std::isfinite(state.chi2) && m.chi2 > 0.0
+                               ? 1.0 - state.chi2 / m.chi2
+                               : std::numeric_limits<double>::quiet_NaN();
+        std::string why = criterion_problem(c, m.criterion);
+        if (why.empty()) why = explained_problem(c, o_.min_explained);
+        if (why.empty()) continue;
+        if (!best || m.criterion < models[*best].criterion)
+          best = i, judged = c, judged.rejected = why;
+      }
+      if (!best) return any;
+      const joints::Joint& j = state.joints[trials[*best].joint];
+      const std::size_t t = trials[*best].term;
+      Step s;
+      s.removed = true;
+      s.added.joint = j.name;
+      s.added.term = j.terms[t];
+      s.added.value = j.values[t];
+      take_fit(s.added, state.fit, j.name, j.terms[t]); // its value and interval before
+      s.added.criterion = models[*best].criterion;
+      s.added.gap = models[*best].gap;
+      s.added.explained = explained(models[*best].gap, state.gap); // (the removal's)
+      s.gap_before = state.gap;
+      s.gap_after = models[*best].gap;
+      s.finding = fmt::format(
+          "Took out {} ({}), added before the terms that now explain what it did: without it the "
+          "model, identified again, leaves a gap of {} (from {}), and as an addition to that "
+          "model it would be rejected ({}).",
+          s.added.name(), s.added.effect(), number(s.gap_after), number(s.gap_before),
+          judged.rejected);
+      state = std::move(models[*best]);
+      warn_left_out(out, state,
+                    "the model after step " + std::to_string(out.steps.size() + 1) + " (− " +
+                        s.added.name() + ")");
+      out.stop_reason += fmt::format("; then, backward, {} was taken out (gap {})", s.added.name(),
+                                     number(s.gap_after));
+      out.steps.push_back(std::move(s));
+      out.states.push_back(state);
+      any = true;
+    }
+  }
+
+  // `term` of `j` taken out (its value, fixed flag, given flag and parameters with it).
+  static void remove_term(joints::Joint& j, std::size_t term) {
+    const auto at = [term](auto& v) {
+      if (term < v.size()) v.erase(v.begin() + static_cast<std::ptrdiff_t>(term));
+    };
+    at(j.terms), at(j.values), at(j.fixed), at(j.given), at(j.parameters);
   }
 
   // The first step of `r` added a parametric term.
@@ -174,11 +336,11 @@ private:
     });
   }
 
-  // "(k3 at 'tip', then c3 at 'tip')".
-  static std::string path(const Result& r) {
+  // "(k3 at 'tip', then c3 at 'tip')": the steps of `r` from `from` on.
+  static std::string path(const Result& r, std::size_t from = 0) {
     std::vector<std::string> names;
-    for (const Step& s : r.steps)
-      names.push_back(s.added.name());
+    for (std::size_t i = from; i < r.steps.size(); ++i)
+      names.push_back(r.steps[i].added.name());
     return "(" + fmt::format("{}", fmt::join(names, ", then ")) + ")";
   }
 
@@ -359,9 +521,14 @@ private:
     std::vector<Candidate> ranking;
     std::vector<State> states;
     std::vector<std::size_t> order;
+    outside_.reset();
     const bool cached = step == 0 && first_.has_value();
     if (cached) { // the first step of a second path: its candidates are the first path's
       ranking = first_->ranking, states = first_->states, order = first_->order;
+    } else if (library_only_ && kept_ && kept_->step == step) { // a look-ahead: the same step's
+      ranking = std::move(kept_->ranking), states = std::move(kept_->states);
+      order = std::move(kept_->order);
+      kept_.reset();
     } else {
       const auto jobs = candidate_jobs(problem_, state, current, values_fitted_);
       if (jobs.empty()) {
@@ -378,6 +545,8 @@ private:
       std::erase_if(open, [&](std::size_t i) {
         return ranking[i].term && joints::has_parameters(*ranking[i].term);
       });
+    if (library_only_)
+      std::erase_if(open, [&](std::size_t i) { return ranking[i].varies.has_value(); });
     std::map<std::vector<int>, CrossValidation> cv_now;
     const Choice choice = choose(
         ranking, open, [&](std::size_t i) { return cross_validated_now(state, states[i], cv_now); },
@@ -411,10 +580,13 @@ private:
       if (choice.outside) {
         out.stop_reason = outside_the_library(ranking, order, *choice.outside, state.gap);
         out.diagnosis.findings.push_back(ranking[*choice.outside].varies->description);
+        outside_ = ranking[*choice.outside];
       } else {
         out.stop_reason = nothing_added(ranking, order, state);
       }
       out.last_ranking = std::move(s.ranking);
+      if (outside_ && !cached)
+        kept_ = Kept{std::move(ranking), std::move(states), std::move(order), step};
       return false;
     }
     s.added = ranking[*choice.chosen];
@@ -526,14 +698,26 @@ private:
     Diagnosis diagnosis;
   };
 
+  // A step's candidates, kept where it stopped at an explanation outside the library: a
+  // look-ahead chooses among them again.
+  struct Kept {
+    std::vector<Candidate> ranking;
+    std::vector<State> states;
+    std::vector<std::size_t> order;
+    int step = -1;
+  };
+
   Problem& problem_;
   const Options& o_;
-  bool values_fitted_ = false;      // the model's values were identified (not all given)
-  std::optional<FirstStep> first_;  // once the first step's candidates were tried
-  bool coefficients_first_ = false; // the first step takes a coefficient term only
-  std::optional<Candidate> avoid_;  // a second path stops when it adds this term
-  bool screen_first_path_ = false;  // the first path is screened past its first step
-  bool screening_ = false;          // candidates are refined on the spread of tests alone
+  std::optional<Kept> kept_;         // the candidates of a step that stopped outside the library
+  std::optional<Candidate> outside_; // the last step stopped at it (a value per test)
+  bool library_only_ = false;        // the step chooses among the library's terms alone
+  bool values_fitted_ = false;       // the model's values were identified (not all given)
+  std::optional<FirstStep> first_;   // once the first step's candidates were tried
+  bool coefficients_first_ = false;  // the first step takes a coefficient term only
+  std::optional<Candidate> avoid_;   // a second path stops when it adds this term
+  bool screen_first_path_ = false;   // the first path is screened past its first step
+  bool screening_ = false;           // candidates are refined on the spread of tests alone
   std::optional<std::pair<Result, State>> after_first_; // a screened path, after its first step
   double screened_best_ = inf; // the lowest criterion a screened path met (its candidates too)
 };

@@ -53,12 +53,19 @@
 /// no term of the library has (e.g. a friction whose normal load falls as the vibration grows).
 /// It is admissible when the per-test values disagree beyond their intervals (and by rules 3 and
 /// 4); it is never added, but when it is the best admissible candidate the loop stops and says
-/// which coefficient changes, with what, and how much of the gap that explains (Variation).
+/// which coefficient changes, with what, and how much of the gap that explains (Variation) —
+/// unless the library's best admissible term, and the best addition after it where that one
+/// alone does not, end below the variation's criterion: two effects missing at once (a cubic
+/// stiffness and a velocity-squared damping) can each explain less alone than a stiffness per
+/// test, which absorbs part of both. Those terms are then added and the loop goes on.
 /// The per-test values show the trend; where the held terms took over part of the effect in
 /// the all-test fit (a viscous c absorbing friction), they are biased towards the mean.
 /// The admissible candidate with the lowest criterion is added. The loop stops at the noise
 /// level — χ²/N at most 3 standard deviations (3 √(2/N)) above 1, overall and for every compared
-/// harmonic on its own — when no candidate is admissible, or after max_steps.
+/// harmonic on its own — when no candidate is admissible, or after max_steps. Then, backward:
+/// each coefficient term added is taken out in turn and the model without it identified again by
+/// output error; one that would not be added to that model now (rules 3 and 4) is taken out, as
+/// a step of its own (Step::removed), the one whose model has the lowest criterion first.
 #include "frf/harmonic_balance.hpp"
 #include "frf/substructure.hpp"
 #include "identify/fit.hpp"
@@ -93,7 +100,9 @@ struct Options {
   int folds = 10;
   /// Candidates refined by output error at each step (the best by the equation-error screen),
   /// and besides them the best parametric one where its describing-function start ranks among
-  /// the best finalists + 1.
+  /// the best finalists + 1, and the coefficient term whose equation-error fit leaves the
+  /// smallest residual (its start's re-simulation can misjudge it when a second effect is
+  /// missing too).
   int finalists = 3;
   /// Points of each state's response curves for the report (0: none).
   int curve_points = 30;
@@ -160,6 +169,9 @@ struct Candidate {
   double gap = 0.0;       ///< after adding it
   double criterion = 0.0; ///< information criterion after adding it
   double explained = 0.0; ///< share of the squared gap it removes (negative: worse)
+  /// A coefficient term: the relative residual of its equation-error fit (identify::FitResult::
+  /// residual_relative, every test), before any re-simulation; NaN for the others.
+  double equation_residual = std::numeric_limits<double>::quiet_NaN();
   /// With the noise known: its χ² (NaN otherwise), the model's before it on the same tests
   /// (< 0: the model's own), and the share of that χ² it removes (NaN: not known).
   double chi2 = std::numeric_limits<double>::quiet_NaN(), chi2_now = -1.0;
@@ -198,7 +210,10 @@ struct State {
 };
 
 struct Step {
+  /// The term added; or, `removed`, the term taken out again (a backward step after the
+  /// forward search: the terms added after it explain what it did), with its value before.
   Candidate added;
+  bool removed = false;
   double gap_before = 0.0, gap_after = 0.0;
   double cv_before = -1.0, cv_after = -1.0;
   std::vector<Candidate> ranking; ///< every candidate tried, lowest criterion first

@@ -125,9 +125,12 @@ std::string refit_finding(const Step& s, const std::vector<joints::Joint>& befor
 }
 
 std::string summary(const Result& r, const Compared& compared) {
-  std::string added;
+  std::string added, removed;
   for (const auto& s : r.steps)
-    added += (added.empty() ? "" : ", ") + s.added.name();
+    if (!s.removed) added += (added.empty() ? "" : ", ") + s.added.name();
+  for (const auto& s : r.steps)
+    if (s.removed) removed += (removed.empty() ? "" : ", ") + s.added.name();
+  if (!removed.empty()) removed = fmt::format(" (and took {} out again)", removed);
   const double first = r.gap.front(), last = r.gap.back();
   std::string floor;
   if (!compared.noise_known)
@@ -142,7 +145,7 @@ std::string summary(const Result& r, const Compared& compared) {
                          : fmt::format("not reached (χ² per value {:.3g})", r.chi2_per_value));
   if (added.empty())
     return fmt::format("Nothing was added: the gap stays at {}{}.", number(last), floor);
-  return fmt::format("Added {}: the gap shrank from {} to {} ({}× smaller){}.", added,
+  return fmt::format("Added {}{}: the gap shrank from {} to {} ({}× smaller){}.", added, removed,
                      number(first), number(last), number(first / std::max(last, 1e-300)), floor);
 }
 

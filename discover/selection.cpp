@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 namespace jointid::discover::detail {
@@ -269,6 +270,16 @@ std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int co
     }
     ++place;
   }
+  // The coefficient term whose equation error leaves the smallest residual: its re-simulated
+  // start (the other terms identified beside it by equation error) can rank low when a second
+  // effect is missing too, where output error would not.
+  std::optional<std::size_t> closest;
+  for (std::size_t i : by)
+    if (std::isfinite(ranking[i].criterion) && !ranking[i].varies && !ranking[i].with &&
+        std::isfinite(ranking[i].equation_residual) &&
+        (!closest || ranking[i].equation_residual < ranking[*closest].equation_residual))
+      closest = i;
+  if (closest && std::find(out.begin(), out.end(), *closest) == out.end()) out.push_back(*closest);
   return out;
 }
 

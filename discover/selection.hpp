@@ -111,8 +111,10 @@ Choice choose(std::vector<Candidate>& ranking, const std::vector<std::size_t>& o
 /// finite criterion, converged, not varying per test and not parametric; and besides them the
 /// best parametric one (jenkins, iwan, gap) when it ranks among the best `count` + 1 of all
 /// those (its start, a describing-function fit, screens it; output error gives its parameters
-/// and their intervals); and every pair of parametric terms (Candidate::with), which is only
-/// tried where the joint's stiffness falls and then rises over the tests.
+/// and their intervals); every pair of parametric terms (Candidate::with), which is only
+/// tried where the joint's stiffness falls and then rises over the tests; and the coefficient
+/// term whose equation-error fit leaves the smallest residual (Candidate::equation_residual),
+/// which its re-simulated start can misjudge when a second effect is missing too.
 std::vector<std::size_t> finalists(const std::vector<Candidate>& ranking, int count);
 
 // Cross-validation.

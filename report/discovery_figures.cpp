@@ -205,10 +205,12 @@ Figure stepped_sine_figure(const discover::Result& r, std::size_t step) {
           phase ? ""
                 : fmt::format("Before step {}: {}", step, model_text(r.states[step - 1])) + key,
           levels, phase));
-      f.charts.push_back(frf_chart(
-          after, r.curves[step], ch,
-          phase ? "" : fmt::format("After step {} (+ {})", step, r.steps[step - 1].added.name()),
-          levels, phase));
+      f.charts.push_back(frf_chart(after, r.curves[step], ch,
+                                   phase ? ""
+                                         : fmt::format("After step {} ({} {})", step,
+                                                       r.steps[step - 1].removed ? "−" : "+",
+                                                       r.steps[step - 1].added.name()),
+                                   levels, phase));
     }
   return f;
 }
@@ -329,9 +331,10 @@ Figure sine_figure(const discover::Result& r, std::size_t step) {
     f.charts.push_back(
         response_chart(before, r.curves[step - 1], ch,
                        fmt::format("Before step {}: {}", step, model_text(r.states[step - 1]))));
-    f.charts.push_back(
-        response_chart(after, r.curves[step], ch,
-                       fmt::format("After step {} (+ {})", step, r.steps[step - 1].added.name())));
+    f.charts.push_back(response_chart(after, r.curves[step], ch,
+                                      fmt::format("After step {} ({} {})", step,
+                                                  r.steps[step - 1].removed ? "−" : "+",
+                                                  r.steps[step - 1].added.name())));
   }
   return f;
 }

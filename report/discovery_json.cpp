@@ -233,6 +233,7 @@ std::string discovery_json(const discover::Result& r) {
     Json j = candidate_json(s.added);
     j.erase("gap");
     j.erase("admissible");
+    j["action"] = s.removed ? "removed" : "added";
     j["gap_before"] = number(s.gap_before);
     j["gap_after"] = number(s.gap_after);
     j["cv_gap_before"] = s.cv_before >= 0.0 ? number(s.cv_before) : Json(nullptr);

@@ -127,11 +127,12 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
       for (const auto& c : r.comparisons[i])
         if (!c.converged && (tests.empty() || tests.back() != c.test)) tests.push_back(c.test);
       if (tests.empty()) continue;
-      left_out +=
-          fmt::format("- {}: {}\n",
-                      i == 0 ? std::string("the starting model")
-                             : fmt::format("after step {} (+ {})", i, r.steps[i - 1].added.name()),
-                      listed(tests));
+      left_out += fmt::format("- {}: {}\n",
+                              i == 0 ? std::string("the starting model")
+                                     : fmt::format("after step {} ({} {})", i,
+                                                   r.steps[i - 1].removed ? "−" : "+",
+                                                   r.steps[i - 1].added.name()),
+                              listed(tests));
     }
     if (!left_out.empty())
       md += "## Tests left out\n\nTheir re-simulation did not converge, even from the measured "
@@ -164,13 +165,15 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   if (r.steps.empty()) {
     md += "Nothing was added.\n\n";
   } else {
-    md += "| step | added | effect | value | 95 % interval | gap before | gap after | explained "
+    md += "| step | added (− taken out) | effect | value | 95 % interval | gap before | gap after "
+          "| explained "
           "|\n|---|---|---|---|---|---|---|---|\n";
     for (std::size_t i = 0; i < r.steps.size(); ++i) {
       const auto& s = r.steps[i];
       const bool parametric = !s.added.parameters.empty();
-      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", i + 1, s.added.name(),
-                        s.added.effect(), parametric ? parameters_text(s.added) : g4(s.added.value),
+      md += fmt::format("| {} | {}{} | {} | {} | {} | {} | {} | {} |\n", i + 1,
+                        s.removed ? "− " : "", s.added.name(), s.added.effect(),
+                        parametric ? parameters_text(s.added) : g4(s.added.value),
                         parametric             ? std::string("(with each parameter)")
                         : s.added.determined() ? interval(s.added.ci_low, s.added.ci_high)
                                                : std::string("undetermined"),
@@ -205,7 +208,7 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
     c.log_y = true;
     c.x_categories.push_back("start");
     for (const auto& s : r.steps)
-      c.x_categories.push_back("+ " + short_name(s.added));
+      c.x_categories.push_back((s.removed ? "− " : "+ ") + short_name(s.added));
     Series gap;
     gap.label = "gap";
     gap.style = Series::Style::line_points;
@@ -272,11 +275,19 @@ std::vector<fs::path> write_discovery_report(const fs::path& dir, const discover
   };
   std::vector<Ranking> rankings;
   for (std::size_t i = 0; i < r.steps.size(); ++i)
-    rankings.push_back({fmt::format("Step {} (added {})", i + 1, r.steps[i].added.name()),
-                        &r.steps[i].ranking, r.steps[i].gap_before});
-  if (!r.last_ranking.empty())
-    rankings.push_back({fmt::format("Step {} (nothing added)", r.steps.size() + 1), &r.last_ranking,
-                        r.gap.back()});
+    if (!r.steps[i].removed) // (a backward step tried no candidates)
+      rankings.push_back({fmt::format("Step {} (added {})", i + 1, r.steps[i].added.name()),
+                          &r.steps[i].ranking, r.steps[i].gap_before});
+  if (!r.last_ranking.empty()) {
+    // Its candidates were tried on the model of the last addition (backward steps follow it).
+    std::size_t forward = r.steps.size();
+    while (forward > 0 && r.steps[forward - 1].removed)
+      --forward;
+    rankings.push_back({forward < r.steps.size()
+                            ? std::string("The forward search's last step (nothing added)")
+                            : fmt::format("Step {} (nothing added)", r.steps.size() + 1),
+                        &r.last_ranking, r.gap[forward]});
+  }
   for (std::size_t i = 0; i < rankings.size(); ++i) {
     const auto& [title, ranking, gap_now] = rankings[i];
     Chart c;

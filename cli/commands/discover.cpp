@@ -158,8 +158,8 @@ void Discover::print(const discover::Result& result) const {
              "gap before", "gap after");
   for (std::size_t i = 0; i < result.steps.size(); ++i) {
     const auto& s = result.steps[i];
-    fmt::print("{:<5} {:<28} {:<26} {:>12} {:>11.4g} {:>11.4g}\n", i + 1, s.added.name(),
-               s.added.effect(),
+    fmt::print("{:<5} {:<28} {:<26} {:>12} {:>11.4g} {:>11.4g}\n", i + 1,
+               (s.removed ? "− " : "") + s.added.name(), s.added.effect(),
                s.added.parameters.empty() ? fmt::format("{:.5g}", s.added.value) : "(below)",
                s.gap_before, s.gap_after);
     // A parametric term (and one added with it): its parameters below it.

@@ -89,6 +89,7 @@ void bind_discover(py::module_& m) {
             py::list out;
             for (const auto& s : self.result.steps) {
               py::dict d;
+              d["action"] = s.removed ? "removed" : "added";
               d["joint"] = s.added.joint;
               d["term"] = s.added.term ? std::string(joints::term_name(*s.added.term))
                                        : std::string("damping_scale");
@@ -104,7 +105,8 @@ void bind_discover(py::module_& m) {
             }
             return out;
           },
-          "The terms added, one dict per step: joint, term (and with: a second parametric term "
+          "The terms added, one dict per step: action (\"added\", or \"removed\": a term taken "
+          "out again after the forward search), joint, term (and with: a second parametric term "
           "added together), effect, value, ci95, gap_before, gap_after, finding.")
       .def_property_readonly(
           "final_joints",
@@ -132,7 +134,7 @@ void bind_discover(py::module_& m) {
       .def("__repr__", [](const DiscoveryResult& self) {
         std::vector<std::string> added;
         for (const auto& s : self.result.steps)
-          added.push_back(s.added.name());
+          added.push_back((s.removed ? "− " : "") + s.added.name());
         return fmt::format("<jointid.DiscoveryResult: {} step{}{}{}, gap {:.4g} → {:.4g}>",
                            self.result.steps.size(), self.result.steps.size() == 1 ? "" : "s",
                            added.empty() ? "" : ": ", fmt::join(added, ", "),

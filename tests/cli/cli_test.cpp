@@ -20,6 +20,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -750,6 +751,92 @@ TEST_F(CliTest, DiscoverTakesMultisineRecordsAndNamesAHiddenCubicStiffness) {
   ASSERT_EQ(j["gap"].size(), 2u);
   EXPECT_LT(j["gap"][1].get<double>(), 0.1 * j["gap"][0].get<double>());
   EXPECT_TRUE(j["at_noise_level"].get<bool>());
+}
+
+// Two effects hidden at once: a ground-vibration test's multisine records (2–15 Hz, period
+// 2.56 s, accelerations, 0.2 % noise, force at 4:uy) of the model with k3 = 1.6e8 N/m³ and
+// c2 = 500 N s²/m² at the tip, at five levels; discovery from k and c with every candidate.
+// - A stiffness with a value per test (it absorbs part of both effects) explains more than
+//   either term alone: discovery must not stop there, "not in the library", but look further.
+// - A term added early for what later terms explain better (here c3, before k3 and c2) must be
+//   taken out again by the backward step.
+// It ends with k3 and c2 near the truth and no c3.
+TEST_F(CliTest, DiscoverLooksPastAValuePerTestAndTakesOutWhatLaterTermsExplain) {
+  const fs::path data = dir() / "two_effects", out = dir() / "two_effects_out";
+  const fs::path truth = dir() / "k3_c2.toml", start = dir() / "linear_two.toml";
+  test::write_text(
+      truth,
+      test::replaced(test::replaced(test::cantilever_toml(), "terms = [\"k\", \"c\", \"k3\"]",
+                                    "terms = [\"k\", \"c\", \"c2\", \"k3\"]"),
+                     "values = { k = 4800.0, c = 20.0, k3 = 1.6e8 }",
+                     "values = { k = 4800.0, c = 20.0, c2 = 500.0, k3 = 1.6e8 }"));
+  test::write_text(start, linear_start_toml());
+  std::vector<std::string> args{"discover", start.string()};
+  for (const char* rms : {"5", "10", "20", "30", "40"}) {
+    const Outcome made = jointid({"simulate",
+                                  truth.string(),
+                                  "--excitation",
+                                  "multisine",
+                                  "--band",
+                                  "2:15",
+                                  "--rms",
+                                  rms,
+                                  "--duration",
+                                  "25.6",
+                                  "--period",
+                                  "2.56",
+                                  "--sample-rate",
+                                  "400",
+                                  "--force",
+                                  "4:uy",
+                                  "--outputs",
+                                  "7:uy,4:uy",
+                                  "--channels",
+                                  "a",
+                                  "--noise",
+                                  "0.002",
+                                  "--seed",
+                                  rms,
+                                  "-o",
+                                  data.string()},
+                                 dir());
+    ASSERT_EQ(made.status, 0) << made.err;
+    args.push_back((data / (std::string("multisine_2-15Hz_") + rms + "N.csv")).string());
+  }
+  args.insert(args.end(), {"--no-plot", "-o", out.string()});
+  const Outcome run = jointid(args, dir());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json j = json::parse(test::read_text(out / "discovery.json"));
+  // The final model: k3 and c2 within 1 % of the truth, k and c too (the records' time
+  // integration and noise leave a few 1e-3 on k, c and c2; their intervals from the period
+  // scatter are narrower than that: not asserted), and no c3.
+  const std::map<std::string, double> truths{
+      {"k", 4800.0}, {"c", 20.0}, {"c2", 500.0}, {"k3", 1.6e8}};
+  std::set<std::string> final_terms;
+  for (const json& t : j["final_model"]["joints"][0]["terms"]) {
+    const std::string term = t["term"].get<std::string>();
+    final_terms.insert(term);
+    if (truths.count(term)) {
+      EXPECT_NEAR(t["value"].get<double>(), truths.at(term), 0.01 * truths.at(term)) << term;
+    }
+  }
+  EXPECT_TRUE(final_terms.count("k3") && final_terms.count("c2")) << j["steps"].dump() << run.out;
+  EXPECT_EQ(final_terms.count("c3"), 0u) << j["steps"].dump();
+  // c3 was added first and taken out again, after the terms that explain what it did.
+  std::vector<std::string> steps;
+  for (const json& s : j["steps"])
+    steps.push_back(s["action"].get<std::string>() + " " + s["term"].get<std::string>());
+  ASSERT_FALSE(steps.empty());
+  EXPECT_EQ(steps.front(), "added c3") << j["steps"].dump();
+  EXPECT_EQ(steps.back(), "removed c3") << j["steps"].dump();
+  EXPECT_LT(j["gap"].back().get<double>(), 3.0 * j["noise_gap"].get<double>()) << j["gap"].dump();
+  // The report says why it went on past the value per test.
+  bool said = false;
+  for (const json& f : j["diagnosis"]["findings"])
+    said = said ||
+           f.get<std::string>().find("the best single explanation was outside the "
+                                     "library (k at 'tip' is not one number") != std::string::npos;
+  EXPECT_TRUE(said) << j["diagnosis"]["findings"].dump();
 }
 
 TEST_F(CliTest, DiscoverNamesAHiddenJenkinsSliderFromASteppedSineTable) {

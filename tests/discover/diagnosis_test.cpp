@@ -283,6 +283,36 @@ TEST(JointBehaviour, AGapIsAClearanceWhereContactIsMade) {
   EXPECT_GT(b.stiffness_change, 0.3);
 }
 
+TEST(JointBehaviour, ADampingThatGrowsBesideAHardeningIsNotNamedMicroslip) {
+  // A ground-vibration test's joint: c2 = 500 N s²/m² (D = 8/3 c2 ω² a³: power 3, as a
+  // microslip's with chi = 0) beside k3 = 1.6e8 N/m³ (k_eq = k + 3/4 k3 a²: it rises). Slip
+  // would soften the joint: the finding must not name microslip.
+  joints::Joint j{"tip",
+                  7,
+                  0,
+                  fem::Dof::uy,
+                  {Term::k, Term::c, Term::c2, Term::k3},
+                  {4800.0, 20.0, 500.0, 1.6e8},
+                  {false, false, false, false},
+                  {}};
+  std::vector<identify::EquivalentStiffness> points;
+  std::vector<std::string> names;
+  for (int i = 0; i < 8; ++i) {
+    const double a = 5e-4 * std::pow(6.0, i / 7.0), w = 2.0 * std::numbers::pi * 4.5;
+    points.push_back({a, w, joint_describing_function(j, a, w)});
+    names.push_back(std::to_string(i));
+  }
+  const auto b = behaviour("tip", points, names);
+  EXPECT_NEAR(b.slope, 3.0, 0.15) << b.finding;
+  const auto k_eq = [](double a) { return 4800.0 + 0.75 * 1.6e8 * a * a; };
+  EXPECT_NEAR(b.stiffness_change, k_eq(3e-3) / k_eq(5e-4) - 1.0, 1e-9) << b.finding; // 0.217
+  EXPECT_EQ(b.behaviour, "") << b.finding;
+  EXPECT_EQ(b.finding.find("microslip"), std::string::npos) << b.finding;
+  EXPECT_NE(b.finding.find("not slip alone"), std::string::npos) << b.finding;
+  // The same dissipation with a stiffness that falls (an Iwan's microslip) is still named so:
+  // AnIwanInMicroslipGrowsAsThreePlusChi.
+}
+
 TEST(JointBehaviour, ACubicStiffnessOrAViscousJointIsNeitherSlipNorClearance) {
   // k3 stiffens from zero amplitude on (k_eq = k + 3/4 k3 a²): not a contact closing.
   const auto cubic = behaviour_of(Term::k3, {}, 0.002, 0.05, 1.6e8);
