@@ -52,22 +52,47 @@ bool interval_determines(const joints::ParameterInfo& info, double value, double
   return hi - lo <= 2.0 * std::abs(value);
 }
 
-Complex describing_function(const joints::Joint& j, std::size_t t, double a, int samples) {
+Complex describing_function(const joints::Joint& j, std::size_t t, double a) {
   const double amplitude[1] = {a};
-  return describing_functions(j, t, amplitude, 0, samples).front();
+  return describing_functions(j, t, amplitude).front();
 }
 
+namespace {
+
+// N(a) of the sliders under y = a cos θ, the steady loop's first harmonic in closed form: an
+// element (k, φ) stuck (a ≤ φ) gives k; one that slips gives (k/π)(β − ½ sin 2β + i sin²β),
+// cos β = 1 − 2φ/a (the in-phase part falls from k at a = φ; the quadrature part is the loop's
+// area 4kφ(a − φ) over π a²).
+Complex sliders_describing_function(const joints::Sliders& s, double a) {
+  double re = 0.0, im = 0.0;
+  for (int i = 0; i < s.size(); ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    const double k = s.stiffness[u], phi = s.reach[u];
+    if (a <= phi) {
+      re += k;
+      continue;
+    }
+    const double cb = 1.0 - 2.0 * phi / a, beta = std::acos(cb), sb2 = 1.0 - cb * cb;
+    re += k / std::numbers::pi * (beta - std::sqrt(sb2) * cb); // ½ sin 2β = sin β cos β
+    im += k / std::numbers::pi * sb2;
+  }
+  return {re, im};
+}
+
+// N(a) of the clearance under y = a cos θ: 0 while a ≤ δ, then kg (1 − (2/π)(asin r +
+// r √(1 − r²))), r = δ/a; real (the force is a single-valued function of y).
+double gap_describing_function(double delta, double kg, double a) {
+  if (a <= delta) return 0.0;
+  const double r = delta / a;
+  return kg * (1.0 - 2.0 / std::numbers::pi * (std::asin(r) + r * std::sqrt(1.0 - r * r)));
+}
+
+} // namespace
+
 std::vector<Complex> describing_functions(const joints::Joint& j, std::size_t t,
-                                          std::span<const double> amplitudes, int per_efold,
-                                          int samples) {
+                                          std::span<const double> amplitudes, int per_efold) {
   std::vector<Complex> out(amplitudes.size());
   if (amplitudes.empty()) return out;
-  const auto n = static_cast<std::size_t>(samples);
-  std::vector<double> cosine(n), sine(n), y(n), g(n);
-  for (std::size_t s = 0; s < n; ++s) {
-    const double theta = 2.0 * std::numbers::pi * static_cast<double>(s) / samples;
-    cosine[s] = std::cos(theta), sine[s] = std::sin(theta);
-  }
   const bool gap = j.terms[t] == joints::Term::gap;
   joints::Sliders sliders;
   double delta = 0.0, kg = 0.0;
@@ -103,23 +128,10 @@ std::vector<Complex> describing_functions(const joints::Joint& j, std::size_t t,
     std::sort(nodes.begin(), nodes.end());
     if (nodes.size() < amplitudes.size()) at = std::move(nodes);
   }
-  joints::LoopWork work;
   std::vector<Complex> N(at.size());
-  for (std::size_t i = 0; i < at.size(); ++i) {
-    const double a = at[i];
-    for (std::size_t s = 0; s < n; ++s)
-      y[s] = a * cosine[s];
-    if (gap) {
-      for (std::size_t s = 0; s < n; ++s)
-        g[s] = joints::gap_force(delta, kg, y[s]);
-    } else {
-      joints::steady_loop(sliders, y, false, g, nullptr, work);
-    }
-    Complex G1 = 0.0; // g = Re(G₁ e^{iθ}) + …: G₁ = (2/n) Σ g e^{−iθ}
-    for (std::size_t s = 0; s < n; ++s)
-      G1 += g[s] * Complex(cosine[s], -sine[s]);
-    N[i] = G1 * (2.0 / samples) / a;
-  }
+  for (std::size_t i = 0; i < at.size(); ++i)
+    N[i] = gap ? Complex(gap_describing_function(delta, kg, at[i]), 0.0)
+               : sliders_describing_function(sliders, at[i]);
   if (at.size() == amplitudes.size()) return N;
   // Linear in ln a between the grid's nodes.
   for (std::size_t i = 0; i < amplitudes.size(); ++i) {

@@ -25,9 +25,12 @@
 
 namespace jointid::identify {
 
-/// N(a) of term t of the joint (its parameters checked): G₁/a under y = a cos θ.
+/// N(a) of term t of the joint (its parameters checked): G₁/a under y = a cos θ, the steady
+/// loop's first harmonic, in closed form (each slider of a jenkins or an iwan stuck, k, or
+/// slipping, (k/π)(β − ½ sin 2β + i sin²β) with cos β = 1 − 2φ/a; the gap's kg (1 − (2/π)(asin r
+/// + r √(1 − r²))), r = δ/a) — the continuous loop, which joints::steady_loop samples.
 std::complex<double> describing_function(const joints::Joint& joint, std::size_t term,
-                                         double amplitude, int samples = 128);
+                                         double amplitude);
 /// The same at every amplitude of `amplitudes` (m, > 0), the term's sliders built once. With
 /// `per_efold` > 0 and more amplitudes than that grid needs, N is computed on a grid evenly
 /// spaced in ln a (`per_efold` points per factor e, spanning the amplitudes, with the onsets of
@@ -39,7 +42,7 @@ std::complex<double> describing_function(const joints::Joint& joint, std::size_t
 /// For a fit's start, not for a result.
 std::vector<std::complex<double>> describing_functions(const joints::Joint& joint, std::size_t term,
                                                        std::span<const double> amplitudes,
-                                                       int per_efold = 0, int samples = 128);
+                                                       int per_efold = 0);
 
 /// The sine that stands for joint j's deformation in a test: a sine test's fundamental (|Y₁|
 /// in m, ω = 2π f); a periodic test's lines (Measurement::lines) as one sine of the same RMS,
