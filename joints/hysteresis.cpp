@@ -142,8 +142,14 @@ double slide_trial(const Sliders& s, std::span<const double> x, double y, double
 
 namespace {
 
-// The elements in order of φ (a joint's terms appended may not be), with prefix sums.
+// The elements in order of φ (a joint's terms appended may not be), with prefix sums; kept
+// from the last call with the same sliders.
 void order(const Sliders& s, LoopWork& w) {
+  if (w.from_stiffness == s.stiffness && w.from_reach == s.reach &&
+      w.K.size() == s.stiffness.size() + 1)
+    return;
+  w.from_stiffness = s.stiffness;
+  w.from_reach = s.reach;
   const std::size_t n = s.stiffness.size();
   w.k = s.stiffness;
   w.phi = s.reach;

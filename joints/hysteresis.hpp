@@ -100,7 +100,10 @@ struct LoopWork {
     double e = 0.0, s = 0.0;
   };
   std::vector<double> k, phi, K, P; ///< in order of φ; K, P: prefix sums of k and k φ
-  std::vector<Group> groups;        ///< largest φ first
+  /// The sliders k, phi, K and P were made from (a loop of the same sliders reuses them: a
+  /// harmonic balance's every residual).
+  std::vector<double> from_stiffness, from_reach;
+  std::vector<Group> groups; ///< largest φ first
   std::vector<double> x, x_start;
 };
 

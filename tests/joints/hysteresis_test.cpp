@@ -317,3 +317,33 @@ TEST(Gap, NoForceInsideTheClearanceContactStiffnessBeyond) {
   // no clearance: a linear spring
   EXPECT_DOUBLE_EQ(gap_force(0.0, kg, 2e-3), kg * 2e-3);
 }
+
+TEST(SteadyLoop, AWorkReusedForOtherSlidersGivesTheirOwnLoop) {
+  // LoopWork keeps the sliders' order and prefix sums from its last call: a call with other
+  // sliders — the same number, only one value changed, or appended out of order — must give
+  // exactly what a fresh work gives.
+  const std::vector<double> y = sine(2e-3, 128);
+  const std::vector<Sliders> sets{
+      iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20), iwan_sliders(3.0, 1.0e4, -0.5, 0.2, 20),
+      iwan_sliders(3.0, 1.1e4, -0.5, 0.2, 20), jenkins_sliders(1.0e4, 3.0),
+      [] {
+        Sliders s = jenkins_sliders(2.0e4, 40.0); // reach 2e-3, then smaller ones
+        s.append(iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20));
+        return s;
+      }(),
+      iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20)};
+  LoopWork reused;
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    std::vector<double> g(y.size()), fresh(y.size());
+    std::vector<LoopEntry> d, fresh_d;
+    ASSERT_TRUE(steady_loop(sets[i], y, false, g, &d, reused));
+    LoopWork own;
+    ASSERT_TRUE(steady_loop(sets[i], y, false, fresh, &fresh_d, own));
+    EXPECT_EQ(g, fresh) << "set " << i;
+    ASSERT_EQ(d.size(), fresh_d.size()) << "set " << i;
+    for (std::size_t e = 0; e < d.size(); ++e)
+      EXPECT_TRUE(d[e].n == fresh_d[e].n && d[e].m == fresh_d[e].m &&
+                  d[e].value == fresh_d[e].value)
+          << "set " << i << " entry " << e;
+  }
+}
