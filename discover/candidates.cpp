@@ -1,6 +1,7 @@
 #include "discover/candidates.hpp"
 
 #include "discover/diagnosis.hpp"
+#include "discover/refine.hpp"
 #include "discover/selection.hpp"
 #include "fem/constants.hpp"
 #include "fem/minimise.hpp"
@@ -15,6 +16,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <span>
 #include <stdexcept>
 
 namespace jointid::discover::detail {
@@ -301,13 +303,20 @@ Outcome consider_damping(const Problem& problem, const State& state) {
   const Compared& compared = problem.compared();
   Candidate c;
   c.joint = "substructure";
-  std::map<double, State> tried;
-  auto trial = [&](double u) -> double {
+  // With more tests than a refinement's spread (RefineScope::spread), the search runs on that
+  // spread alone (the trials, all with the same parameters, compared by their gap there), and
+  // the scale it finds is then judged on every test, with one parabolic step from the
+  // misfit's curvature there: a table's hundreds of tests fix one scale far beyond what the
+  // search needs.
+  const std::vector<int> skip = problem.outside_spread(RefineScope{}.spread);
+  // Trials on the tests `out` leaves (the spread, or all of them), kept by ln s.
+  const auto evaluate = [&](std::map<double, State>& tried, double u,
+                            std::span<const int> out) -> double {
     if (const auto it = tried.find(u); it != tried.end()) return it->second.criterion;
     try {
       const auto sim = problem.make_simulator(std::exp(u), false);
       const identify::FitResult fit = problem.identify(state.joints, *sim, problem.all_tests());
-      State st = problem.evaluate(fit.identified(state.joints), *sim);
+      State st = problem.evaluate(fit.identified(state.joints), *sim, nullptr, out);
       st.fit = fit;
       // The trials are compared with each other: each must re-simulate every test the model
       // now does.
@@ -323,33 +332,50 @@ Outcome consider_damping(const Problem& problem, const State& state) {
       return inf;
     }
   };
+  std::map<double, State> searched, on_all;
+  std::map<double, State>& judged = skip.empty() ? searched : on_all; // on every test
+  const auto search = [&](double u) { return evaluate(searched, u, skip); };
+  const auto trial = [&](double u) { return evaluate(judged, u, {}); };
   const double lo = std::log(0.05), hi = std::log(20.0);
   double best_u = 0.0, best_f = inf;
   for (int i = 0; i <= 6; ++i) {
-    const double u = lo + (hi - lo) * i / 6.0, f = trial(u);
+    const double u = lo + (hi - lo) * i / 6.0, f = search(u);
     if (f < best_f) best_f = f, best_u = u;
   }
   const double width = (hi - lo) / 6.0;
-  fem::golden_section_minimum(trial, best_u - width, best_u + width, 10); // (tried: the best)
-  if (tried.empty()) return refused(std::move(c), state, "no damping scale gives a model");
-  const double u = std::min_element(tried.begin(), tried.end(), [](const auto& x, const auto& y) {
-                     return x.second.criterion < y.second.criterion;
-                   })->first;
+  fem::golden_section_minimum(search, best_u - width, best_u + width, 10); // (tried: the best)
+  if (searched.empty()) return refused(std::move(c), state, "no damping scale gives a model");
+  const auto lowest = [](const std::map<double, State>& tried) {
+    return std::min_element(
+               tried.begin(), tried.end(),
+               [](const auto& x, const auto& y) { return x.second.criterion < y.second.criterion; })
+        ->first;
+  };
+  double u = lowest(searched);
   // Its uncertainty from the curvature of the misfit in ln s: χ² with known noise, else
   // S / σ̂² with σ̂² = S_min / (N − p); σ_u² = 2 / (∂²misfit/∂u²).
   const double h = 0.02;
   double sigma_u = nan;
-  if (std::isfinite(trial(u + h)) && std::isfinite(trial(u - h))) {
-    const State &s0 = tried.at(u), &sp = tried.at(u + h), &sm = tried.at(u - h);
+  if (std::isfinite(trial(u)) && std::isfinite(trial(u + h)) && std::isfinite(trial(u - h))) {
+    const State &s0 = judged.at(u), &sp = judged.at(u + h), &sm = judged.at(u - h);
     const double sigma2 =
         s0.gap * s0.gap * compared.measured2 / std::max(1, compared.values - s0.parameters);
     auto misfit = [&](const State& st) {
       return compared.noise_known ? st.chi2 : st.gap * st.gap * compared.measured2 / sigma2;
     };
-    const double curvature = (misfit(sp) - 2.0 * misfit(s0) + misfit(sm)) / (h * h);
-    if (curvature > 0.0) sigma_u = std::sqrt(2.0 / curvature);
+    const double m0 = misfit(s0), mp = misfit(sp), mm = misfit(sm);
+    const double curvature = (mp - 2.0 * m0 + mm) / (h * h);
+    if (curvature > 0.0) {
+      sigma_u = std::sqrt(2.0 / curvature);
+      // Searched on the spread: the parabola's vertex on every test, where it lies further
+      // than the step (within the search's bracket).
+      const double vertex = std::clamp(u - (mp - mm) / (2.0 * h * curvature), u - width, u + width);
+      if (!skip.empty() && std::abs(vertex - u) > h) (void)trial(vertex);
+    }
   }
-  State st = tried.at(u);
+  if (judged.empty()) return refused(std::move(c), state, "no damping scale gives a model");
+  if (!skip.empty()) u = lowest(judged);
+  State st = judged.at(u);
   c.value = std::exp(u);
   c.std = c.value * sigma_u;
   c.ci_low = std::exp(u - 1.96 * sigma_u);

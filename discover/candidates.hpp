@@ -54,7 +54,9 @@ Outcome consider_pair(const Problem& problem, const State& state, const Simulato
 Outcome consider_variation(const Problem& problem, const State& state, const Simulator& sim,
                            const std::string& joint, joints::Term term);
 /// The substructure's damping scaled by s: ln s is searched by a coarse scan and a golden
-/// section on the criterion, every joint term identified again at each trial.
+/// section on the criterion, every joint term identified again at each trial. With more tests
+/// than RefineScope::spread, the search runs on that spread of them, and the scale is then
+/// judged on every test with one parabolic step from the misfit's curvature there.
 Outcome consider_damping(const Problem& problem, const State& state);
 
 /// Every candidate of a step from `state` (simulated with `current`), as jobs to run in

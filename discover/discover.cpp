@@ -475,7 +475,8 @@ private:
         const Simulator& sim = own ? *own : current;
         State refined = refine(problem_, states[i], sim, scope());
         // Also from the model now with the term at 0; the better of the two (on the same tests).
-        if (const auto js = nested_start(ranking[i], states[i], now)) {
+        // Not while a path is screened: the one start is near enough for a screen.
+        if (const auto js = screening_ ? std::nullopt : nested_start(ranking[i], states[i], now)) {
           State start = problem_.evaluate(*js, sim, &now);
           start.fit = states[i].fit;
           if (std::isfinite(start.criterion)) {

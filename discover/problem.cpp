@@ -256,6 +256,14 @@ std::vector<int> Problem::spread(std::size_t taken) const {
   return out;
 }
 
+std::vector<int> Problem::outside_spread(std::size_t taken) const {
+  const std::vector<int> kept = spread(taken);
+  std::vector<int> out;
+  for (int i = 0; i < static_cast<int>(tests_.size()); ++i)
+    if (!std::binary_search(kept.begin(), kept.end(), i)) out.push_back(i);
+  return out;
+}
+
 std::vector<std::string> Problem::sources(const std::vector<int>& tests) const {
   std::vector<std::string> out;
   for (int i : tests)

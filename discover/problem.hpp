@@ -70,6 +70,8 @@ public:
   /// it, and an even spread by index misses them): half of them those whose measured values
   /// are largest (their sum of squares), the rest an even spread of the others.
   std::vector<int> spread(std::size_t taken) const;
+  /// The tests that spread(taken) leaves out, ascending (none when taken covers them all).
+  std::vector<int> outside_spread(std::size_t taken) const;
   /// The sources of these tests ("table.csv:12"), for messages.
   std::vector<std::string> sources(const std::vector<int>& tests) const;
 

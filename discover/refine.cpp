@@ -544,12 +544,8 @@ State refine_from(const Problem& problem, const State& start, const Simulator& s
   const int n = static_cast<int>(problem.tests().size());
   if (scope.spread > 0 && n > scope.spread) {
     // First stage: a spread of the tests (those the start re-simulated, not held out).
-    std::vector<int> skip;
-    const std::vector<int> spread = problem.spread(static_cast<std::size_t>(scope.spread));
-    for (int i = 0; i < n; ++i)
-      if (!std::binary_search(spread.begin(), spread.end(), i)) skip.push_back(i);
     OutputError first(problem, sim, start);
-    first.skip(skip);
+    first.skip(problem.outside_spread(static_cast<std::size_t>(scope.spread)));
     first.compare_on(begin, scope.held_out);
     const State reached = first.search(start, begin, scope.iterations);
     // Every test at the values reached; kept where it is no worse than the start on them.
