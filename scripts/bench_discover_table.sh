@@ -5,8 +5,11 @@
 # a 0.4 m steel cantilever, 0.3 % modal damping, a joint at its tip with k, c and a hidden
 # softening k3 and cubic damping c3), made by `jointid simulate --method hb --table` with 1 %
 # noise on the time samples. Prints the wall and CPU time of the discovery (without pictures,
-# then with them when xvfb-run is there) and what it found. Uses an existing build:
-# JOINTID=path/to/jointid (default build/cli/jointid). Output under out/bench_discover_table/.
+# then with them when xvfb-run is there) and what it found; then, with SEEDS="2 3 …" (default
+# none), the same table with each of those noise seeds (the path a discovery screens can differ
+# between them, and its time with it), without pictures, its time, result and screened path.
+# Uses an existing build: JOINTID=path/to/jointid (default build/cli/jointid). Output under
+# out/bench_discover_table/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 J=${JOINTID:-build/cli/jointid}
@@ -73,3 +76,14 @@ if command -v xvfb-run > /dev/null; then
     xvfb-run -a "$J" discover "$out/start.toml" "$out/table/stepped_sine.csv" \
     -o "$out/discovery_pictures" 2> >(grep -v '^jointid: warning' >&2) > /dev/null
 fi
+for seed in ${SEEDS:-}; do
+  "$J" simulate "$out/truth.toml" --force 11:uy --freq "$freqs" --amplitude "$levels" \
+    --method hb --table --channels a --noise 0.01 --seed "$seed" -o "$out/table_$seed" > /dev/null
+  echo "seed $seed, load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+  /usr/bin/time -f "discover --no-plot: %e s wall, %U s user, %S s system" \
+    "$J" discover "$out/start.toml" "$out/table_$seed/stepped_sine.csv" \
+    -o "$out/discovery_$seed" --no-plot 2> >(grep -v '^jointid: warning' >&2) > /dev/null
+  grep '^\*\*Result' "$out/discovery_$seed/report.md"
+  grep -o 'own noise, the path ([^)]*) ends at a criterion of [^ ]*' "$out/discovery_$seed/report.md" ||
+    true
+done
