@@ -323,15 +323,17 @@ TEST(SteadyLoop, AWorkReusedForOtherSlidersGivesTheirOwnLoop) {
   // sliders — the same number, only one value changed, or appended out of order — must give
   // exactly what a fresh work gives.
   const std::vector<double> y = sine(2e-3, 128);
-  const std::vector<Sliders> sets{
-      iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20), iwan_sliders(3.0, 1.0e4, -0.5, 0.2, 20),
-      iwan_sliders(3.0, 1.1e4, -0.5, 0.2, 20), jenkins_sliders(1.0e4, 3.0),
-      [] {
-        Sliders s = jenkins_sliders(2.0e4, 40.0); // reach 2e-3, then smaller ones
-        s.append(iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20));
-        return s;
-      }(),
-      iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20)};
+  const std::vector<Sliders> sets{iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20),
+                                  iwan_sliders(3.0, 1.0e4, -0.5, 0.2, 20),
+                                  iwan_sliders(3.0, 1.1e4, -0.5, 0.2, 20),
+                                  jenkins_sliders(1.0e4, 3.0),
+                                  [] {
+                                    Sliders s = jenkins_sliders(
+                                        2.0e4, 40.0); // reach 2e-3, then smaller ones
+                                    s.append(iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20));
+                                    return s;
+                                  }(),
+                                  iwan_sliders(3.0, 1.0e4, -0.5, 0.1, 20)};
   LoopWork reused;
   for (std::size_t i = 0; i < sets.size(); ++i) {
     std::vector<double> g(y.size()), fresh(y.size());
